@@ -1,0 +1,88 @@
+//! Analyses: algorithms that turn a [`crate::model::Model`] and an initial
+//! [`crate::state::State`] into a sequence of converged states.
+//!
+//! An analysis reports its progress to an [`Observer`]: every Newton
+//! iteration, every converged increment (with the state, for output) and
+//! every cut-back. The library never prints; the command-line tool turns
+//! these events into log lines, a progress bar and result files.
+
+pub mod newton;
+pub mod statics;
+
+pub use newton::{ConvergenceNorms, NewtonFailure};
+pub use statics::{StaticAnalysis, StaticOutcome};
+
+use crate::model::Model;
+use crate::state::State;
+
+/// One Newton iteration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IterationInfo {
+    /// Increment number (0 is the initial equilibrium at `t = 0`).
+    pub increment: usize,
+    /// Iteration number within the increment (0: before any correction).
+    pub iteration: usize,
+    /// Load parameter.
+    pub time: f64,
+    /// Norms measured at this iteration.
+    pub norms: ConvergenceNorms,
+}
+
+/// A converged increment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IncrementInfo {
+    /// Increment number (0 is the initial equilibrium at `t = 0`).
+    pub increment: usize,
+    /// Load parameter reached.
+    pub time: f64,
+    /// Size of the increment.
+    pub step: f64,
+    /// Newton iterations (corrections) it took.
+    pub iterations: usize,
+    /// Relative residual at each iteration, from the first evaluation to
+    /// the converged one.
+    pub residuals: Vec<f64>,
+    /// Whether results are to be written for this increment.
+    pub output: bool,
+}
+
+/// An increment that failed and is retried with a smaller step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CutbackInfo {
+    /// Increment number being attempted.
+    pub increment: usize,
+    /// Load parameter at the start of the increment.
+    pub time: f64,
+    /// Step that failed.
+    pub failed_step: f64,
+    /// Step that will be tried next.
+    pub next_step: f64,
+    /// Why it failed.
+    pub reason: NewtonFailure,
+}
+
+/// Receives the events of an analysis. Every method has an empty default.
+pub trait Observer {
+    /// After each residual evaluation of a Newton iteration.
+    fn iteration(&mut self, _info: &IterationInfo) {}
+
+    /// After each converged increment; returning an error stops the
+    /// analysis (used by result writers when a file cannot be written).
+    fn increment(
+        &mut self,
+        _info: &IncrementInfo,
+        _model: &Model,
+        _state: &State,
+        _reactions: &[f64],
+    ) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    /// When an increment is cut back.
+    fn cutback(&mut self, _info: &CutbackInfo) {}
+}
+
+/// An observer that ignores everything.
+pub struct NoObserver;
+
+impl Observer for NoObserver {}

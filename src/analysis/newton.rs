@@ -1,0 +1,392 @@
+//! Newton–Raphson on the nodes' configuration manifold: the solver shared
+//! by every analysis.
+//!
+//! One iteration (docs/theory.md §7):
+//! 1. assemble `r(q)` and `K = ∂r/∂q` at the current state;
+//! 2. stop if the residual and the last correction are small (below);
+//! 3. solve `K Δq = −r` with the sparse LU, whose symbolic analysis is
+//!    computed once and reused;
+//! 4. update translations additively and rotations multiplicatively,
+//!    `x ← x + Δx`, `R ← R exp(ΔΘ~)`.
+//!
+//! Convergence requires both
+//! - **residual**: for forces and for moments separately,
+//!   `‖r‖₂ ≤ ε_r · ‖flux‖₂`, where the flux `Σₑ|rₑ|` measures the forces
+//!   flowing through each dof (reactions included), or `‖r‖₂ ≤ 10⁻¹²·k·L`,
+//!   the round-off floor of a structure of stiffness `k = max Kᵢᵢ` and size
+//!   `L`;
+//! - **increment**: `max|Δx| ≤ ε_u · L` and `max|ΔΘ| ≤ ε_θ`, for the last
+//!   correction (not required when the residual is already satisfied
+//!   before any correction).
+
+use super::{IterationInfo, Observer};
+use crate::assembly::Assembler;
+use crate::dofs::{DofKind, DofMap, NO_EQUATION};
+use crate::elements::EvalContext;
+use crate::linalg::{smallest_relative_pivot, SolveError, SparseLu};
+use crate::model::{Model, StaticSettings, COMPONENT_NAMES};
+use crate::so3::{self, Vec3};
+use crate::state::State;
+
+/// A relative pivot below this marks the tangent as singular (round-off of
+/// an exactly singular matrix is ~1e-16; a stiff but sound structure is far
+/// above).
+const SINGULAR_PIVOT: f64 = 1e-11;
+
+/// Corrections larger than this (times the model size, or in radians)
+/// mean the tangent is singular or nearly so.
+const RUNAWAY_CORRECTION: f64 = 1e6;
+
+/// The round-off floor of the residual, relative to `k·L`.
+const RESIDUAL_FLOOR: f64 = 1e-12;
+
+/// A relative residual above this after the first correction is divergence.
+const DIVERGED_RESIDUAL: f64 = 1e10;
+
+/// Norms of one Newton iteration.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ConvergenceNorms {
+    /// `‖r‖₂` over free translation equations.
+    pub residual_force: f64,
+    /// `‖r‖₂` over free rotation equations.
+    pub residual_moment: f64,
+    /// `‖flux‖₂` over all translation dofs.
+    pub flux_force: f64,
+    /// `‖flux‖₂` over all rotation dofs.
+    pub flux_moment: f64,
+    /// `max(‖r_F‖/ref_F, ‖r_M‖/ref_M)` with `ref = max(‖flux‖, floor/ε_r)`:
+    /// the residual criterion holds when this is at most `ε_r`.
+    pub relative_residual: f64,
+    /// `max|Δx|` of the last correction (0 before the first).
+    pub displacement_correction: f64,
+    /// `max|ΔΘ|` of the last correction (0 before the first).
+    pub rotation_correction: f64,
+}
+
+/// Why Newton iterations stopped without converging.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum NewtonFailure {
+    /// The iteration limit was reached.
+    #[error(
+        "no convergence in {iterations} iterations (relative residual {relative_residual:.3e})"
+    )]
+    MaxIterations {
+        /// Iterations done.
+        iterations: usize,
+        /// Last relative residual.
+        relative_residual: f64,
+    },
+    /// The residual grew beyond any hope.
+    #[error("diverging at iteration {iteration} (relative residual {relative_residual:.3e})")]
+    Diverging {
+        /// Iteration at which divergence was detected.
+        iteration: usize,
+        /// Relative residual then.
+        relative_residual: f64,
+    },
+    /// NaN or infinite values appeared.
+    #[error("non-finite values at iteration {iteration}")]
+    NonFinite {
+        /// Iteration at which they appeared.
+        iteration: usize,
+    },
+    /// The tangent is singular.
+    #[error("singular tangent: no stiffness for {dof} (relative pivot {pivot:.1e}); the structure is a mechanism or is not restrained there")]
+    Singular {
+        /// The unknown without stiffness, e.g. `node 5 rz`.
+        dof: String,
+        /// Relative pivot size.
+        pivot: f64,
+    },
+}
+
+/// A converged Newton solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewtonResult {
+    /// Corrections applied.
+    pub iterations: usize,
+    /// Relative residual at each evaluation.
+    pub residuals: Vec<f64>,
+}
+
+/// Newton–Raphson solver: dof numbering, assembly storage, sparse LU and
+/// work vectors, all allocated once.
+pub struct NewtonSolver {
+    /// Numbering of the free unknowns.
+    pub dofs: DofMap,
+    assembler: Assembler,
+    lu: Option<SparseLu>,
+    rhs: Vec<f64>,
+    /// `max Kᵢᵢ` over translation and rotation equations, from the first
+    /// tangent (sets the residual floor).
+    stiffness_scale: Option<(f64, f64)>,
+}
+
+impl NewtonSolver {
+    /// Prepares numbering, pattern and buffers for `model`.
+    pub fn new(model: &Model) -> Self {
+        let dofs = DofMap::new(model);
+        let assembler = Assembler::new(model, &dofs);
+        let n = dofs.n_equations();
+        Self {
+            dofs,
+            assembler,
+            lu: None,
+            rhs: vec![0.0; n],
+            stiffness_scale: None,
+        }
+    }
+
+    /// Residual at every dof after the last evaluation: at fixed dofs, the
+    /// reactions of the supports (`r = f_int − f_ext` there).
+    pub fn residual(&self) -> &[f64] {
+        &self.assembler.residual
+    }
+
+    /// Number of stored entries of the system matrix.
+    pub fn nnz(&self) -> usize {
+        self.assembler.matrix.nnz()
+    }
+
+    /// Describes a dof for messages: `node 5 rz`, `spring 3 unknown 1`.
+    pub fn dof_label(&self, model: &Model, dof: usize) -> String {
+        match self.dofs.node_component(dof) {
+            Some((node, c)) => format!("node {} {}", model.node_ids[node], COMPONENT_NAMES[c]),
+            None => {
+                // find the element owning the extra unknown
+                let mut k = dof - 6 * model.n_nodes();
+                for e in &model.elements {
+                    if k < e.n_extra() {
+                        return format!("{} {} unknown {}", e.kind().name(), e.id(), k + 1);
+                    }
+                    k -= e.n_extra();
+                }
+                format!("dof {dof}")
+            }
+        }
+    }
+
+    /// Assembles residual (and tangent if asked) at `state` and `time`.
+    pub fn assemble(&mut self, model: &Model, state: &State, time: f64, need_tangent: bool) {
+        let ctx = EvalContext {
+            time,
+            curves: &model.curves,
+            gravity: model.gravity_at(time),
+            need_tangent,
+            dynamics: None,
+        };
+        self.assembler.assemble(model, &ctx, state);
+    }
+
+    /// Residual and flux norms of the last assembly. The relative residual
+    /// is measured against `max(flux, floor/ε_r)`, so that it is below
+    /// `ε_r` exactly when the residual criterion holds.
+    fn norms(&self, floor: (f64, f64), tol: f64) -> ConvergenceNorms {
+        let (mut rf, mut rm, mut ff, mut fm) = (0.0, 0.0, 0.0, 0.0);
+        let res = &self.assembler.residual;
+        let flux = &self.assembler.flux;
+        for dof in 0..res.len() {
+            let free = self.dofs.equation(dof) != NO_EQUATION;
+            let r2 = if free { res[dof] * res[dof] } else { 0.0 };
+            match self.dofs.kind(dof) {
+                DofKind::Translation => {
+                    rf += r2;
+                    ff += flux[dof] * flux[dof];
+                }
+                DofKind::Rotation => {
+                    rm += r2;
+                    fm += flux[dof] * flux[dof];
+                }
+                DofKind::Extra => {}
+            }
+        }
+        let (rf, rm, ff, fm) = (rf.sqrt(), rm.sqrt(), ff.sqrt(), fm.sqrt());
+        let rel = |r: f64, f: f64, floor: f64| {
+            if r == 0.0 {
+                0.0
+            } else {
+                r / f.max(floor / tol).max(f64::MIN_POSITIVE)
+            }
+        };
+        ConvergenceNorms {
+            residual_force: rf,
+            residual_moment: rm,
+            flux_force: ff,
+            flux_moment: fm,
+            relative_residual: rel(rf, ff, floor.0).max(rel(rm, fm, floor.1)),
+            displacement_correction: 0.0,
+            rotation_correction: 0.0,
+        }
+    }
+
+    /// Largest diagonal entries of the tangent for translation and rotation
+    /// equations.
+    fn diagonal_scale(&self) -> (f64, f64) {
+        let (mut kf, mut km) = (0.0f64, 0.0f64);
+        let m = &self.assembler.matrix;
+        for eq in 0..self.dofs.n_equations() {
+            let d = m.position(eq, eq).map_or(0.0, |p| m.values()[p].abs());
+            match self.dofs.kind(self.dofs.dof(eq)) {
+                DofKind::Translation => kf = kf.max(d),
+                DofKind::Rotation => km = km.max(d),
+                DofKind::Extra => {}
+            }
+        }
+        (kf, km)
+    }
+
+    /// Iterates to equilibrium at load parameter `time`, starting from
+    /// `state` (which holds the prescribed values for `time`).
+    pub fn solve(
+        &mut self,
+        model: &Model,
+        settings: &StaticSettings,
+        state: &mut State,
+        time: f64,
+        increment: usize,
+        observer: &mut dyn Observer,
+    ) -> Result<NewtonResult, NewtonFailure> {
+        let length = model.length_scale;
+        let mut residuals = Vec::new();
+        let mut last_correction = None::<(f64, f64)>;
+        for iteration in 0..=settings.max_iterations {
+            // assemble residual and tangent
+            self.assemble(model, state, time, true);
+            if self.stiffness_scale.is_none() {
+                self.stiffness_scale = Some(self.diagonal_scale());
+            }
+            let scale = self.stiffness_scale.expect("set above");
+            let tol = settings.residual_tolerance;
+            let floor = (RESIDUAL_FLOOR * scale.0 * length, RESIDUAL_FLOOR * scale.1);
+            let mut norms = self.norms(floor, tol);
+            if let Some((dx, dth)) = last_correction {
+                norms.displacement_correction = dx;
+                norms.rotation_correction = dth;
+            }
+            residuals.push(norms.relative_residual);
+            observer.iteration(&IterationInfo {
+                increment,
+                iteration,
+                time,
+                norms,
+            });
+            if !(norms.residual_force.is_finite() && norms.residual_moment.is_finite()) {
+                return Err(NewtonFailure::NonFinite { iteration });
+            }
+
+            // convergence: residual and last correction
+            let residual_ok = norms.relative_residual <= tol;
+            let correction_ok = last_correction.is_none_or(|(dx, dth)| {
+                dx <= settings.displacement_tolerance * length && dth <= settings.rotation_tolerance
+            });
+            if residual_ok && correction_ok {
+                return Ok(NewtonResult {
+                    iterations: iteration,
+                    residuals,
+                });
+            }
+            if iteration == settings.max_iterations {
+                return Err(NewtonFailure::MaxIterations {
+                    iterations: iteration,
+                    relative_residual: norms.relative_residual,
+                });
+            }
+            if iteration > 0 && norms.relative_residual > DIVERGED_RESIDUAL {
+                return Err(NewtonFailure::Diverging {
+                    iteration,
+                    relative_residual: norms.relative_residual,
+                });
+            }
+
+            // solve K Δq = −r
+            for (eq, r) in self.rhs.iter_mut().enumerate() {
+                *r = -self.assembler.residual[self.dofs.dof(eq)];
+            }
+            let solved = self.factor_and_solve();
+            let (dx, dth) = match solved {
+                Ok(()) => correction_size(&self.dofs, &self.rhs),
+                Err(_) => (f64::INFINITY, f64::INFINITY),
+            };
+            if !(dx <= RUNAWAY_CORRECTION * length && dth <= RUNAWAY_CORRECTION) {
+                return Err(self.diagnose(model, iteration));
+            }
+
+            // update: x ← x + Δx, R ← R exp(ΔΘ~), extras additively
+            self.update(model, state);
+            last_correction = Some((dx, dth));
+        }
+        unreachable!("the loop returns at max_iterations")
+    }
+
+    fn factor_and_solve(&mut self) -> Result<(), SolveError> {
+        if self.lu.is_none() {
+            self.lu = Some(SparseLu::analyze(&self.assembler.matrix)?);
+        }
+        let lu = self.lu.as_mut().expect("analysed above");
+        lu.factor(&self.assembler.matrix)?;
+        lu.solve_in_place(&mut self.rhs)
+    }
+
+    /// Explains a failed or runaway solve: singular (with the dof) or
+    /// non-finite.
+    fn diagnose(&self, model: &Model, iteration: usize) -> NewtonFailure {
+        match smallest_relative_pivot(&self.assembler.matrix) {
+            Ok((eq, pivot)) if pivot < SINGULAR_PIVOT => NewtonFailure::Singular {
+                dof: self.dof_label(model, self.dofs.dof(eq)),
+                pivot,
+            },
+            _ => NewtonFailure::NonFinite { iteration },
+        }
+    }
+
+    /// Applies the correction in `self.rhs` to `state`.
+    fn update(&self, model: &Model, state: &mut State) {
+        let n_nodes = model.n_nodes();
+        for node in 0..n_nodes {
+            let mut dx = Vec3::zeros();
+            let mut dth = Vec3::zeros();
+            let mut any_rotation = false;
+            for c in 0..6 {
+                let eq = self.dofs.equation(6 * node + c);
+                if eq == NO_EQUATION {
+                    continue;
+                }
+                if c < 3 {
+                    dx[c] = self.rhs[eq];
+                } else {
+                    dth[c - 3] = self.rhs[eq];
+                    any_rotation = true;
+                }
+            }
+            state.x[node] += dx;
+            if any_rotation {
+                state.q[node] = state.q[node] * so3::exp(&dth);
+                state.q[node].renormalize_fast();
+            }
+        }
+        for (k, v) in state.extra.iter_mut().enumerate() {
+            let eq = self.dofs.equation(6 * n_nodes + k);
+            if eq != NO_EQUATION {
+                *v += self.rhs[eq];
+            }
+        }
+    }
+}
+
+/// `(max|Δx|, max|ΔΘ|)` of a correction.
+fn correction_size(dofs: &DofMap, delta: &[f64]) -> (f64, f64) {
+    let (mut dx, mut dth) = (0.0f64, 0.0f64);
+    for (eq, &d) in delta.iter().enumerate() {
+        let a = if d.is_finite() {
+            d.abs()
+        } else {
+            f64::INFINITY
+        };
+        match dofs.kind(dofs.dof(eq)) {
+            DofKind::Translation => dx = dx.max(a),
+            DofKind::Rotation => dth = dth.max(a),
+            DofKind::Extra => {}
+        }
+    }
+    (dx, dth)
+}

@@ -1,0 +1,224 @@
+//! Nonlinear static analysis: Newton–Raphson over increments of the load
+//! parameter `t`, with automatic cut-back and regrowth.
+//!
+//! 1. Equilibrium at `t = 0` (pretension, loads whose curves start at a
+//!    non-zero value): increment 0.
+//! 2. Each increment moves `t` by `Δt`, sets prescribed motions to their
+//!    values at the new `t`, and iterates to equilibrium.
+//! 3. A failed increment (no convergence, divergence, singular tangent) is
+//!    restarted from the last converged state with `Δt/2`; the analysis
+//!    stops when `Δt` would fall below `min_increment`.
+//! 4. After an increment converged in at most [`EASY_ITERATIONS`]
+//!    iterations, `Δt` grows by [`GROWTH`], up to `max_increment`.
+//!
+//! Everything converged before a failure has already been passed to the
+//! observer, so result files written so far stay valid.
+
+use std::time::Instant;
+
+use super::newton::{NewtonFailure, NewtonSolver};
+use super::{CutbackInfo, IncrementInfo, Observer};
+use crate::model::Model;
+use crate::state::State;
+
+/// Increments converged in this many iterations or fewer let `Δt` grow.
+pub const EASY_ITERATIONS: usize = 5;
+/// Growth factor of `Δt` after an easy increment.
+pub const GROWTH: f64 = 1.5;
+/// Reduction factor of `Δt` after a failed increment.
+pub const CUTBACK: f64 = 0.5;
+
+/// Why a static analysis stopped before `end_time`.
+#[derive(Debug, thiserror::Error)]
+pub enum StaticError {
+    /// An increment failed with the smallest allowed step.
+    #[error("no convergence at increment {increment}: from t = {time} the step was cut back to {step:.3e} (below min_increment) and still failed: {reason}")]
+    Diverged {
+        /// Increment that failed.
+        increment: usize,
+        /// Last converged load parameter.
+        time: f64,
+        /// Last step tried.
+        step: f64,
+        /// Last failure.
+        reason: NewtonFailure,
+    },
+    /// Equilibrium could not be found in the initial configuration.
+    #[error("no equilibrium in the initial configuration (t = 0): {0}")]
+    Initial(NewtonFailure),
+    /// A result file could not be written.
+    #[error("writing results: {0}")]
+    Output(#[from] std::io::Error),
+}
+
+/// What a static analysis did.
+#[derive(Debug)]
+pub struct StaticOutcome {
+    /// Last converged state.
+    pub state: State,
+    /// Converged increments after the initial equilibrium.
+    pub increments: usize,
+    /// Newton iterations in all converged increments (increment 0 included).
+    pub iterations: usize,
+    /// Newton iterations spent in failed attempts.
+    pub wasted_iterations: usize,
+    /// Number of cut-backs.
+    pub cutbacks: usize,
+    /// Load parameter reached.
+    pub time: f64,
+    /// Wall-clock time in seconds.
+    pub wall_time: f64,
+    /// `None` if `end_time` was reached.
+    pub error: Option<StaticError>,
+}
+
+/// A nonlinear static analysis of a model.
+pub struct StaticAnalysis<'m> {
+    model: &'m Model,
+    solver: NewtonSolver,
+}
+
+impl<'m> StaticAnalysis<'m> {
+    /// Prepares the analysis: dof numbering, sparse pattern, buffers.
+    pub fn new(model: &'m Model) -> Self {
+        Self {
+            model,
+            solver: NewtonSolver::new(model),
+        }
+    }
+
+    /// Number of free unknowns.
+    pub fn n_equations(&self) -> usize {
+        self.solver.dofs.n_equations()
+    }
+
+    /// The Newton solver (for inspection: dof numbering, residual).
+    pub fn solver(&self) -> &NewtonSolver {
+        &self.solver
+    }
+
+    /// Runs from the reference configuration to `end_time`.
+    pub fn run(&mut self, observer: &mut dyn Observer) -> StaticOutcome {
+        let start = Instant::now();
+        let model = self.model;
+        let s = &model.settings;
+        let mut state = model.initial_state();
+        let mut outcome = StaticOutcome {
+            state: state.clone(),
+            increments: 0,
+            iterations: 0,
+            wasted_iterations: 0,
+            cutbacks: 0,
+            time: 0.0,
+            wall_time: 0.0,
+            error: None,
+        };
+        let finish = |mut o: StaticOutcome, state: State, error: Option<StaticError>| {
+            o.state = state;
+            o.error = error;
+            o.wall_time = start.elapsed().as_secs_f64();
+            o
+        };
+
+        // initial equilibrium, increment 0
+        model.apply_prescribed(&mut state, 0.0);
+        match self.solver.solve(model, s, &mut state, 0.0, 0, observer) {
+            Ok(r) => {
+                outcome.iterations += r.iterations;
+                let info = IncrementInfo {
+                    increment: 0,
+                    time: 0.0,
+                    step: 0.0,
+                    iterations: r.iterations,
+                    residuals: r.residuals,
+                    output: true,
+                };
+                if let Err(e) = observer.increment(&info, model, &state, self.solver.residual()) {
+                    return finish(outcome, state, Some(e.into()));
+                }
+            }
+            Err(f) => return finish(outcome, state, Some(StaticError::Initial(f))),
+        }
+
+        let mut t = 0.0;
+        let mut dt = s.initial_increment;
+        let mut backup = state.clone();
+
+        let mut increment = 1;
+        while t < s.end_time {
+            // step, snapped to end_time when within round-off of it
+            let mut step = dt.min(s.end_time - t);
+            if s.end_time - (t + step) <= 1e-9 * s.end_time {
+                step = s.end_time - t;
+            }
+            let t_new = t + step;
+            backup.clone_from(&state);
+            state.time = t_new;
+            model.apply_prescribed(&mut state, t_new);
+            match self
+                .solver
+                .solve(model, s, &mut state, t_new, increment, observer)
+            {
+                Ok(r) => {
+                    t = if t_new >= s.end_time {
+                        s.end_time
+                    } else {
+                        t_new
+                    };
+                    outcome.increments += 1;
+                    outcome.iterations += r.iterations;
+                    outcome.time = t;
+                    let output = increment % s.output_every == 0 || t >= s.end_time;
+                    let info = IncrementInfo {
+                        increment,
+                        time: t,
+                        step,
+                        iterations: r.iterations,
+                        residuals: r.residuals,
+                        output,
+                    };
+                    if let Err(e) = observer.increment(&info, model, &state, self.solver.residual())
+                    {
+                        return finish(outcome, state, Some(e.into()));
+                    }
+                    if r.iterations <= EASY_ITERATIONS {
+                        dt = (dt * GROWTH).min(s.max_increment);
+                    }
+                    increment += 1;
+                }
+                Err(reason) => {
+                    outcome.wasted_iterations += match &reason {
+                        NewtonFailure::MaxIterations { iterations, .. } => *iterations,
+                        NewtonFailure::Diverging { iteration, .. }
+                        | NewtonFailure::NonFinite { iteration } => *iteration,
+                        NewtonFailure::Singular { .. } => 0,
+                    };
+                    state.clone_from(&backup);
+                    let next = step * CUTBACK;
+                    if next < s.min_increment {
+                        return finish(
+                            outcome,
+                            state,
+                            Some(StaticError::Diverged {
+                                increment,
+                                time: t,
+                                step,
+                                reason,
+                            }),
+                        );
+                    }
+                    outcome.cutbacks += 1;
+                    observer.cutback(&CutbackInfo {
+                        increment,
+                        time: t,
+                        failed_step: step,
+                        next_step: next,
+                        reason,
+                    });
+                    dt = next;
+                }
+            }
+        }
+        finish(outcome, state, None)
+    }
+}

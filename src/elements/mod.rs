@@ -1,0 +1,243 @@
+//! Elements: everything that contributes to the residual and the tangent.
+//!
+//! Beams, rigid bodies, point masses, springs and nodal loads are all
+//! elements behind one small trait, [`Element`]; the assembler does not know
+//! which is which. The same trait carries what later analyses and joints
+//! need:
+//! - extra unknowns owned by an element ([`Element::n_extra`]): Lagrange
+//!   multipliers of joints, modal amplitudes of superelements. They follow
+//!   the node unknowns in the element's local vector;
+//! - internal variables ([`Element::n_internal`]): hysteresis, latch states,
+//!   read from the last converged state and updated at convergence;
+//! - inertia, damping and gyroscopic terms: [`EvalContext::dynamics`]
+//!   carries the integrator's coefficients when an analysis needs them
+//!   (statics leaves it `None`).
+//!
+//! ## Local unknowns and sign convention
+//! A node contributes 6 local unknowns: the translation increment `Δx`
+//! (global frame) and the incremental *material* rotation `ΔΘ`, with the
+//! update `R ← R exp(ΔΘ~)` (docs/theory.md §2). An element writes its
+//! contribution to the residual `r = f_int − f_ext` (so a load enters with a
+//! minus sign) and to the tangent `∂r/∂q`, column-major, derivatives taken
+//! along the update above.
+
+pub mod beam;
+pub mod load;
+pub mod mass;
+pub mod spring;
+
+use crate::curves::Curve;
+use crate::model::input::Id;
+use crate::so3::Vec3;
+use crate::state::State;
+
+/// The closed set of element kinds (for outputs and messages).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ElementKind {
+    /// Geometrically exact beam.
+    Beam,
+    /// Rigid body attached to a node.
+    RigidBody,
+    /// Point mass attached to a node.
+    PointMass,
+    /// Linear spring.
+    Spring,
+    /// Nodal force and moment.
+    NodalLoad,
+}
+
+impl ElementKind {
+    /// Lower-case name used in messages and output file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Beam => "beam",
+            Self::RigidBody => "rigid body",
+            Self::PointMass => "point mass",
+            Self::Spring => "spring",
+            Self::NodalLoad => "load",
+        }
+    }
+
+    /// Numeric code written to VTK files (cell data `kind`).
+    pub fn code(self) -> i32 {
+        match self {
+            Self::Beam => 1,
+            Self::RigidBody => 2,
+            Self::PointMass => 3,
+            Self::Spring => 4,
+            Self::NodalLoad => 5,
+        }
+    }
+}
+
+/// Shape of an element in the VTK output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellShape {
+    /// A line between the element's two nodes.
+    Line,
+    /// A vertex at the element's node.
+    Vertex,
+    /// Not drawn.
+    None,
+}
+
+/// Coefficients of a time integrator, for elements with inertia or damping.
+/// Reserved for dynamic analyses; statics passes `None`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DynamicsCoefficients {
+    /// `∂a/∂q`: factor of the mass matrix in the iteration matrix.
+    pub mass: f64,
+    /// `∂v/∂q`: factor of the damping matrix in the iteration matrix.
+    pub damping: f64,
+}
+
+/// What every element may read besides the state.
+#[derive(Clone, Copy, Debug)]
+pub struct EvalContext<'a> {
+    /// Load parameter (pseudo-time in statics, time in dynamics).
+    pub time: f64,
+    /// All load curves of the model.
+    pub curves: &'a [Curve],
+    /// Gravity acceleration at `time` (already scaled by its curve).
+    pub gravity: Vec3,
+    /// Whether the tangent is wanted (a residual-only evaluation leaves the
+    /// tangent buffer untouched).
+    pub need_tangent: bool,
+    /// Integrator coefficients in dynamics, `None` in statics.
+    pub dynamics: Option<DynamicsCoefficients>,
+}
+
+/// Where an element writes its contributions.
+pub struct ElementOutput<'a> {
+    /// Local residual `f_int − f_ext`, length `n = 6·nodes + extra`.
+    pub residual: &'a mut [f64],
+    /// Local tangent `∂r/∂q`, `n × n`, column-major.
+    pub tangent: &'a mut [f64],
+}
+
+/// A finite element of the mechanism.
+pub trait Element: Send + Sync {
+    /// The element's kind.
+    fn kind(&self) -> ElementKind;
+
+    /// The element's id in the model file.
+    fn id(&self) -> Id;
+
+    /// Indices of the nodes it connects (into the model's node list).
+    fn nodes(&self) -> &[usize];
+
+    /// Number of extra unknowns it owns (multipliers, modal amplitudes).
+    fn n_extra(&self) -> usize {
+        0
+    }
+
+    /// Number of internal variables it keeps between converged states.
+    fn n_internal(&self) -> usize {
+        0
+    }
+
+    /// Size of the local vector: 6 per node plus the extra unknowns.
+    fn n_local(&self) -> usize {
+        6 * self.nodes().len() + self.n_extra()
+    }
+
+    /// Adds the residual and (if `ctx.need_tangent`) the tangent for the
+    /// current state. Buffers are zeroed by the caller.
+    fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput);
+
+    /// Names of the result quantities reported by [`Element::results`].
+    fn result_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// Result quantities (section forces, spring forces...) for the current
+    /// state, in the order of [`Element::result_names`].
+    fn results(&self, _ctx: &EvalContext, _state: &State, _out: &mut [f64]) {}
+
+    /// How the element is drawn in VTK files.
+    fn cell_shape(&self) -> CellShape {
+        CellShape::None
+    }
+
+    /// Mass carried by the element (for model summaries and checks).
+    fn mass(&self) -> f64 {
+        0.0
+    }
+}
+
+/// Adds a 3×3 block into a column-major `n × n` buffer at (row, col).
+#[inline]
+pub(crate) fn add_block(buf: &mut [f64], n: usize, row: usize, col: usize, m: &crate::so3::Mat3) {
+    for j in 0..3 {
+        let base = (col + j) * n + row;
+        for i in 0..3 {
+            buf[base + i] += m[(i, j)];
+        }
+    }
+}
+
+/// Adds a 3-vector into a buffer at `row`.
+#[inline]
+pub(crate) fn add_vec(buf: &mut [f64], row: usize, v: &Vec3) {
+    buf[row] += v.x;
+    buf[row + 1] += v.y;
+    buf[row + 2] += v.z;
+}
+
+#[cfg(test)]
+pub(crate) mod testing {
+    //! Finite-difference checks of element tangents, shared by the
+    //! element tests.
+    use super::*;
+    use crate::so3;
+
+    /// Perturbs local unknown `k` of an element by `h` along the update
+    /// rule (translation added, rotation composed on the right).
+    pub fn perturb(state: &State, nodes: &[usize], k: usize, h: f64) -> State {
+        let mut s = state.clone();
+        let node = nodes[k / 6];
+        let c = k % 6;
+        if c < 3 {
+            s.x[node][c] += h;
+        } else {
+            let mut d = Vec3::zeros();
+            d[c - 3] = h;
+            s.q[node] = s.q[node] * so3::exp(&d);
+        }
+        s
+    }
+
+    /// Evaluates residual and tangent of `e`.
+    pub fn eval(e: &dyn Element, ctx: &EvalContext, state: &State) -> (Vec<f64>, Vec<f64>) {
+        let n = e.n_local();
+        let mut r = vec![0.0; n];
+        let mut k = vec![0.0; n * n];
+        e.evaluate(
+            ctx,
+            state,
+            &mut ElementOutput {
+                residual: &mut r,
+                tangent: &mut k,
+            },
+        );
+        (r, k)
+    }
+
+    /// Largest error between the analytic tangent and central finite
+    /// differences of the residual, relative to the largest tangent entry.
+    pub fn tangent_error(e: &dyn Element, ctx: &EvalContext, state: &State, h: f64) -> f64 {
+        let n = e.n_local();
+        let (_, k) = eval(e, ctx, state);
+        let scale = k.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
+        let mut worst = 0.0f64;
+        for j in 0..6 * e.nodes().len() {
+            let (rp, _) = eval(e, ctx, &perturb(state, e.nodes(), j, h));
+            let (rm, _) = eval(e, ctx, &perturb(state, e.nodes(), j, -h));
+            for i in 0..n {
+                let fd = (rp[i] - rm[i]) / (2.0 * h);
+                worst = worst.max((fd - k[j * n + i]).abs() / scale);
+            }
+        }
+        worst
+    }
+}

@@ -1,0 +1,60 @@
+//! # unfold
+//!
+//! Finite-element simulation of flexible mechanisms: geometrically exact
+//! beams, rigid bodies, springs and (later) kinematic joints, for the
+//! deployment analysis of space structures.
+//!
+//! The crate follows the formulation of Cardona & Géradin (the reference
+//! paper, `docs/theory.md`): nodes carry positions and orientations,
+//! rotations are updated on the group with incremental material rotation
+//! vectors, and every component of the mechanism is an element contributing
+//! a residual and a consistent tangent to a Newton–Raphson solution.
+//!
+//! Layout:
+//! - [`so3`]: finite rotations (exponential, logarithm, tangent operators);
+//! - [`model`]: the model definition (file schema and Rust API) and its
+//!   validated form;
+//! - [`elements`]: beams, rigid bodies, springs, nodal loads;
+//! - [`dofs`], [`assembly`], [`linalg`]: numbering, sparse assembly, sparse
+//!   direct solver;
+//! - [`analysis`]: Newton–Raphson and the nonlinear static analysis;
+//! - [`io`]: model files in, results (CSV, JSON, VTK) out.
+//!
+//! ```
+//! use unfold::model::{input::ModelInput, Model};
+//! use unfold::analysis::{StaticAnalysis, NoObserver};
+//!
+//! // a 2 m cantilever of 4 elements with a small tip load
+//! let mut m = ModelInput::new("cantilever");
+//! for i in 0..5 {
+//!     m.add_node(i + 1, [0.5 * i as f64, 0.0, 0.0]);
+//! }
+//! m.add_section("s", [1e8, 4e7, 4e7, 1e5, 1e5, 1e5]);
+//! for i in 1..5 {
+//!     m.add_beam(i, [i, i + 1], "s", Some([0.0, 0.0, 1.0]));
+//! }
+//! m.fix(1, &["all"]);
+//! m.add_load(5, [0.0, 0.0, -1.0], [0.0; 3]);
+//! let model = Model::from_input(&m).unwrap();
+//! let outcome = StaticAnalysis::new(&model).run(&mut NoObserver);
+//! assert!(outcome.error.is_none());
+//! // tip deflection ≈ P L³ / 3EI = 8 / 3e5
+//! let tip = outcome.state.x[4].z;
+//! assert!((tip + 8.0 / 3e5).abs() < 1e-3 * 8.0 / 3e5);
+//! ```
+
+#![warn(missing_docs)]
+#![allow(non_snake_case)]
+// index loops read better than iterator chains in the numerical kernels
+#![allow(clippy::needless_range_loop)]
+
+pub mod analysis;
+pub mod assembly;
+pub mod curves;
+pub mod dofs;
+pub mod elements;
+pub mod io;
+pub mod linalg;
+pub mod model;
+pub mod so3;
+pub mod state;

@@ -1,0 +1,465 @@
+//! The model definition as written by a user: the schema of the TOML model
+//! file (docs/model-format.md), also usable directly from Rust.
+//!
+//! Every table rejects unknown fields, so a misspelt key is an error and not
+//! a silently ignored value. A [`ModelInput`] is turned into a validated
+//! [`crate::model::Model`] by [`crate::model::Model::from_input`].
+
+use serde::{Deserialize, Serialize};
+
+/// Identifier of a node or an element, as written in the model file.
+pub type Id = u64;
+
+/// A complete model definition.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModelInput {
+    /// Free text describing the model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub title: Option<String>,
+    /// The analysis to run and its parameters.
+    #[serde(default)]
+    pub analysis: AnalysisInput,
+    /// Nodes: positions and orientations of the reference configuration.
+    #[serde(default)]
+    pub nodes: Vec<NodeInput>,
+    /// Beam cross-section properties, referenced by name.
+    #[serde(default)]
+    pub sections: Vec<SectionInput>,
+    /// Two-node geometrically exact beam elements.
+    #[serde(default)]
+    pub beams: Vec<BeamInput>,
+    /// Straight or circular lines meshed into beam elements.
+    #[serde(default)]
+    pub beam_lines: Vec<BeamLineInput>,
+    /// Rigid bodies attached to a node.
+    #[serde(default)]
+    pub rigid_bodies: Vec<RigidBodyInput>,
+    /// Point masses attached to a node.
+    #[serde(default)]
+    pub point_masses: Vec<PointMassInput>,
+    /// Linear springs between two nodes or from a node to the ground.
+    #[serde(default)]
+    pub springs: Vec<SpringInput>,
+    /// Fixed degrees of freedom.
+    #[serde(default)]
+    pub supports: Vec<SupportInput>,
+    /// Prescribed displacements and rotations.
+    #[serde(default)]
+    pub prescribed: Vec<PrescribedInput>,
+    /// Nodal forces and moments.
+    #[serde(default)]
+    pub loads: Vec<LoadInput>,
+    /// Uniform gravity field acting on every mass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<GravityInput>,
+    /// Piecewise-linear load curves, referenced by name.
+    #[serde(default)]
+    pub curves: Vec<CurveInput>,
+}
+
+/// Kind and parameters of the analysis.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysisInput {
+    /// Analysis type; only `"static"` (nonlinear statics) so far.
+    #[serde(rename = "type", default = "default_analysis_type")]
+    pub kind: String,
+    /// Final value of the load parameter `t` (pseudo-time), default 1.
+    #[serde(default = "default_end_time")]
+    pub end_time: f64,
+    /// First increment of `t`, default `end_time / 10`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_increment: Option<f64>,
+    /// Smallest increment before the analysis gives up, default `end_time · 1e-6`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_increment: Option<f64>,
+    /// Largest increment, default `end_time / 4`... or the initial increment if larger.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_increment: Option<f64>,
+    /// Newton iterations allowed per increment before it is cut back, default 25.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_iterations: Option<usize>,
+    /// Residual tolerance relative to the force flux, default 1e-8.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residual_tolerance: Option<f64>,
+    /// Displacement increment tolerance relative to the model size, default 1e-8.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displacement_tolerance: Option<f64>,
+    /// Rotation increment tolerance in radians, default 1e-8.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation_tolerance: Option<f64>,
+    /// Write results every this many converged increments (default 1); the
+    /// last increment is always written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_every: Option<usize>,
+}
+
+fn default_analysis_type() -> String {
+    "static".to_string()
+}
+fn default_end_time() -> f64 {
+    1.0
+}
+
+impl Default for AnalysisInput {
+    fn default() -> Self {
+        Self {
+            kind: default_analysis_type(),
+            end_time: default_end_time(),
+            initial_increment: None,
+            min_increment: None,
+            max_increment: None,
+            max_iterations: None,
+            residual_tolerance: None,
+            displacement_tolerance: None,
+            rotation_tolerance: None,
+            output_every: None,
+        }
+    }
+}
+
+/// A node of the reference configuration.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct NodeInput {
+    /// Unique node id.
+    pub id: Id,
+    /// Position in the global frame.
+    pub x: [f64; 3],
+    /// Orientation as a rotation vector (global frame), default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<[f64; 3]>,
+}
+
+/// Cross-section properties of a beam.
+///
+/// Give either the six diagonal stiffnesses (`EA`, `GA2`, `GA3`, `GJ`,
+/// `EI2`, `EI3`) or the full symmetric 6×6 `stiffness` matrix in the order
+/// (axial strain, shear strains 2 and 3, torsion, curvatures 2 and 3).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SectionInput {
+    /// Name by which beams refer to the section.
+    pub name: String,
+    /// Axial stiffness E·A.
+    #[serde(rename = "EA", default, skip_serializing_if = "Option::is_none")]
+    pub ea: Option<f64>,
+    /// Shear stiffness along local axis 2, κ₂·G·A.
+    #[serde(rename = "GA2", default, skip_serializing_if = "Option::is_none")]
+    pub ga2: Option<f64>,
+    /// Shear stiffness along local axis 3, κ₃·G·A.
+    #[serde(rename = "GA3", default, skip_serializing_if = "Option::is_none")]
+    pub ga3: Option<f64>,
+    /// Torsional stiffness G·J.
+    #[serde(rename = "GJ", default, skip_serializing_if = "Option::is_none")]
+    pub gj: Option<f64>,
+    /// Bending stiffness about local axis 2, E·I₂.
+    #[serde(rename = "EI2", default, skip_serializing_if = "Option::is_none")]
+    pub ei2: Option<f64>,
+    /// Bending stiffness about local axis 3, E·I₃.
+    #[serde(rename = "EI3", default, skip_serializing_if = "Option::is_none")]
+    pub ei3: Option<f64>,
+    /// Full 6×6 sectional stiffness (rows), instead of the diagonal values.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<[[f64; 6]; 6]>,
+    /// Mass per unit length, default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass_per_length: Option<f64>,
+    /// Rotational inertia per unit length about the local axes 1, 2, 3
+    /// (ρJ, ρI₂, ρI₃), default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia_per_length: Option<[f64; 3]>,
+}
+
+/// A two-node beam element.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BeamInput {
+    /// Unique element id.
+    pub id: Id,
+    /// End nodes.
+    pub nodes: [Id; 2],
+    /// Name of the section.
+    pub section: String,
+    /// Reference vector: local axis 2 is its part normal to the beam axis.
+    /// Default: global z, or global x for beams along z.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<[f64; 3]>,
+    /// Sectional strains at which the section is stress-free, measured from
+    /// the reference geometry (axial, shear 2, shear 3, torsion, curvature 2,
+    /// curvature 3). A negative axial value shortens the beam: pretension.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_strain: Option<[f64; 6]>,
+}
+
+/// A line between two existing nodes, meshed into beam elements.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BeamLineInput {
+    /// End nodes (must exist).
+    pub nodes: [Id; 2],
+    /// Number of elements.
+    pub elements: usize,
+    /// Name of the section.
+    pub section: String,
+    /// Reference vector for local axis 2 (as for beams).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<[f64; 3]>,
+    /// Id of the first interior node; the others follow. Default: one more
+    /// than the largest node id of the model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_node: Option<Id>,
+    /// Id of the first element; the others follow. Default: one more than
+    /// the largest element id of the model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_element: Option<Id>,
+    /// Centre of a circular arc through both end nodes; absent for a
+    /// straight line.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arc_center: Option<[f64; 3]>,
+    /// Initial strain of every element (as for beams).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_strain: Option<[f64; 6]>,
+}
+
+/// A rigid body carried by a node.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RigidBodyInput {
+    /// Unique element id.
+    pub id: Id,
+    /// The node that carries the body.
+    pub node: Id,
+    /// Mass.
+    pub mass: f64,
+    /// Inertia tensor about the centre of mass, in the node's material
+    /// frame: either the diagonal `[I11, I22, I33]` or the full 3×3 rows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia: Option<InertiaInput>,
+    /// Position of the centre of mass relative to the node, in the node's
+    /// material frame. Default: at the node.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center_of_mass: Option<[f64; 3]>,
+}
+
+/// An inertia tensor: principal values or the full symmetric matrix.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum InertiaInput {
+    /// `[I11, I22, I33]`.
+    Diagonal([f64; 3]),
+    /// The full 3×3 tensor, by rows.
+    Full([[f64; 3]; 3]),
+}
+
+/// A point mass carried by a node.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PointMassInput {
+    /// Unique element id.
+    pub id: Id,
+    /// The node that carries the mass.
+    pub node: Id,
+    /// Mass.
+    pub mass: f64,
+}
+
+/// What a spring resists.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum SpringKind {
+    /// Relative displacement along the global axes: `f = diag(k) Δu`.
+    Translational,
+    /// Relative rotation, measured in the first node's material frame (or
+    /// the global frame for a spring to ground): `m = diag(k) ψ`.
+    Rotational,
+    /// Change of the distance between the two nodes: `f = k (ℓ − ℓ₀)`.
+    Axial,
+}
+
+/// A linear spring between two nodes, or between a node and the ground.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpringInput {
+    /// Unique element id.
+    pub id: Id,
+    /// What the spring resists.
+    pub kind: SpringKind,
+    /// One node (spring to ground, at the node's reference position and
+    /// orientation) or two nodes.
+    pub nodes: Vec<Id>,
+    /// Stiffness: one value (isotropic) or three values along the axes.
+    /// Axial springs take one value.
+    pub stiffness: StiffnessInput,
+}
+
+/// A scalar or a 3-vector of spring stiffnesses.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum StiffnessInput {
+    /// The same value on all three axes.
+    Isotropic(f64),
+    /// One value per axis.
+    PerAxis([f64; 3]),
+}
+
+/// Fixed degrees of freedom of a node.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SupportInput {
+    /// The node.
+    pub node: Id,
+    /// Components to fix: `x`, `y`, `z` (global translations), `rx`, `ry`,
+    /// `rz` (incremental rotations about the node's material axes), or the
+    /// groups `translations`, `rotations`, `all`.
+    pub fixed: Vec<String>,
+}
+
+/// A prescribed motion of a node: one translation component, or the whole
+/// rotation.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PrescribedInput {
+    /// The node.
+    pub node: Id,
+    /// Translation component `x`, `y` or `z` to prescribe, with `value`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dof: Option<String>,
+    /// Displacement reached when the curve equals 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub value: Option<f64>,
+    /// Rotation vector (global frame) reached when the curve equals 1:
+    /// `R(t) = exp(f(t) ψ~) R₀`. Fixes all three rotations of the node.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<[f64; 3]>,
+    /// Name of the curve `f(t)`; default `ramp` (`f(t) = t`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve: Option<String>,
+}
+
+/// A nodal force and moment.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LoadInput {
+    /// The loaded node.
+    pub node: Id,
+    /// Force reached when the curve equals 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force: Option<[f64; 3]>,
+    /// Moment reached when the curve equals 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moment: Option<[f64; 3]>,
+    /// `false` (default): fixed global direction (dead load). `true`:
+    /// components in the node's material frame, turning with the node.
+    #[serde(default)]
+    pub follower: bool,
+    /// Name of the load curve; default `ramp` (`f(t) = t`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve: Option<String>,
+}
+
+/// A uniform gravity field.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GravityInput {
+    /// Acceleration of gravity reached when the curve equals 1.
+    pub acceleration: [f64; 3],
+    /// Name of the load curve; default `ramp`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve: Option<String>,
+}
+
+/// A piecewise-linear curve `f(t)`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CurveInput {
+    /// Name by which loads refer to the curve.
+    pub name: String,
+    /// Points `[t, f]` with strictly increasing `t`. Constant beyond the
+    /// first and last points.
+    pub points: Vec<[f64; 2]>,
+}
+
+// ---------- builder helpers for models written in Rust ----------
+
+impl ModelInput {
+    /// An empty model with a title.
+    pub fn new(title: impl Into<String>) -> Self {
+        Self {
+            title: Some(title.into()),
+            ..Self::default()
+        }
+    }
+
+    /// Adds a node at `x` with the identity orientation.
+    pub fn add_node(&mut self, id: Id, x: [f64; 3]) -> &mut Self {
+        self.nodes.push(NodeInput {
+            id,
+            x,
+            rotation: None,
+        });
+        self
+    }
+
+    /// Adds a section with the diagonal stiffnesses
+    /// `[EA, GA2, GA3, GJ, EI2, EI3]`.
+    pub fn add_section(&mut self, name: impl Into<String>, diagonal: [f64; 6]) -> &mut Self {
+        let [ea, ga2, ga3, gj, ei2, ei3] = diagonal;
+        self.sections.push(SectionInput {
+            name: name.into(),
+            ea: Some(ea),
+            ga2: Some(ga2),
+            ga3: Some(ga3),
+            gj: Some(gj),
+            ei2: Some(ei2),
+            ei3: Some(ei3),
+            ..SectionInput::default()
+        });
+        self
+    }
+
+    /// Adds a beam between two nodes.
+    pub fn add_beam(
+        &mut self,
+        id: Id,
+        nodes: [Id; 2],
+        section: impl Into<String>,
+        orientation: Option<[f64; 3]>,
+    ) -> &mut Self {
+        self.beams.push(BeamInput {
+            id,
+            nodes,
+            section: section.into(),
+            orientation,
+            initial_strain: None,
+        });
+        self
+    }
+
+    /// Fixes the listed components (`"all"`, `"x"`, `"rz"`, ...) of a node.
+    pub fn fix(&mut self, node: Id, components: &[&str]) -> &mut Self {
+        self.supports.push(SupportInput {
+            node,
+            fixed: components.iter().map(|s| s.to_string()).collect(),
+        });
+        self
+    }
+
+    /// Adds a dead nodal force and moment following the default ramp.
+    pub fn add_load(&mut self, node: Id, force: [f64; 3], moment: [f64; 3]) -> &mut Self {
+        self.loads.push(LoadInput {
+            node,
+            force: Some(force),
+            moment: Some(moment),
+            follower: false,
+            curve: None,
+        });
+        self
+    }
+
+    /// Serialises the model to TOML text.
+    pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
+        toml::to_string_pretty(self)
+    }
+}

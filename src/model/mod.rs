@@ -1,0 +1,211 @@
+//! The validated, immutable model: nodes, elements, supports, prescribed
+//! motions, curves and analysis settings, with ids resolved to indices.
+//!
+//! A [`Model`] is built from a [`input::ModelInput`] (read from a model file
+//! or written in Rust) by [`Model::from_input`], which checks everything and
+//! reports every problem it finds, each naming the entity concerned.
+
+mod build;
+pub mod input;
+
+use std::fmt;
+
+use crate::curves::{Curve, CurveIndex};
+use crate::elements::Element;
+use crate::so3::{Rotation, Vec3};
+use crate::state::State;
+use input::Id;
+
+/// Names of the six components of a node, in local unknown order.
+pub const COMPONENT_NAMES: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+
+/// A prescribed motion of one node.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Prescribed {
+    /// `x_axis(t) = X_axis + f(t) value`.
+    Translation {
+        /// Node index.
+        node: usize,
+        /// Global axis 0, 1 or 2.
+        axis: usize,
+        /// Displacement when the curve equals 1.
+        value: f64,
+        /// Curve index.
+        curve: CurveIndex,
+    },
+    /// `R(t) = exp(f(t) ψ~) R₀`, `ψ` in the global frame.
+    Rotation {
+        /// Node index.
+        node: usize,
+        /// Rotation vector when the curve equals 1.
+        psi: Vec3,
+        /// Curve index.
+        curve: CurveIndex,
+    },
+}
+
+/// Parameters of the nonlinear static analysis (see docs/model-format.md,
+/// `[analysis]`, for the meaning and default of each).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StaticSettings {
+    /// Final value of the load parameter.
+    pub end_time: f64,
+    /// First increment.
+    pub initial_increment: f64,
+    /// Smallest increment allowed after cut-backs.
+    pub min_increment: f64,
+    /// Largest increment allowed when increments grow again.
+    pub max_increment: f64,
+    /// Newton iterations per increment before a cut-back.
+    pub max_iterations: usize,
+    /// Residual tolerance, relative to the force flux.
+    pub residual_tolerance: f64,
+    /// Displacement increment tolerance, relative to the model size.
+    pub displacement_tolerance: f64,
+    /// Rotation increment tolerance (radians).
+    pub rotation_tolerance: f64,
+    /// Results are written every this many increments.
+    pub output_every: usize,
+}
+
+/// A validated model.
+pub struct Model {
+    /// Title from the model file.
+    pub title: String,
+    /// Node ids, by node index.
+    pub node_ids: Vec<Id>,
+    /// Reference positions, by node index.
+    pub reference_x: Vec<Vec3>,
+    /// Reference orientations, by node index.
+    pub reference_q: Vec<Rotation>,
+    /// All elements (loads included).
+    pub elements: Vec<Box<dyn Element>>,
+    /// Fixed components of each node (supports and prescribed motions).
+    pub fixed: Vec<[bool; 6]>,
+    /// Prescribed motions.
+    pub prescribed: Vec<Prescribed>,
+    /// Load curves; index 0 is the built-in ramp.
+    pub curves: Vec<Curve>,
+    /// Gravity acceleration and its curve.
+    pub gravity: Option<(Vec3, CurveIndex)>,
+    /// Analysis settings.
+    pub settings: StaticSettings,
+    /// Diagonal of the bounding box of the nodes (1 if zero): the length
+    /// against which displacement tolerances are measured.
+    pub length_scale: f64,
+}
+
+impl fmt::Debug for Model {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Model")
+            .field("title", &self.title)
+            .field("nodes", &self.node_ids.len())
+            .field("elements", &self.elements.len())
+            .finish()
+    }
+}
+
+impl Model {
+    /// Number of nodes.
+    pub fn n_nodes(&self) -> usize {
+        self.node_ids.len()
+    }
+
+    /// The reference (initial) state.
+    pub fn initial_state(&self) -> State {
+        State {
+            time: 0.0,
+            x: self.reference_x.clone(),
+            q: self.reference_q.clone(),
+            extra: vec![0.0; self.elements.iter().map(|e| e.n_extra()).sum()],
+            internal: vec![0.0; self.elements.iter().map(|e| e.n_internal()).sum()],
+        }
+    }
+
+    /// Index of the node with id `id`.
+    pub fn node_index(&self, id: Id) -> Option<usize> {
+        self.node_ids.iter().position(|&n| n == id)
+    }
+
+    /// Gravity acceleration at load parameter `t`.
+    pub fn gravity_at(&self, t: f64) -> Vec3 {
+        match self.gravity {
+            Some((g, c)) => g * self.curves[c].value(t),
+            None => Vec3::zeros(),
+        }
+    }
+
+    /// Sets the prescribed components of `state` to their values at `t`.
+    pub fn apply_prescribed(&self, state: &mut State, t: f64) {
+        for p in &self.prescribed {
+            match *p {
+                Prescribed::Translation {
+                    node,
+                    axis,
+                    value,
+                    curve,
+                } => {
+                    state.x[node][axis] =
+                        self.reference_x[node][axis] + value * self.curves[curve].value(t);
+                }
+                Prescribed::Rotation { node, psi, curve } => {
+                    state.q[node] = crate::so3::exp(&(psi * self.curves[curve].value(t)))
+                        * self.reference_q[node];
+                }
+            }
+        }
+    }
+}
+
+/// What is wrong with a model definition.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelErrorKind {
+    /// A reference to a node id that does not exist.
+    UnknownNode,
+    /// Two entities with the same id or name.
+    DuplicateId,
+    /// A beam or spring whose nodes coincide.
+    ZeroLength,
+    /// A stiffness, mass or inertia that must be positive is not.
+    NonPositive,
+    /// A reference to a section that does not exist.
+    UnknownSection,
+    /// A reference to a curve that does not exist.
+    UnknownCurve,
+    /// A required value is missing.
+    Missing,
+    /// A value is not acceptable (wrong name, not finite, inconsistent).
+    Invalid,
+    /// Part of the structure can move as a rigid body.
+    Unrestrained,
+}
+
+/// One problem in a model definition, naming the entity concerned.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{entity}: {message}")]
+pub struct ModelError {
+    /// Kind of problem.
+    pub kind: ModelErrorKind,
+    /// The entity, as the user wrote it (`beam 3`, `section "tube"`).
+    pub entity: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+/// Every problem found in a model definition.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelErrors(pub Vec<ModelError>);
+
+impl fmt::Display for ModelErrors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, e) in self.0.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "{e}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for ModelErrors {}

@@ -299,10 +299,7 @@ impl NewtonSolver {
             }
 
             // solve K Δq = −r
-            for (eq, r) in self.rhs.iter_mut().enumerate() {
-                *r = -self.assembler.residual[self.dofs.dof(eq)];
-            }
-            let solved = self.factor_and_solve();
+            let solved = self.solve_linear_system();
             let (dx, dth) = match solved {
                 Ok(()) => correction_size(&self.dofs, &self.rhs),
                 Err(_) => (f64::INFINITY, f64::INFINITY),
@@ -318,13 +315,30 @@ impl NewtonSolver {
         unreachable!("the loop returns at max_iterations")
     }
 
-    fn factor_and_solve(&mut self) -> Result<(), SolveError> {
+    /// Symbolic analysis of the tangent's pattern (done once; later calls
+    /// do nothing).
+    pub fn analyze(&mut self) -> Result<(), SolveError> {
         if self.lu.is_none() {
             self.lu = Some(SparseLu::analyze(&self.assembler.matrix)?);
         }
+        Ok(())
+    }
+
+    /// Factors the last assembled tangent and solves `K Δq = −r`; the
+    /// correction is then in [`NewtonSolver::correction`].
+    pub fn solve_linear_system(&mut self) -> Result<(), SolveError> {
+        for (eq, r) in self.rhs.iter_mut().enumerate() {
+            *r = -self.assembler.residual[self.dofs.dof(eq)];
+        }
+        self.analyze()?;
         let lu = self.lu.as_mut().expect("analysed above");
         lu.factor(&self.assembler.matrix)?;
         lu.solve_in_place(&mut self.rhs)
+    }
+
+    /// The correction `Δq` (by equation) of the last linear solve.
+    pub fn correction(&self) -> &[f64] {
+        &self.rhs
     }
 
     /// Explains a failed or runaway solve: singular (with the dof) or

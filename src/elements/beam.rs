@@ -180,13 +180,6 @@ impl Beam {
         }
     }
 
-    /// Strain energy `½ L₀ εᵀ C ε`.
-    pub fn strain_energy(&self, state: &State) -> f64 {
-        let (x, r) = self.pose(state);
-        let k = self.kinematics(&x, &r);
-        0.5 * self.length * k.strain.dot(&(self.stiffness * k.strain))
-    }
-
     /// Local residual and tangent in the section variables
     /// `(δx₁, δα₁, δx₂, δα₂)`, `δαᵢ = Qᵢᵀ δΘᵢ`.
     fn local(&self, k: &Kinematics, need_tangent: bool) -> (Vec12, Option<Mat12>) {
@@ -340,6 +333,13 @@ impl Element for Beam {
         let s = self.section_forces(state);
         out[..3].copy_from_slice(s.force.as_slice());
         out[3..6].copy_from_slice(s.moment.as_slice());
+    }
+
+    /// Strain energy `½ L₀ εᵀ C ε`.
+    fn strain_energy(&self, state: &State) -> f64 {
+        let (x, r) = self.pose(state);
+        let k = self.kinematics(&x, &r);
+        0.5 * self.length * k.strain.dot(&(self.stiffness * k.strain))
     }
 
     fn cell_shape(&self) -> CellShape {

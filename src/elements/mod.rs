@@ -154,6 +154,11 @@ pub trait Element: Send + Sync {
     /// state, in the order of [`Element::result_names`].
     fn results(&self, _ctx: &EvalContext, _state: &State, _out: &mut [f64]) {}
 
+    /// Elastic energy stored in the element (beams, springs).
+    fn strain_energy(&self, _state: &State) -> f64 {
+        0.0
+    }
+
     /// How the element is drawn in VTK files.
     fn cell_shape(&self) -> CellShape {
         CellShape::None

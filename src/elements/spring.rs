@@ -222,6 +222,12 @@ impl Element for Spring {
         out[3..6].copy_from_slice(d.as_slice());
     }
 
+    /// `½ Σ kᵢ dᵢ²` of the spring's deformation.
+    fn strain_energy(&self, state: &State) -> f64 {
+        let (f, d) = self.force_and_deformation(state);
+        0.5 * f.dot(&d)
+    }
+
     fn cell_shape(&self) -> CellShape {
         if self.grounded() {
             CellShape::Vertex

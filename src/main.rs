@@ -6,7 +6,8 @@
 //! ```
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
 //! written so far are kept) or results could not be written; 2 the command
-//! line or the model file is invalid.
+//! line or the model file is invalid, including a model whose tangent is
+//! singular from the start (a mechanism or an unrestrained structure).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -16,7 +17,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use unfold::analysis::{CutbackInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis};
+use unfold::analysis::statics::StaticError;
+use unfold::analysis::{CutbackInfo, IncrementInfo, IterationInfo, NewtonFailure, Observer, StaticAnalysis};
 use unfold::elements::ElementKind;
 use unfold::io::model_file::read_model;
 use unfold::io::results::{ResultWriter, Summary};
@@ -300,11 +302,11 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
     println!("{tail}");
     if let Some(m) = message {
         eprintln!("error: {}: {m}", path.display());
-        eprintln!(
-            "note: results up to t = {} are kept in {}",
-            outcome.time,
-            out.display()
-        );
+        // a model that is singular from the start is invalid input
+        if let Some(StaticError::Initial(NewtonFailure::Singular { .. })) = outcome.error {
+            return ExitCode::from(EXIT_INPUT);
+        }
+        eprintln!("note: results up to t = {:.6} are kept in {}", outcome.time, out.display());
         return ExitCode::from(EXIT_FAILED);
     }
     if let Err(e) = summary_written {

@@ -154,16 +154,15 @@ impl unfold::analysis::Observer for Norms {
 }
 
 /// Runs `input` and checks, in every increment, that Newton ends
-/// quadratically: the number of correct digits at least doubles in the last
-/// iterations. Returns the number of increments checked.
+/// quadratically: once the residual is small, the number of correct digits
+/// at least doubles at each iteration. Returns the number of increments
+/// checked.
 ///
 /// Norm: `e = max(‖r_F‖/F, ‖r_M‖/M)`, the residual relative to the applied
-/// load (`F`, `M`). Round-off: `e` cannot fall below the smallest value
-/// reached in the increment, `e_min`. Two checks:
-/// - once `e < 1e-3`, Newton reaches `e_min` in at most 3 more iterations
-///   (digits 3 → 6 → 12 → round-off; a linear rate of 0.1 would need 9);
-/// - the last step squares the residual or lands on round-off:
-///   `e_last ≤ max(e_prev², e_min)`, with `e_prev < 1e-3`.
+/// load (`F`, `M`). Check: from the first iterate with `e < 1e-2`, the
+/// smallest residual of the increment (convergence or round-off) is reached
+/// in at most 3 iterations — digits 2 → 4 → 8 → 16. A linear rate of 0.1
+/// would need 9 iterations to go from 1e-2 to 1e-11.
 fn assert_quadratic(input: &ModelInput, force: f64, moment: f64) -> usize {
     let model = unfold::model::Model::from_input(input).unwrap();
     let mut norms = Norms::default();
@@ -174,16 +173,14 @@ fn assert_quadratic(input: &ModelInput, force: f64, moment: f64) -> usize {
         let e: Vec<f64> = inc.iter().map(|n| (n.residual_force / force).max(n.residual_moment / moment)).collect();
         println!("increment {k}: {:?}", e.iter().map(|v| format!("{v:.1e}")).collect::<Vec<_>>());
         let floor = e.iter().copied().fold(f64::INFINITY, f64::min);
-        let Some(first_small) = e.iter().position(|&v| v < 1e-3) else {
-            continue; // converged before the residual was ever computed small
-        };
-        let reached = first_small + e[first_small..].iter().position(|&v| v == floor).unwrap();
-        assert!(reached - first_small <= 3, "increment {k}: {} iterations from 1e-3 to round-off", reached - first_small);
-        if reached > first_small {
-            let (prev, last) = (e[reached - 1], e[reached]);
-            assert!(last <= (prev * prev).max(floor), "increment {k}: {prev:.3e} → {last:.3e} is not quadratic");
-            judged += 1;
-        }
+        let reached = e.iter().position(|&v| v == floor).unwrap();
+        let first_small = e.iter().position(|&v| v < 1e-2).unwrap();
+        assert!(
+            reached - first_small <= 3,
+            "increment {k}: {} iterations from e < 1e-2 to {floor:.1e}",
+            reached - first_small
+        );
+        judged += 1;
     }
     judged
 }

@@ -15,9 +15,14 @@
 //!   flowing through each dof (reactions included), or `‖r‖₂ ≤ 10⁻¹²·k·L`,
 //!   the round-off floor of a structure of stiffness `k = max Kᵢᵢ` and size
 //!   `L`;
-//! - **increment**: `max|Δx| ≤ ε_u · L` and `max|ΔΘ| ≤ ε_θ`, for the last
-//!   correction (not required when the residual is already satisfied
-//!   before any correction).
+//! - **correction**: `max|Δx| ≤ ε_u · L` and `max|ΔΘ| ≤ ε_θ` for the next
+//!   correction, estimated from the last one times the residual ratio,
+//!   `|Δq_{k+1}| ≈ |Δq_k| ‖r_k‖/‖r_{k−1}‖` (exact in the quadratic regime;
+//!   this saves the extra iteration that would only confirm convergence).
+//!
+//! The very first solve of a model always makes one correction, even from
+//! equilibrium, so that a singular tangent (a mechanism, a missing support)
+//! is found before the analysis starts.
 
 use super::{IterationInfo, Observer};
 use crate::assembly::Assembler;
@@ -120,6 +125,10 @@ pub struct NewtonSolver {
     /// `max Kᵢᵢ` over translation and rotation equations, from the first
     /// tangent (sets the residual floor).
     stiffness_scale: Option<(f64, f64)>,
+    /// Whether a tangent has been factored and solved once: until then a
+    /// solve always makes one correction, even from equilibrium, so that a
+    /// singular model (a mechanism) is caught at the start.
+    tangent_checked: bool,
 }
 
 impl NewtonSolver {
@@ -134,6 +143,7 @@ impl NewtonSolver {
             lu: None,
             rhs: vec![0.0; n],
             stiffness_scale: None,
+            tangent_checked: false,
         }
     }
 
@@ -274,10 +284,16 @@ impl NewtonSolver {
                 return Err(NewtonFailure::NonFinite { iteration });
             }
 
-            // convergence: residual and last correction
-            let residual_ok = norms.relative_residual <= tol;
+            // convergence: residual, and the next correction estimated as the
+            // last one scaled by the residual ratio, |Δq_k+1| ≈ |Δq_k| r_k/r_k-1
+            let residual_ok = norms.relative_residual <= tol && self.tangent_checked;
+            let ratio = match residuals.len() {
+                n if n >= 2 && residuals[n - 2] > 0.0 => (residuals[n - 1] / residuals[n - 2]).min(1.0),
+                _ => 1.0,
+            };
             let correction_ok = last_correction.is_none_or(|(dx, dth)| {
-                dx <= settings.displacement_tolerance * length && dth <= settings.rotation_tolerance
+                dx * ratio <= settings.displacement_tolerance * length
+                    && dth * ratio <= settings.rotation_tolerance
             });
             if residual_ok && correction_ok {
                 return Ok(NewtonResult {
@@ -307,6 +323,8 @@ impl NewtonSolver {
             if !(dx <= RUNAWAY_CORRECTION * length && dth <= RUNAWAY_CORRECTION) {
                 return Err(self.diagnose(model, iteration));
             }
+
+            self.tangent_checked = true;
 
             // update: x ← x + Δx, R ← R exp(ΔΘ~), extras additively
             self.update(model, state);

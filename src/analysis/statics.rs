@@ -32,7 +32,7 @@ pub const CUTBACK: f64 = 0.5;
 #[derive(Debug, thiserror::Error)]
 pub enum StaticError {
     /// An increment failed with the smallest allowed step.
-    #[error("no convergence at increment {increment}: from t = {time} the step was cut back to {step:.3e} (below min_increment) and still failed: {reason}")]
+    #[error("no convergence at increment {increment} from t = {time:.6}: the step {step:.3e} failed and half of it would be below min_increment: {reason}")]
     Diverged {
         /// Increment that failed.
         increment: usize,

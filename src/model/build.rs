@@ -732,8 +732,8 @@ fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         max_iterations: a.max_iterations.unwrap_or(25),
         // quadratic convergence makes 1e-8 cheap: one iteration more than 1e-4
         residual_tolerance: a.residual_tolerance.unwrap_or(1e-8),
-        displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-8),
-        rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-8),
+        displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
+        rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
         output_every: a.output_every.unwrap_or(1),
     };
     ck.positive("analysis", "initial_increment", s.initial_increment);

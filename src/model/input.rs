@@ -83,10 +83,10 @@ pub struct AnalysisInput {
     /// Residual tolerance relative to the force flux, default 1e-8.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub residual_tolerance: Option<f64>,
-    /// Displacement increment tolerance relative to the model size, default 1e-8.
+    /// Displacement correction tolerance relative to the model size, default 1e-6.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub displacement_tolerance: Option<f64>,
-    /// Rotation increment tolerance in radians, default 1e-8.
+    /// Rotation correction tolerance in radians, default 1e-6.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotation_tolerance: Option<f64>,
     /// Write results every this many converged increments (default 1); the

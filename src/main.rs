@@ -18,7 +18,9 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use unfold::analysis::statics::StaticError;
-use unfold::analysis::{CutbackInfo, IncrementInfo, IterationInfo, NewtonFailure, Observer, StaticAnalysis};
+use unfold::analysis::{
+    CutbackInfo, IncrementInfo, IterationInfo, NewtonFailure, Observer, StaticAnalysis,
+};
 use unfold::elements::ElementKind;
 use unfold::io::model_file::read_model;
 use unfold::io::results::{ResultWriter, Summary};
@@ -306,7 +308,11 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
         if let Some(StaticError::Initial(NewtonFailure::Singular { .. })) = outcome.error {
             return ExitCode::from(EXIT_INPUT);
         }
-        eprintln!("note: results up to t = {:.6} are kept in {}", outcome.time, out.display());
+        eprintln!(
+            "note: results up to t = {:.6} are kept in {}",
+            outcome.time,
+            out.display()
+        );
         return ExitCode::from(EXIT_FAILED);
     }
     if let Err(e) = summary_written {

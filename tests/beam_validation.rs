@@ -40,7 +40,14 @@ fn linear_cantilever_matches_timoshenko() {
         let p = 10.0;
         let mut m = ModelInput::new("linear cantilever");
         m.add_section("steel", [ea, ga2, ga3, gj, ei2, ei3]);
-        line(&mut m, [0.0; 3], [length, 0.0, 0.0], 10, "steel", [0.0, 0.0, 1.0]);
+        line(
+            &mut m,
+            [0.0; 3],
+            [length, 0.0, 0.0],
+            10,
+            "steel",
+            [0.0, 0.0, 1.0],
+        );
         m.fix(1, &["all"]);
         let mut f = [0.0; 3];
         f[direction] = p;
@@ -51,7 +58,11 @@ fn linear_cantilever_matches_timoshenko() {
         let tip = outcome.state.x[node(&model, 2)] - model.reference_x[node(&model, 2)];
         // load along z bends about local 3 with shear along local 2, and
         // load along y bends about local 2 with shear along local 3
-        let (ei, ga) = if direction == 2 { (ei3, ga2) } else { (ei2, ga3) };
+        let (ei, ga) = if direction == 2 {
+            (ei3, ga2)
+        } else {
+            (ei2, ga3)
+        };
         let expected = p * length.powi(3) / (3.0 * ei) + p * length / ga;
         let error = (tip[direction] - expected).abs() / expected;
         println!("L = {length}, load along {direction}: w = {:.6e}, Timoshenko {expected:.6e}, error {:.3} %", tip[direction], 100.0 * error);
@@ -64,7 +75,14 @@ fn linear_cantilever_matches_timoshenko() {
 fn rollup(n: usize, end_time: f64) -> ModelInput {
     let mut m = ModelInput::new("roll-up");
     m.add_section("strip", [1e5, 4e4, 4e4, 10.0, 10.0, 10.0]);
-    line(&mut m, [0.0; 3], [1.0, 0.0, 0.0], n, "strip", [0.0, 1.0, 0.0]);
+    line(
+        &mut m,
+        [0.0; 3],
+        [1.0, 0.0, 0.0],
+        n,
+        "strip",
+        [0.0, 1.0, 0.0],
+    );
     m.fix(1, &["all"]);
     m.add_load(2, [0.0; 3], [0.0, 0.0, 2.0 * PI * 10.0]);
     m.analysis.end_time = end_time;
@@ -75,7 +93,10 @@ fn rollup(n: usize, end_time: f64) -> ModelInput {
 fn report(name: &str, increments: &[IncrementInfo]) -> (usize, usize) {
     let n = increments.len() - 1;
     let iterations: usize = increments[1..].iter().map(|i| i.iterations).sum();
-    println!("{name}: {n} increments, {iterations} iterations ({:.1} per increment)", iterations as f64 / n as f64);
+    println!(
+        "{name}: {n} increments, {iterations} iterations ({:.1} per increment)",
+        iterations as f64 / n as f64
+    );
     (n, iterations)
 }
 
@@ -104,7 +125,10 @@ fn rollup_into_full_circle() {
     let r = 0.1 / (2.0 * (PI / 10.0).sin());
     for x in &outcome.state.x {
         let d = (x - Vec3::new(0.0, r, 0.0)).norm();
-        assert!((d - r).abs() < 1e-6, "node at {x:?} is {d} from the centre, not {r}");
+        assert!(
+            (d - r).abs() < 1e-6,
+            "node at {x:?} is {d} from the centre, not {r}"
+        );
     }
 }
 
@@ -127,7 +151,10 @@ fn rollup_half_moment_reaches_the_analytic_circle() {
         let radius = 1.0 / PI; // EI/M with M = π EI/L, L = 1
         let expected = Vec3::new(0.0, 2.0 * radius, 0.0);
         let error = (outcome.state.x[tip] - expected).norm();
-        println!("{n} elements: tip at {:?}, analytic {:?}, error {:.3e} L", outcome.state.x[tip], expected, error);
+        println!(
+            "{n} elements: tip at {:?}, analytic {:?}, error {:.3e} L",
+            outcome.state.x[tip], expected, error
+        );
         // tip rotation: exactly π about z
         let psi = so3::log(&outcome.state.q[tip]);
         assert!((psi.norm() - PI).abs() < 1e-7, "tip rotation {psi:?}");
@@ -170,8 +197,14 @@ fn assert_quadratic(input: &ModelInput, force: f64, moment: f64) -> usize {
     assert!(outcome.error.is_none());
     let mut judged = 0;
     for (k, inc) in norms.0.iter().enumerate().skip(1) {
-        let e: Vec<f64> = inc.iter().map(|n| (n.residual_force / force).max(n.residual_moment / moment)).collect();
-        println!("increment {k}: {:?}", e.iter().map(|v| format!("{v:.1e}")).collect::<Vec<_>>());
+        let e: Vec<f64> = inc
+            .iter()
+            .map(|n| (n.residual_force / force).max(n.residual_moment / moment))
+            .collect();
+        println!(
+            "increment {k}: {:?}",
+            e.iter().map(|v| format!("{v:.1e}")).collect::<Vec<_>>()
+        );
         let floor = e.iter().copied().fold(f64::INFINITY, f64::min);
         let reached = e.iter().position(|&v| v == floor).unwrap();
         let first_small = e.iter().position(|&v| v < 1e-2).unwrap();
@@ -203,8 +236,13 @@ fn newton_converges_quadratically_on_the_rollup() {
 /// Source: Newton's method with the exact tangent.
 #[test]
 fn newton_converges_quadratically_on_the_bend() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/bend_45.toml")).unwrap();
-    let input = unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/bend_45.toml"
+    ))
+    .unwrap();
+    let input =
+        unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
     let judged = assert_quadratic(&input, 600.0, 600.0 * 100.0);
     assert_eq!(judged, 8);
 }
@@ -221,8 +259,13 @@ fn newton_converges_quadratically_on_the_bend() {
 /// the difference between 8-element discretisations.
 #[test]
 fn bend_45_matches_simo_vu_quoc() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/bend_45.toml")).unwrap();
-    let input = unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/bend_45.toml"
+    ))
+    .unwrap();
+    let input =
+        unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
     let (model, outcome, increments) = run(&input);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     report("45° bend", &increments);
@@ -230,7 +273,10 @@ fn bend_45_matches_simo_vu_quoc() {
     let published = Vec3::new(47.23, 15.79, 53.37);
     let displacement = (published - model.reference_x[node(&model, 9)]).norm();
     let error = (tip - published).norm() / displacement;
-    println!("tip {tip:?}, Simo & Vu-Quoc {published:?}: error {:.3} % of the displacement", 100.0 * error);
+    println!(
+        "tip {tip:?}, Simo & Vu-Quoc {published:?}: error {:.3} % of the displacement",
+        100.0 * error
+    );
     assert!(error < 2e-3, "error {error}");
 }
 
@@ -269,9 +315,15 @@ fn right_angle_frame_small_load() {
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     let w = outcome.state.x[node(&model, 3)].z;
     // out-of-plane bending of both legs uses EI3 (about local 3) and GA2
-    let expected = p * a.powi(3) / (3.0 * ei3) + p * b.powi(3) / (3.0 * ei3) + p * b * b * a / gj + p * (a + b) / ga2;
+    let expected = p * a.powi(3) / (3.0 * ei3)
+        + p * b.powi(3) / (3.0 * ei3)
+        + p * b * b * a / gj
+        + p * (a + b) / ga2;
     let error = (w - expected).abs() / expected;
-    println!("L frame: w = {w:.6e}, analytic {expected:.6e}, error {:.3} %", 100.0 * error);
+    println!(
+        "L frame: w = {w:.6e}, analytic {expected:.6e}, error {:.3} %",
+        100.0 * error
+    );
     assert!(error < 5e-3);
 }
 
@@ -287,8 +339,13 @@ fn right_angle_frame_small_load() {
 #[test]
 fn rigid_motion_leaves_strains_and_forces_unchanged() {
     // a deformed 3-D state: the 45° bend at full load
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/bend_45.toml")).unwrap();
-    let input = unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/bend_45.toml"
+    ))
+    .unwrap();
+    let input =
+        unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
     let (model, outcome, _) = run(&input);
     let deformed = outcome.state;
     // superimposed rigid motion: large rotation and a translation
@@ -308,7 +365,11 @@ fn rigid_motion_leaves_strains_and_forces_unchanged() {
     };
     let mut worst: f64 = 0.0;
     let (mut a, mut b) = ([0.0; 6], [0.0; 6]);
-    for e in model.elements.iter().filter(|e| e.kind() == unfold::elements::ElementKind::Beam) {
+    for e in model
+        .elements
+        .iter()
+        .filter(|e| e.kind() == unfold::elements::ElementKind::Beam)
+    {
         e.results(&ctx, &deformed, &mut a);
         e.results(&ctx, &moved, &mut b);
         let scale = a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
@@ -322,8 +383,22 @@ fn rigid_motion_leaves_strains_and_forces_unchanged() {
         let n = e.n_local();
         let (mut ra, mut rb) = (vec![0.0; n], vec![0.0; n]);
         let mut t = vec![0.0; 0];
-        e.evaluate(&ctx, &deformed, &mut unfold::elements::ElementOutput { residual: &mut ra, tangent: &mut t });
-        e.evaluate(&ctx, &moved, &mut unfold::elements::ElementOutput { residual: &mut rb, tangent: &mut t });
+        e.evaluate(
+            &ctx,
+            &deformed,
+            &mut unfold::elements::ElementOutput {
+                residual: &mut ra,
+                tangent: &mut t,
+            },
+        );
+        e.evaluate(
+            &ctx,
+            &moved,
+            &mut unfold::elements::ElementOutput {
+                residual: &mut rb,
+                tangent: &mut t,
+            },
+        );
         for blk in 0..n / 3 {
             let va = Vec3::new(ra[3 * blk], ra[3 * blk + 1], ra[3 * blk + 2]).norm();
             let vb = Vec3::new(rb[3 * blk], rb[3 * blk + 1], rb[3 * blk + 2]).norm();

@@ -15,7 +15,10 @@ fn scratch(name: &str) -> PathBuf {
 
 /// Runs `unfold` with `args`, returning (exit code, stdout, stderr).
 fn unfold(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_unfold")).args(args).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args(args)
+        .output()
+        .unwrap();
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -72,7 +75,12 @@ fn run_model(dir: &Path, name: &str, text: &str) -> (i32, String, String) {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
     let out = dir.join("out");
-    unfold(&["run", path.to_str().unwrap(), "--out", out.to_str().unwrap()])
+    unfold(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
 }
 
 /// Asserts a bad-input rejection: exit code 2, and a message on stderr
@@ -82,7 +90,10 @@ fn assert_rejected(name: &str, text: &str, fragments: &[&str]) {
     let file = format!("{name}.toml");
     let (code, _, err) = run_model(&dir, &file, text);
     assert_eq!(code, 2, "{name}: exit code {code}, stderr: {err}");
-    assert!(err.contains(&file), "{name}: the message does not name the file: {err}");
+    assert!(
+        err.contains(&file),
+        "{name}: the message does not name the file: {err}"
+    );
     for f in fragments {
         assert!(err.contains(f), "{name}: message lacks «{f}»: {err}");
     }
@@ -97,7 +108,10 @@ fn valid_model_runs_and_checks() {
     assert!(out.contains("completed"), "{out}");
     let (code, out, _) = unfold(&["check", dir.join("ok.toml").to_str().unwrap()]);
     assert_eq!(code, 0);
-    assert!(out.contains("valid model") && out.contains("12 unknowns"), "{out}");
+    assert!(
+        out.contains("valid model") && out.contains("12 unknowns"),
+        "{out}"
+    );
 }
 
 #[test]
@@ -111,31 +125,64 @@ fn duplicate_id() {
     let text = CANTILEVER.replace("id = 3\nx = [1.0, 0.0, 0.0]", "id = 2\nx = [1.0, 0.0, 0.0]");
     assert_rejected("duplicate_node", &text, &["node 2", "duplicate node id"]);
     let text = CANTILEVER.replace("id = 2\nnodes = [2, 3]", "id = 1\nnodes = [2, 3]");
-    assert_rejected("duplicate_element", &text, &["beam 1", "duplicate element id"]);
+    assert_rejected(
+        "duplicate_element",
+        &text,
+        &["beam 1", "duplicate element id"],
+    );
 }
 
 #[test]
 fn zero_length_beam() {
     let text = CANTILEVER.replace("x = [1.0, 0.0, 0.0]", "x = [0.5, 0.0, 0.0]");
-    assert_rejected("zero_length", &text, &["beam 2", "zero length", "nodes 2 and 3 coincide"]);
+    assert_rejected(
+        "zero_length",
+        &text,
+        &["beam 2", "zero length", "nodes 2 and 3 coincide"],
+    );
 }
 
 #[test]
 fn non_positive_stiffness_and_mass() {
     let text = CANTILEVER.replace("EA = 1.0e7", "EA = -1.0e7");
-    assert_rejected("negative_stiffness", &text, &["section \"s\"", "EA must be positive"]);
+    assert_rejected(
+        "negative_stiffness",
+        &text,
+        &["section \"s\"", "EA must be positive"],
+    );
     let text = format!("{CANTILEVER}\n[[point_masses]]\nid = 10\nnode = 3\nmass = 0.0\n");
-    assert_rejected("zero_mass", &text, &["point mass 10", "mass must be positive"]);
-    let text = format!("{CANTILEVER}\n[[springs]]\nid = 11\nkind = \"axial\"\nnodes = [1, 3]\nstiffness = -5.0\n");
-    assert_rejected("negative_spring", &text, &["spring 11", "stiffness must be positive"]);
+    assert_rejected(
+        "zero_mass",
+        &text,
+        &["point mass 10", "mass must be positive"],
+    );
+    let text = format!(
+        "{CANTILEVER}\n[[springs]]\nid = 11\nkind = \"axial\"\nnodes = [1, 3]\nstiffness = -5.0\n"
+    );
+    assert_rejected(
+        "negative_spring",
+        &text,
+        &["spring 11", "stiffness must be positive"],
+    );
 }
 
 #[test]
 fn missing_section() {
-    let text = CANTILEVER.replace("section = \"s\"\n\n[[beams]]\nid = 2", "section = \"tube\"\n\n[[beams]]\nid = 2");
-    assert_rejected("missing_section", &text, &["beam 1", "section \"tube\" is not defined"]);
+    let text = CANTILEVER.replace(
+        "section = \"s\"\n\n[[beams]]\nid = 2",
+        "section = \"tube\"\n\n[[beams]]\nid = 2",
+    );
+    assert_rejected(
+        "missing_section",
+        &text,
+        &["beam 1", "section \"tube\" is not defined"],
+    );
     let text = CANTILEVER.replace("EI3 = 1.0e3\n", "");
-    assert_rejected("incomplete_section", &text, &["section \"s\"", "missing EI3"]);
+    assert_rejected(
+        "incomplete_section",
+        &text,
+        &["section \"s\"", "missing EI3"],
+    );
 }
 
 #[test]
@@ -147,16 +194,31 @@ fn unknown_field() {
 
 #[test]
 fn malformed_file_and_missing_file() {
-    assert_rejected("malformed", "[[nodes]\nid = 1", &["TOML parse error at line 1"]);
+    assert_rejected(
+        "malformed",
+        "[[nodes]\nid = 1",
+        &["TOML parse error at line 1"],
+    );
     let (code, _, err) = unfold(&["run", "/nonexistent/model.toml"]);
     assert_eq!(code, 2);
-    assert!(err.contains("/nonexistent/model.toml") && err.contains("cannot read"), "{err}");
+    assert!(
+        err.contains("/nonexistent/model.toml") && err.contains("cannot read"),
+        "{err}"
+    );
 }
 
 #[test]
 fn unrestrained_structure_is_detected_before_running() {
     let text = CANTILEVER.replace("[[supports]]\nnode = 1\nfixed = [\"all\"]\n", "");
-    assert_rejected("free_body", &text, &["nodes 1, 2, 3", "free body", "unrestrained rigid-body motion"]);
+    assert_rejected(
+        "free_body",
+        &text,
+        &[
+            "nodes 1, 2, 3",
+            "free body",
+            "unrestrained rigid-body motion",
+        ],
+    );
 }
 
 #[test]
@@ -169,7 +231,10 @@ fn mechanism_is_reported_as_singular_with_its_dof() {
     let (code, _, err) = run_model(&dir, "pinned.toml", &text);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("pinned.toml"), "{err}");
-    assert!(err.contains("singular tangent") && err.contains("mechanism"), "{err}");
+    assert!(
+        err.contains("singular tangent") && err.contains("mechanism"),
+        "{err}"
+    );
     assert!(err.contains("node "), "the message names no node: {err}");
     let summary = std::fs::read_to_string(dir.join("out/summary.json")).unwrap();
     assert!(summary.contains("\"status\": \"failed\""), "{summary}");
@@ -178,11 +243,30 @@ fn mechanism_is_reported_as_singular_with_its_dof() {
 #[test]
 fn bad_values_in_analysis_and_supports() {
     let text = format!("{CANTILEVER}\n[analysis]\ntype = \"dynamic\"\nend_time = -1.0\n");
-    assert_rejected("bad_analysis", &text, &["analysis", "unknown analysis type \"dynamic\"", "end_time must be positive"]);
+    assert_rejected(
+        "bad_analysis",
+        &text,
+        &[
+            "analysis",
+            "unknown analysis type \"dynamic\"",
+            "end_time must be positive",
+        ],
+    );
     let text = CANTILEVER.replace("fixed = [\"all\"]", "fixed = [\"everything\"]");
-    assert_rejected("bad_support", &text, &["supports[1] (node 1)", "unknown component \"everything\""]);
-    let text = CANTILEVER.replace("[[loads]]\nnode = 3", "[[loads]]\nnode = 3\ncurve = \"missing\"");
-    assert_rejected("bad_curve", &text, &["loads[1] (node 3)", "curve \"missing\" is not defined"]);
+    assert_rejected(
+        "bad_support",
+        &text,
+        &["supports[1] (node 1)", "unknown component \"everything\""],
+    );
+    let text = CANTILEVER.replace(
+        "[[loads]]\nnode = 3",
+        "[[loads]]\nnode = 3\ncurve = \"missing\"",
+    );
+    assert_rejected(
+        "bad_curve",
+        &text,
+        &["loads[1] (node 3)", "curve \"missing\" is not defined"],
+    );
 }
 
 #[test]
@@ -195,8 +279,14 @@ fn divergence_stops_cleanly_and_keeps_results() {
         + "\n[analysis]\ninitial_increment = 0.05\nmax_iterations = 3\nmin_increment = 0.01\n";
     let (code, out, err) = run_model(&dir, "diverge.toml", &text);
     assert_eq!(code, 1, "stdout {out}\nstderr {err}");
-    assert!(err.contains("diverge.toml") && err.contains("no convergence at increment"), "{err}");
-    assert!(err.contains("from t = ") && err.contains("no convergence in 3 iterations"), "{err}");
+    assert!(
+        err.contains("diverge.toml") && err.contains("no convergence at increment"),
+        "{err}"
+    );
+    assert!(
+        err.contains("from t = ") && err.contains("no convergence in 3 iterations"),
+        "{err}"
+    );
     assert!(err.contains("results up to t ="), "{err}");
     let summary: String = std::fs::read_to_string(dir.join("out/summary.json")).unwrap();
     assert!(summary.contains("\"status\": \"failed\""));

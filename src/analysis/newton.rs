@@ -288,7 +288,9 @@ impl NewtonSolver {
             // last one scaled by the residual ratio, |Δq_k+1| ≈ |Δq_k| r_k/r_k-1
             let residual_ok = norms.relative_residual <= tol && self.tangent_checked;
             let ratio = match residuals.len() {
-                n if n >= 2 && residuals[n - 2] > 0.0 => (residuals[n - 1] / residuals[n - 2]).min(1.0),
+                n if n >= 2 && residuals[n - 2] > 0.0 => {
+                    (residuals[n - 1] / residuals[n - 2]).min(1.0)
+                }
                 _ => 1.0,
             };
             let correction_ok = last_correction.is_none_or(|(dx, dth)| {
@@ -360,7 +362,11 @@ impl NewtonSolver {
         let n = self.dofs.n_equations();
         let m = &self.assembler.matrix;
         (0..n)
-            .map(|i| (0..n).map(|j| m.position(i, j).map_or(0.0, |p| m.values()[p])).collect())
+            .map(|i| {
+                (0..n)
+                    .map(|j| m.position(i, j).map_or(0.0, |p| m.values()[p]))
+                    .collect()
+            })
             .collect()
     }
 

@@ -437,6 +437,28 @@ impl ModelInput {
         self
     }
 
+    /// Adds a straight line of `elements` beams between two existing nodes;
+    /// interior nodes and elements get the next free ids.
+    pub fn add_beam_line(
+        &mut self,
+        nodes: [Id; 2],
+        elements: usize,
+        section: impl Into<String>,
+        orientation: Option<[f64; 3]>,
+    ) -> &mut Self {
+        self.beam_lines.push(BeamLineInput {
+            nodes,
+            elements,
+            section: section.into(),
+            orientation,
+            first_node: None,
+            first_element: None,
+            arc_center: None,
+            initial_strain: None,
+        });
+        self
+    }
+
     /// Fixes the listed components (`"all"`, `"x"`, `"rz"`, ...) of a node.
     pub fn fix(&mut self, node: Id, components: &[&str]) -> &mut Self {
         self.supports.push(SupportInput {

@@ -13,7 +13,13 @@ pub struct Recorder {
 }
 
 impl Observer for Recorder {
-    fn increment(&mut self, info: &IncrementInfo, _: &Model, _: &State, _: &[f64]) -> std::io::Result<()> {
+    fn increment(
+        &mut self,
+        info: &IncrementInfo,
+        _: &Model,
+        _: &State,
+        _: &[f64],
+    ) -> std::io::Result<()> {
         self.increments.push(info.clone());
         Ok(())
     }
@@ -30,7 +36,14 @@ pub fn run(input: &ModelInput) -> (Model, StaticOutcome, Vec<IncrementInfo>) {
 
 /// A straight line of `n` beam elements from node 1 at `a` to node 2 at
 /// `b`; interior nodes get ids 3, 4, ... in order from `a`.
-pub fn line(m: &mut ModelInput, a: [f64; 3], b: [f64; 3], n: usize, section: &str, orientation: [f64; 3]) {
+pub fn line(
+    m: &mut ModelInput,
+    a: [f64; 3],
+    b: [f64; 3],
+    n: usize,
+    section: &str,
+    orientation: [f64; 3],
+) {
     m.add_node(1, a);
     m.add_node(2, b);
     m.beam_lines.push(BeamLineInput {

@@ -70,7 +70,7 @@ fn main() {
         for (i, (x, q)) in state.x.iter_mut().zip(state.q.iter_mut()).enumerate() {
             let s = i as f64 / n as f64;
             *x += Vec3::new(-0.01 * s, 0.05 * s * s, -0.03 * s);
-            *q = *q * so3::exp(&Vec3::new(0.1 * s, 0.2 * s, 0.05 * s));
+            *q *= so3::exp(&Vec3::new(0.1 * s, 0.2 * s, 0.05 * s));
         }
         solver.assemble(&model, &state, 1.0, true);
         let t1 = Instant::now();

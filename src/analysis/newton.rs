@@ -408,7 +408,7 @@ impl NewtonSolver {
             }
             state.x[node] += dx;
             if any_rotation {
-                state.q[node] = state.q[node] * so3::exp(&dth);
+                state.q[node] *= so3::exp(&dth);
                 state.q[node].renormalize_fast();
             }
         }

@@ -207,7 +207,7 @@ pub(crate) mod testing {
         } else {
             let mut d = Vec3::zeros();
             d[c - 3] = h;
-            s.q[node] = s.q[node] * so3::exp(&d);
+            s.q[node] *= so3::exp(&d);
         }
         s
     }

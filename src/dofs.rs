@@ -177,7 +177,6 @@ fn node_order(model: &Model) -> Vec<usize> {
                     .filter(|&b| !visited[b]),
             );
             neighbours.sort_by_key(|&b| degree[b]);
-            neighbours.dedup();
             for &b in &neighbours {
                 if !visited[b] {
                     visited[b] = true;

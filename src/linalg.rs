@@ -279,3 +279,85 @@ pub fn smallest_relative_pivot(a: &SparseMatrix) -> Result<(usize, f64), SolveEr
     }
     Ok(worst)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `[[K, Bᵀ], [B, 0]]` with K the 1-D Laplacian (4 unknowns) and two
+    /// constraint rows: an indefinite saddle-point matrix.
+    fn saddle(scale: f64) -> (SparseMatrix, Vec<f64>) {
+        let k = [
+            (0, 0, 2.0),
+            (0, 1, -1.0),
+            (1, 0, -1.0),
+            (1, 1, 2.0),
+            (1, 2, -1.0),
+            (2, 1, -1.0),
+            (2, 2, 2.0),
+            (2, 3, -1.0),
+            (3, 2, -1.0),
+            (3, 3, 2.0),
+            // constraints x0 − x3 = …, x1 + x2 = …
+            (4, 0, 1.0),
+            (4, 3, -1.0),
+            (0, 4, 1.0),
+            (3, 4, -1.0),
+            (5, 1, 1.0),
+            (5, 2, 1.0),
+            (1, 5, 1.0),
+            (2, 5, 1.0),
+        ];
+        let mut a = SparseMatrix::from_pattern(6, k.iter().map(|&(i, j, _)| (i, j)).collect());
+        for &(i, j, v) in &k {
+            let p = a.position(i, j).unwrap();
+            a.values_mut()[p] = v * scale;
+        }
+        (a, vec![1.0, -2.0, 0.5, 3.0, 0.25, -1.0])
+    }
+
+    #[test]
+    fn lu_solves_saddle_point_systems_and_reuses_the_analysis() {
+        let (a, b) = saddle(1.0);
+        let mut lu = SparseLu::analyze(&a).unwrap();
+        for scale in [1.0, 3.5] {
+            // new values, same pattern: the symbolic analysis is reused
+            let (a, _) = saddle(scale);
+            lu.factor(&a).unwrap();
+            let mut x = b.clone();
+            lu.solve_in_place(&mut x).unwrap();
+            let mut ax = vec![0.0; 6];
+            a.mul_vec(&x, &mut ax);
+            let err = ax
+                .iter()
+                .zip(&b)
+                .map(|(p, q)| (p - q).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-13, "residual {err:e}");
+        }
+    }
+
+    #[test]
+    fn singular_matrix_is_located() {
+        // two uncoupled springs, the second without stiffness
+        let mut a = SparseMatrix::from_pattern(3, vec![(0, 0), (0, 1), (1, 0), (1, 1), (2, 2)]);
+        for (i, j, v) in [
+            (0, 0, 2.0),
+            (0, 1, -1.0),
+            (1, 0, -1.0),
+            (1, 1, 2.0),
+            (2, 2, 0.0),
+        ] {
+            let p = a.position(i, j).unwrap();
+            a.values_mut()[p] = v;
+        }
+        let (eq, pivot) = smallest_relative_pivot(&a).unwrap();
+        assert_eq!(eq, 2);
+        assert!(pivot < 1e-12);
+        // and a regular one is not flagged
+        let p = a.position(2, 2).unwrap();
+        a.values_mut()[p] = 5.0;
+        let (_, pivot) = smallest_relative_pivot(&a).unwrap();
+        assert!(pivot > 0.1);
+    }
+}

@@ -162,7 +162,7 @@ impl Observer for RunObserver {
         let n = &info.norms;
         let _ = writeln!(
             self.log,
-            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  relative {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
             info.increment,
             info.iteration,
             n.residual_force,
@@ -170,6 +170,7 @@ impl Observer for RunObserver {
             n.residual_moment,
             n.flux_moment,
             n.relative_residual,
+            n.residual_constraint,
             n.displacement_correction,
             n.rotation_correction
         );

@@ -15,6 +15,8 @@
 //!   flowing through each dof (reactions included), or `‖r‖₂ ≤ 10⁻¹²·k·L`,
 //!   the round-off floor of a structure of stiffness `k = max Kᵢᵢ` and size
 //!   `L`;
+//! - **constraints**: the equations of extra unknowns (the constraints of
+//!   joints) hold to `ε_u · L`;
 //! - **correction**: `max|Δx| ≤ ε_u · L` and `max|ΔΘ| ≤ ε_θ` for the next
 //!   correction, estimated from the last one times the residual ratio,
 //!   `|Δq_{k+1}| ≈ |Δq_k| ‖r_k‖/‖r_{k−1}‖` (exact in the quadratic regime;
@@ -62,6 +64,9 @@ pub struct ConvergenceNorms {
     /// `max(‖r_F‖/ref_F, ‖r_M‖/ref_M)` with `ref = max(‖flux‖, floor/ε_r)`:
     /// the residual criterion holds when this is at most `ε_r`.
     pub relative_residual: f64,
+    /// `max|r|` over the equations of extra unknowns (constraint
+    /// violations of joints), 0 without them.
+    pub residual_constraint: f64,
     /// `max|Δx|` of the last correction (0 before the first).
     pub displacement_correction: f64,
     /// `max|ΔΘ|` of the last correction (0 before the first).
@@ -192,7 +197,7 @@ impl NewtonSolver {
     /// is measured against `max(flux, floor/ε_r)`, so that it is below
     /// `ε_r` exactly when the residual criterion holds.
     fn norms(&self, floor: (f64, f64), tol: f64) -> ConvergenceNorms {
-        let (mut rf, mut rm, mut ff, mut fm) = (0.0, 0.0, 0.0, 0.0);
+        let (mut rf, mut rm, mut ff, mut fm, mut rc) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
         let res = &self.assembler.residual;
         let flux = &self.assembler.flux;
         for dof in 0..res.len() {
@@ -207,7 +212,11 @@ impl NewtonSolver {
                     rm += r2;
                     fm += flux[dof] * flux[dof];
                 }
-                DofKind::Extra => {}
+                DofKind::Extra => {
+                    if free {
+                        rc = rc.max(res[dof].abs());
+                    }
+                }
             }
         }
         let (rf, rm, ff, fm) = (rf.sqrt(), rm.sqrt(), ff.sqrt(), fm.sqrt());
@@ -224,6 +233,7 @@ impl NewtonSolver {
             flux_force: ff,
             flux_moment: fm,
             relative_residual: rel(rf, ff, floor.0).max(rel(rm, fm, floor.1)),
+            residual_constraint: rc,
             displacement_correction: 0.0,
             rotation_correction: 0.0,
         }
@@ -286,7 +296,9 @@ impl NewtonSolver {
 
             // convergence: residual, and the next correction estimated as the
             // last one scaled by the residual ratio, |Δq_k+1| ≈ |Δq_k| r_k/r_k-1
-            let residual_ok = norms.relative_residual <= tol && self.tangent_checked;
+            let residual_ok = norms.relative_residual <= tol
+                && norms.residual_constraint <= settings.displacement_tolerance * length
+                && self.tangent_checked;
             let ratio = match residuals.len() {
                 n if n >= 2 && residuals[n - 2] > 0.0 => {
                     (residuals[n - 1] / residuals[n - 2]).min(1.0)

@@ -44,6 +44,9 @@ pub enum ElementKind {
     Spring,
     /// Nodal force and moment.
     NodalLoad,
+    /// Kinematic constraint enforced with Lagrange multipliers (its extra
+    /// unknowns).
+    Constraint,
 }
 
 impl ElementKind {
@@ -55,6 +58,7 @@ impl ElementKind {
             Self::PointMass => "point mass",
             Self::Spring => "spring",
             Self::NodalLoad => "load",
+            Self::Constraint => "constraint",
         }
     }
 
@@ -66,6 +70,7 @@ impl ElementKind {
             Self::PointMass => 3,
             Self::Spring => 4,
             Self::NodalLoad => 5,
+            Self::Constraint => 6,
         }
     }
 }

@@ -8,7 +8,7 @@
 //!   global frame);
 //! - cells: beams and two-node springs as lines, rigid bodies, point masses
 //!   and springs to ground as vertices, with cell data `kind` (1 beam,
-//!   2 rigid body, 3 point mass, 4 spring), `element_id`, the beam section
+//!   2 rigid body, 3 point mass, 4 spring, 6 constraint), `element_id`, the beam section
 //!   forces `N`, `V2`, `V3`, `T`, `M2`, `M3` (zero on other cells) and the
 //!   spring force and deformation `spring_F`, `spring_D` (zero on other
 //!   cells).

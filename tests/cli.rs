@@ -296,3 +296,50 @@ fn divergence_stops_cleanly_and_keeps_results() {
     let pvd = std::fs::read_to_string(dir.join("out/unfold.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), steps.lines().count() - 1);
 }
+
+#[test]
+fn other_inconsistencies_are_named() {
+    let text = CANTILEVER.replace(
+        "section = \"s\"\n\n[[beams]]\nid = 2",
+        "section = \"s\"\norientation = [2.0, 0.0, 0.0]\n\n[[beams]]\nid = 2",
+    );
+    assert_rejected(
+        "parallel_orientation",
+        &text,
+        &["beam 1", "parallel to the beam axis"],
+    );
+    let text = format!("{CANTILEVER}\n[[rigid_bodies]]\nid = 10\nnode = 3\nmass = 1.0\ninertia = [1.0, -2.0, 1.0]\n");
+    assert_rejected(
+        "bad_inertia",
+        &text,
+        &["rigid body 10", "positive semi-definite"],
+    );
+    let text = format!(
+        "{CANTILEVER}\n[[springs]]\nid = 11\nkind = \"axial\"\nnodes = [3]\nstiffness = 5.0\n"
+    );
+    assert_rejected("axial_to_ground", &text, &["spring 11", "needs two nodes"]);
+    let text = format!("{CANTILEVER}\n[[nodes]]\nid = 7\nx = [3.0, 0.0, 0.0]\n");
+    assert_rejected("lonely_node", &text, &["node 7", "not connected"]);
+    let text = format!(
+        "{CANTILEVER}\n[[curves]]\nname = \"c\"\npoints = [[0.0, 0.0], [1.0, 1.0], [0.5, 2.0]]\n"
+    );
+    assert_rejected(
+        "bad_curve_points",
+        &text,
+        &["curve \"c\"", "increase strictly"],
+    );
+    let text = format!("{CANTILEVER}\n[[prescribed]]\nnode = 3\ndof = \"x\"\nvalue = 0.1\nrotation = [0.0, 0.0, 1.0]\n");
+    assert_rejected(
+        "bad_prescribed",
+        &text,
+        &["prescribed[1] (node 3)", "either `dof` and `value`"],
+    );
+    let text = format!("{CANTILEVER}\n[[beam_lines]]\nnodes = [1, 3]\nelements = 2\nsection = \"s\"\narc_center = [0.5, 5.0, 0.0]\nfirst_node = 50\nfirst_element = 50\n");
+    let text = text.replace("x = [1.0, 0.0, 0.0]", "x = [1.0, 0.1, 0.0]");
+    assert_rejected("bad_arc", &text, &["beam_lines[1]", "not equidistant"]);
+    let text = CANTILEVER.replace(
+        "[[beams]]\nid = 2\nnodes = [2, 3]",
+        "[[beams]]\nid = 2\nnodes = [2, 2]",
+    );
+    assert_rejected("self_beam", &text, &["beam 2", "both ends are node 2"]);
+}

@@ -105,37 +105,38 @@ mod tests {
     use super::*;
     use crate::curves::Curve;
     use crate::elements::testing::tangent_error;
+    use proptest::prelude::*;
 
-    #[test]
-    fn tangents_match_finite_differences() {
-        let curves = [Curve::ramp()];
-        let ctx = EvalContext {
-            time: 0.7,
-            curves: &curves,
-            gravity: Vec3::zeros(),
-            need_tangent: true,
-            dynamics: None,
-        };
-        let state = State {
-            time: 0.7,
-            x: vec![Vec3::new(0.3, 0.1, 0.2)],
-            q: vec![so3::exp(&Vec3::new(1.2, -0.4, 2.1))],
-            extra: vec![],
-            internal: vec![],
-        };
-        for follower in [false, true] {
-            let l = NodalLoad::new(
-                1,
-                0,
-                Vec3::new(1.0, -2.0, 3.0),
-                Vec3::new(-0.5, 4.0, 1.5),
-                follower,
-                0,
-            );
-            assert!(
-                tangent_error(&l, &ctx, &state, 1e-6) < 1e-6,
-                "follower = {follower}"
-            );
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// Tangents of dead and follower loads equal central finite
+        /// differences of the residual (relative error ≤ 1e-6, h = 1e-6)
+        /// for random orientations and load vectors.
+        #[test]
+        fn tangents_match_finite_differences(
+            r in (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64),
+            f in (-5.0..5.0f64, -5.0..5.0f64, -5.0..5.0f64),
+            m in (-5.0..5.0f64, -5.0..5.0f64, -5.0..5.0f64),
+        ) {
+            let curves = [Curve::ramp()];
+            let ctx = EvalContext {
+                time: 0.7,
+                curves: &curves,
+                gravity: Vec3::zeros(),
+                need_tangent: true,
+                dynamics: None,
+            };
+            let state = State {
+                time: 0.7,
+                x: vec![Vec3::new(0.3, 0.1, 0.2)],
+                q: vec![so3::exp(&Vec3::new(r.0, r.1, r.2))],
+                extra: vec![],
+                internal: vec![],
+            };
+            for follower in [false, true] {
+                let l = NodalLoad::new(1, 0, Vec3::new(f.0, f.1, f.2), Vec3::new(m.0, m.1, m.2), follower, 0);
+                prop_assert!(tangent_error(&l, &ctx, &state, 1e-6) < 1e-6, "follower = {}", follower);
+            }
         }
     }
 }

@@ -103,6 +103,7 @@ mod tests {
     use crate::elements::testing::{eval, tangent_error};
     use crate::so3::Rotation;
     use approx::assert_relative_eq;
+    use proptest::prelude::*;
 
     fn state(q: Rotation) -> State {
         State {
@@ -124,12 +125,20 @@ mod tests {
         }
     }
 
-    #[test]
-    fn tangent_matches_finite_differences() {
-        let body = RigidBody::new(1, 0, 2.5, Mat3::identity(), Vec3::new(0.3, -0.1, 0.7));
-        let s = state(so3::exp(&Vec3::new(0.7, -1.1, 2.0)));
-        // relative error bound as for beams (central differences, h = 1e-6)
-        assert!(tangent_error(&body, &ctx(), &s, 1e-6) < 1e-6);
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// Tangent equals central finite differences of the residual
+        /// (relative error ≤ 1e-6, h = 1e-6) for random orientations and
+        /// centre-of-mass offsets.
+        #[test]
+        fn tangent_matches_finite_differences(
+            r in (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64),
+            c in (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64),
+        ) {
+            let body = RigidBody::new(1, 0, 2.5, Mat3::identity(), Vec3::new(c.0, c.1, c.2));
+            let s = state(so3::exp(&Vec3::new(r.0, r.1, r.2)));
+            prop_assert!(tangent_error(&body, &ctx(), &s, 1e-6) < 1e-6);
+        }
     }
 
     #[test]

@@ -242,6 +242,7 @@ mod tests {
     use super::*;
     use crate::elements::testing::{eval, tangent_error};
     use approx::assert_relative_eq;
+    use proptest::prelude::*;
 
     fn ctx() -> EvalContext<'static> {
         EvalContext {
@@ -263,31 +264,35 @@ mod tests {
         }
     }
 
-    #[test]
-    fn tangents_match_finite_differences() {
-        let x0 = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.5, -0.2)];
-        let r0 = [
-            so3::exp(&Vec3::new(0.3, -0.2, 0.1)),
-            so3::exp(&Vec3::new(-1.0, 0.4, 0.8)),
-        ];
-        let x = [Vec3::new(0.1, -0.2, 0.05), Vec3::new(1.3, 0.2, 0.1)];
-        let q = [
-            r0[0] * so3::exp(&Vec3::new(0.5, 0.9, -0.4)),
-            r0[1] * so3::exp(&Vec3::new(-0.7, 0.2, 1.1)),
-        ];
-        let k = Vec3::new(10.0, 20.0, 35.0);
-        for kind in [
-            SpringKind::Translational,
-            SpringKind::Rotational,
-            SpringKind::Axial,
-        ] {
-            let s2 = Spring::new(1, kind, &[0, 1], &x0, &r0, k).unwrap();
-            let err = tangent_error(&s2, &ctx(), &state(&x, &q), 1e-6);
-            assert!(err < 1e-6, "{kind:?} two nodes: {err:e}");
-            if kind != SpringKind::Axial {
-                let s1 = Spring::new(2, kind, &[0], &x0[..1], &r0[..1], k).unwrap();
-                let err = tangent_error(&s1, &ctx(), &state(&x[..1], &q[..1]), 1e-6);
-                assert!(err < 1e-6, "{kind:?} grounded: {err:e}");
+    fn vec3(max: f64) -> impl Strategy<Value = Vec3> {
+        (-max..max, -max..max, -max..max).prop_map(|(a, b, c)| Vec3::new(a, b, c))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// Tangents equal central finite differences of the residual
+        /// (relative error ≤ 1e-6, h = 1e-6) on random configurations:
+        /// reference orientations anywhere, relative rotations up to ~2.5
+        /// rad (below π, where the rotational spring is defined).
+        #[test]
+        fn tangents_match_finite_differences(
+            ra in vec3(3.0), rb in vec3(3.0), da in vec3(0.7), db in vec3(0.7),
+            xa in vec3(0.3), xb in vec3(0.3), k in vec3(1.0),
+        ) {
+            let x0 = [Vec3::zeros(), Vec3::new(1.0, 0.5, -0.2)];
+            let r0 = [so3::exp(&ra), so3::exp(&rb)];
+            let x = [x0[0] + xa, x0[1] + xb];
+            let q = [r0[0] * so3::exp(&da), r0[1] * so3::exp(&db)];
+            let k = k.map(|v| 10.0 + 20.0 * v.abs());
+            for kind in [SpringKind::Translational, SpringKind::Rotational, SpringKind::Axial] {
+                let s2 = Spring::new(1, kind, &[0, 1], &x0, &r0, k).unwrap();
+                let err = tangent_error(&s2, &ctx(), &state(&x, &q), 1e-6);
+                prop_assert!(err < 1e-6, "{kind:?} two nodes: {err:e}");
+                if kind != SpringKind::Axial {
+                    let s1 = Spring::new(2, kind, &[0], &x0[..1], &r0[..1], k).unwrap();
+                    let err = tangent_error(&s1, &ctx(), &state(&x[..1], &q[..1]), 1e-6);
+                    prop_assert!(err < 1e-6, "{kind:?} grounded: {err:e}");
+                }
             }
         }
     }

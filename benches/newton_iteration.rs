@@ -29,6 +29,7 @@ fn cantilever(n: usize) -> Model {
         first_element: Some(1),
         arc_center: None,
         initial_strain: None,
+        initial_strain_curve: None,
     });
     m.fix(1, &["all"]);
     m.add_load(2, [0.0, 1.0, -1.0], [0.5, 0.0, 0.0]);

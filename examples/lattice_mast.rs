@@ -89,6 +89,7 @@ pub fn build(bays: usize) -> ModelInput {
             first_element: Some(next_element),
             arc_center: None,
             initial_strain: strain,
+            initial_strain_curve: None,
         });
         next_node += 1;
         next_element += 2;

@@ -306,6 +306,7 @@ fn right_angle_frame_small_load() {
             first_element: Some(1 + 10 * k as u64),
             arc_center: None,
             initial_strain: None,
+            initial_strain_curve: None,
         });
     }
     m.fix(1, &["all"]);
@@ -376,7 +377,10 @@ fn rigid_motion_leaves_strains_and_forces_unchanged() {
         for k in 0..6 {
             worst = worst.max((a[k] - b[k]).abs() / scale);
         }
-        let (ua, ub) = (e.strain_energy(&deformed), e.strain_energy(&moved));
+        let (ua, ub) = (
+            e.strain_energy(&ctx, &deformed),
+            e.strain_energy(&ctx, &moved),
+        );
         assert!(ua > 0.0);
         worst = worst.max((ua - ub).abs() / ua);
         // internal nodal forces: same magnitudes
@@ -407,4 +411,125 @@ fn rigid_motion_leaves_strains_and_forces_unchanged() {
     }
     println!("largest relative change under rigid motion: {worst:.2e}");
     assert!(worst < 1e-9, "{worst}");
+}
+
+/// A straight beam whose stress-free state is curved (initial curvature
+/// κ₀ = (π/2)/L, applied along the ramp) settles, without load, into a
+/// quarter circle of radius 1/κ₀.
+///
+/// Source: a stress-free arc of radius R = 1/κ₀ has its tip at (R, R)
+/// from a root tangent to x. Tolerance: as for the roll-up, the nodes lie
+/// on a circle of radius `(L/n)/(2 sin(φ/2))` instead of `(L/n)/φ`
+/// (φ = π/2n): `φ²/24 = 0.1 %` of R with 10 elements; 0.2 % allowed.
+#[test]
+fn natural_curvature_gives_a_stress_free_arc() {
+    let l = 1.0;
+    let kappa = PI / 2.0 / l;
+    let mut m = ModelInput::new("naturally curved strip");
+    m.add_section("strip", [1e5, 4e4, 4e4, 10.0, 10.0, 10.0]);
+    m.add_node(1, [0.0; 3]).add_node(2, [l, 0.0, 0.0]);
+    m.beam_lines.push(BeamLineInput {
+        nodes: [1, 2],
+        elements: 10,
+        section: "strip".into(),
+        orientation: Some([0.0, 1.0, 0.0]),
+        first_node: Some(3),
+        first_element: Some(1),
+        arc_center: None,
+        // local axis 3 = x × y = z: curvature about local 3 bends towards +y
+        initial_strain: Some([0.0, 0.0, 0.0, 0.0, 0.0, kappa]),
+        initial_strain_curve: Some("ramp".into()),
+    });
+    m.fix(1, &["all"]);
+    let (model, outcome, increments) = run(&m);
+    assert!(outcome.error.is_none(), "{:?}", outcome.error);
+    report("natural curvature", &increments);
+    let r = 1.0 / kappa;
+    let tip = outcome.state.x[node(&model, 2)];
+    let error = (tip - Vec3::new(r, r, 0.0)).norm() / r;
+    println!(
+        "tip {tip:?}, arc ({r}, {r}): error {:.3} % of R",
+        100.0 * error
+    );
+    assert!(error < 2e-3);
+    // stress-free: every beam's strain energy vanishes at t = 1
+    let ctx = EvalContext {
+        time: 1.0,
+        curves: &model.curves,
+        gravity: Vec3::zeros(),
+        need_tangent: false,
+        dynamics: None,
+    };
+    let energy: f64 = model
+        .elements
+        .iter()
+        .map(|e| e.strain_energy(&ctx, &outcome.state))
+        .sum();
+    assert!(energy < 1e-12, "energy {energy:e}");
+}
+
+/// Gravity on a cantilever carrying its own weight and a tip rigid body
+/// whose centre of mass is offset beyond the tip: the deflection is that
+/// of a distributed load `q = m_l g`, a tip force `M g` and a tip moment
+/// `M g c`, all small:
+/// `w = qL⁴/8EI + qL²/2GA + MgL³/3EI + MgL/GA + MgcL²/2EI`.
+///
+/// Source: linear beam theory. Tolerance 1 %: half the weight of each
+/// element is lumped at its nodes, an O(h²) error (< 0.5 % with 10
+/// elements) on top of the 0.25 % of one-point integration.
+#[test]
+fn gravity_on_beam_mass_and_offset_rigid_body() {
+    let [ea, ga2, ga3, gj, ei2, ei3] = steel_section();
+    let (l, ml, mass, c, g): (f64, f64, f64, f64, f64) = (2.0, 6.3, 3.0, 0.2, 9.81);
+    let mut m = ModelInput::new("cantilever under gravity");
+    m.sections.push(unfold::model::input::SectionInput {
+        name: "steel".into(),
+        ea: Some(ea),
+        ga2: Some(ga2),
+        ga3: Some(ga3),
+        gj: Some(gj),
+        ei2: Some(ei2),
+        ei3: Some(ei3),
+        mass_per_length: Some(ml),
+        ..Default::default()
+    });
+    line(
+        &mut m,
+        [0.0; 3],
+        [l, 0.0, 0.0],
+        10,
+        "steel",
+        [0.0, 0.0, 1.0],
+    );
+    m.fix(1, &["all"]);
+    m.rigid_bodies.push(unfold::model::input::RigidBodyInput {
+        id: 100,
+        node: 2,
+        mass,
+        inertia: Some(unfold::model::input::InertiaInput::Diagonal([
+            0.01, 0.02, 0.02,
+        ])),
+        center_of_mass: Some([c, 0.0, 0.0]),
+    });
+    m.gravity = Some(unfold::model::input::GravityInput {
+        acceleration: [0.0, 0.0, -g],
+        curve: None,
+    });
+    m.analysis.initial_increment = Some(1.0);
+    let (model, outcome, _) = run(&m);
+    assert!(outcome.error.is_none(), "{:?}", outcome.error);
+    let w = -outcome.state.x[node(&model, 2)].z;
+    // load along z: bending about local 3 (EI3), shear along local 2 (GA2)
+    let (q, p) = (ml * g, mass * g);
+    let expected = q * l.powi(4) / (8.0 * ei3)
+        + q * l * l / (2.0 * ga2)
+        + p * l.powi(3) / (3.0 * ei3)
+        + p * l / ga2
+        + p * c * l * l / (2.0 * ei3);
+    let error = (w - expected).abs() / expected;
+    println!(
+        "tip deflection {w:.6e}, beam theory {expected:.6e}, error {:.3} %",
+        100.0 * error
+    );
+    assert!(error < 1e-2);
 }

@@ -66,14 +66,16 @@ pub trait Observer {
     /// After each residual evaluation of a Newton iteration.
     fn iteration(&mut self, _info: &IterationInfo) {}
 
-    /// After each converged increment; returning an error stops the
-    /// analysis (used by result writers when a file cannot be written).
+    /// After each converged increment, with the converged state and the
+    /// residual at every dof (at fixed dofs: the support reactions);
+    /// returning an error stops the analysis (used by result writers when a
+    /// file cannot be written).
     fn increment(
         &mut self,
         _info: &IncrementInfo,
         _model: &Model,
         _state: &State,
-        _reactions: &[f64],
+        _residual: &[f64],
     ) -> std::io::Result<()> {
         Ok(())
     }

@@ -29,6 +29,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{add_block, add_vec, CellShape, Element, ElementKind, ElementOutput, EvalContext};
+use crate::curves::{Curve, CurveIndex};
 use crate::model::input::Id;
 use crate::so3::{self, skew, Mat3, Operator, Rotation, SkewSeries, Vec3};
 use crate::state::State;
@@ -49,6 +50,29 @@ pub struct SectionForces {
     pub moment: Vec3,
 }
 
+/// Properties of a beam cross-section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BeamSection {
+    /// Sectional stiffness `C` (axial, shear 2, shear 3, torsion,
+    /// bending 2, bending 3).
+    pub stiffness: SectionStiffness,
+    /// Mass per unit length.
+    pub mass_per_length: f64,
+    /// Rotational inertia per unit length about the section axes 1, 2, 3.
+    pub inertia_per_length: Vec3,
+}
+
+/// Sectional strains added to the stress-free state of a beam, optionally
+/// applied gradually: `f(t) ε_init` with `f` a load curve (all at once if
+/// `curve` is `None`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InitialStrain {
+    /// `ε_init`: axial, shear 2, shear 3, torsion, curvature 2, curvature 3.
+    pub strain: [f64; 6],
+    /// Curve `f(t)` that scales it, if any.
+    pub curve: Option<CurveIndex>,
+}
+
 /// A two-node geometrically exact beam element.
 #[derive(Clone, Debug)]
 pub struct Beam {
@@ -56,16 +80,14 @@ pub struct Beam {
     nodes: [usize; 2],
     /// Reference length `L₀`.
     length: f64,
-    /// Sectional stiffness `C`.
-    stiffness: SectionStiffness,
+    /// Section properties.
+    section: BeamSection,
     /// Offsets `Qᵢ` from node frame to section frame.
     offsets: [Rotation; 2],
-    /// Strains of the stress-free state, `(Γ₀, K₀)`.
-    free_strain: Vec6,
-    /// Mass per unit length.
-    mass_per_length: f64,
-    /// Rotational inertia per unit length about the section axes.
-    inertia_per_length: Vec3,
+    /// Strains of the reference configuration, `(Γ_ref, K_ref)`.
+    reference_strain: Vec6,
+    /// Strain added to the stress-free state.
+    initial: InitialStrain,
 }
 
 /// Everything computed from one configuration of the element.
@@ -84,45 +106,46 @@ impl Beam {
     /// Creates a beam between `nodes` (with reference positions `x` and
     /// orientations `r`), with section axis 2 taken from `reference_vector`
     /// (its part normal to the beam axis). The stress-free state is the
-    /// reference geometry shifted by `initial_strain`.
+    /// reference geometry shifted by the initial strain.
     ///
     /// Returns `None` if the beam has zero length or the reference vector is
     /// parallel to its axis.
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         id: Id,
         nodes: [usize; 2],
         x: [Vec3; 2],
         r: [Rotation; 2],
         reference_vector: Vec3,
-        stiffness: SectionStiffness,
-        initial_strain: [f64; 6],
-        mass_per_length: f64,
-        inertia_per_length: Vec3,
+        section: BeamSection,
+        initial: InitialStrain,
     ) -> Option<Self> {
         let axis = x[1] - x[0];
         let length = axis.norm();
         if length <= 0.0 || !length.is_finite() {
             return None;
         }
-        let section = so3::frame_from_axis_and_vector(&axis, &reference_vector)?;
-        let section = so3::from_matrix(&section);
-        let offsets = [r[0].inverse() * section, r[1].inverse() * section];
+        let frame = so3::frame_from_axis_and_vector(&axis, &reference_vector)?;
+        let frame = so3::from_matrix(&frame);
+        let offsets = [r[0].inverse() * frame, r[1].inverse() * frame];
         let mut beam = Self {
             id,
             nodes,
             length,
-            stiffness,
+            section,
             offsets,
-            free_strain: Vec6::zeros(),
-            mass_per_length,
-            inertia_per_length,
+            reference_strain: Vec6::zeros(),
+            initial,
         };
-        // stress-free strains: those of the reference configuration, plus
-        // the initial strain
-        let reference = beam.kinematics(&x, &r);
-        beam.free_strain = reference.strain + Vec6::from_row_slice(&initial_strain);
+        // strains of the reference configuration: stress-free
+        beam.reference_strain = beam.kinematics(&x, &r, &Vec6::zeros()).strain;
         Some(beam)
+    }
+
+    /// Strains `(Γ₀, K₀)` of the stress-free state at load parameter `t`:
+    /// the reference strains plus `f(t) ε_init`.
+    fn free_strain(&self, curves: &[Curve], t: f64) -> Vec6 {
+        let scale = self.initial.curve.map_or(1.0, |c| curves[c].value(t));
+        self.reference_strain + Vec6::from_row_slice(&self.initial.strain) * scale
     }
 
     /// Reference length `L₀`.
@@ -130,19 +153,14 @@ impl Beam {
         self.length
     }
 
-    /// Sectional stiffness.
-    pub fn stiffness(&self) -> &SectionStiffness {
-        &self.stiffness
+    /// Section properties.
+    pub fn section(&self) -> &BeamSection {
+        &self.section
     }
 
-    /// Rotational inertia per unit length (for dynamics).
-    pub fn inertia_per_length(&self) -> Vec3 {
-        self.inertia_per_length
-    }
-
-    /// Kinematics for node positions `x` and orientations `r`; `strain` is
-    /// the total strain (before subtracting the stress-free state).
-    fn kinematics(&self, x: &[Vec3; 2], r: &[Rotation; 2]) -> Kinematics {
+    /// Kinematics for node positions `x` and orientations `r`, with the
+    /// strains measured from the stress-free strains `free`.
+    fn kinematics(&self, x: &[Vec3; 2], r: &[Rotation; 2], free: &Vec6) -> Kinematics {
         // section frames and relative rotation, B1
         let l1 = r[0] * self.offsets[0];
         let l2 = r[1] * self.offsets[1];
@@ -155,7 +173,7 @@ impl Beam {
         strain
             .fixed_rows_mut::<3>(3)
             .copy_from(&(phi / self.length));
-        strain -= self.free_strain;
+        strain -= free;
         Kinematics {
             lm,
             dm,
@@ -169,11 +187,16 @@ impl Beam {
         ([state.x[a], state.x[b]], [state.q[a], state.q[b]])
     }
 
-    /// Section forces at the integration point for the given state.
-    pub fn section_forces(&self, state: &State) -> SectionForces {
+    /// Kinematics of the current state.
+    fn current(&self, ctx: &EvalContext, state: &State) -> Kinematics {
         let (x, r) = self.pose(state);
-        let k = self.kinematics(&x, &r);
-        let s = self.stiffness * k.strain;
+        self.kinematics(&x, &r, &self.free_strain(ctx.curves, ctx.time))
+    }
+
+    /// Section forces at the integration point for the given state.
+    pub fn section_forces(&self, ctx: &EvalContext, state: &State) -> SectionForces {
+        let k = self.current(ctx, state);
+        let s = self.section.stiffness * k.strain;
         SectionForces {
             force: s.fixed_rows::<3>(0).into(),
             moment: s.fixed_rows::<3>(3).into(),
@@ -184,7 +207,8 @@ impl Beam {
     /// `(δx₁, δα₁, δx₂, δα₂)`, `δαᵢ = Qᵢᵀ δΘᵢ`.
     fn local(&self, k: &Kinematics, need_tangent: bool) -> (Vec12, Option<Mat12>) {
         let l0 = self.length;
-        let sigma = self.stiffness * k.strain;
+        let c = &self.section.stiffness;
+        let sigma = c * k.strain;
         let n: Vec3 = sigma.fixed_rows::<3>(0).into();
         let m: Vec3 = sigma.fixed_rows::<3>(3).into();
 
@@ -230,7 +254,7 @@ impl Beam {
                 .copy_from(&(bphi[i] / l0));
         }
         // material stiffness, B7
-        let mut kt: Mat12 = b.transpose() * (self.stiffness * b) * l0;
+        let mut kt: Mat12 = b.transpose() * (c * b) * l0;
 
         // geometric stiffness, B8: derivatives of Bᵀσ at fixed σ
         let n_skew = skew(&n);
@@ -294,13 +318,12 @@ impl Element for Beam {
     }
 
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
-        let (x, r) = self.pose(state);
-        let k = self.kinematics(&x, &r);
+        let k = self.current(ctx, state);
         let (f, kt) = self.local(&k, ctx.need_tangent);
         let q = [so3::matrix(&self.offsets[0]), so3::matrix(&self.offsets[1])];
 
         // residual, rotated from section to node frames: f_Θ = Q f_α
-        let weight = -0.5 * self.mass_per_length * self.length;
+        let weight = -0.5 * self.section.mass_per_length * self.length;
         for i in 0..2 {
             let fx: Vec3 = f.fixed_rows::<3>(6 * i).into();
             let fa: Vec3 = f.fixed_rows::<3>(6 * i + 3).into();
@@ -329,17 +352,16 @@ impl Element for Beam {
         &["N", "V2", "V3", "T", "M2", "M3"]
     }
 
-    fn results(&self, _ctx: &EvalContext, state: &State, out: &mut [f64]) {
-        let s = self.section_forces(state);
+    fn results(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
+        let s = self.section_forces(ctx, state);
         out[..3].copy_from_slice(s.force.as_slice());
         out[3..6].copy_from_slice(s.moment.as_slice());
     }
 
     /// Strain energy `½ L₀ εᵀ C ε`.
-    fn strain_energy(&self, state: &State) -> f64 {
-        let (x, r) = self.pose(state);
-        let k = self.kinematics(&x, &r);
-        0.5 * self.length * k.strain.dot(&(self.stiffness * k.strain))
+    fn strain_energy(&self, ctx: &EvalContext, state: &State) -> f64 {
+        let k = self.current(ctx, state);
+        0.5 * self.length * k.strain.dot(&(self.section.stiffness * k.strain))
     }
 
     fn cell_shape(&self) -> CellShape {
@@ -347,7 +369,7 @@ impl Element for Beam {
     }
 
     fn mass(&self) -> f64 {
-        self.mass_per_length * self.length
+        self.section.mass_per_length * self.length
     }
 }
 
@@ -368,6 +390,14 @@ mod tests {
         }
     }
 
+    fn section(stiffness: SectionStiffness, mass_per_length: f64) -> BeamSection {
+        BeamSection {
+            stiffness,
+            mass_per_length,
+            inertia_per_length: Vec3::zeros(),
+        }
+    }
+
     /// A beam with a full, coupled 6×6 section (all terms exercised).
     fn test_beam(x: [Vec3; 2], r: [Rotation; 2], initial: [f64; 6]) -> Beam {
         let mut c =
@@ -377,18 +407,16 @@ mod tests {
         c[(4, 0)] = 50.0;
         c[(1, 3)] = -20.0;
         c[(3, 1)] = -20.0;
-        Beam::new(
-            1,
-            [0, 1],
-            x,
-            r,
-            Vec3::new(0.2, 1.0, 0.3),
-            c,
-            initial,
-            2.0,
-            Vec3::new(0.1, 0.05, 0.05),
-        )
-        .unwrap()
+        let section = BeamSection {
+            stiffness: c,
+            mass_per_length: 2.0,
+            inertia_per_length: Vec3::new(0.1, 0.05, 0.05),
+        };
+        let initial = InitialStrain {
+            strain: initial,
+            curve: None,
+        };
+        Beam::new(1, [0, 1], x, r, Vec3::new(0.2, 1.0, 0.3), section, initial).unwrap()
     }
 
     fn state_of(x: [Vec3; 2], r: [Rotation; 2]) -> State {
@@ -448,7 +476,7 @@ mod tests {
         c.gravity = Vec3::zeros();
         let (f, _) = eval(&beam, &c, &state_of(x, r));
         assert!(f.iter().all(|v| v.abs() < 1e-12), "{f:?}");
-        assert_eq!(beam.strain_energy(&state_of(x, r)), 0.0);
+        assert_eq!(beam.strain_energy(&c, &state_of(x, r)), 0.0);
     }
 
     #[test]
@@ -457,21 +485,29 @@ mod tests {
         let x = [Vec3::zeros(), Vec3::new(2.0, 0.0, 0.0)];
         let r = [Rotation::identity(); 2];
         let c = SectionStiffness::from_diagonal(&Vec6::new(1e4, 1e3, 1e3, 1e2, 1e2, 1e2));
-        let beam = Beam::new(
-            1,
-            [0, 1],
-            x,
-            r,
-            Vec3::z(),
-            c,
-            [-0.01, 0.0, 0.0, 0.0, 0.0, 0.0],
-            0.0,
-            Vec3::zeros(),
-        )
-        .unwrap();
-        let s = beam.section_forces(&state_of(x, r));
+        let shortening = [-0.01, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let all_at_once = InitialStrain {
+            strain: shortening,
+            curve: None,
+        };
+        let beam = Beam::new(1, [0, 1], x, r, Vec3::z(), section(c, 0.0), all_at_once).unwrap();
+        let curves = [crate::curves::Curve::ramp()];
+        let s = beam.section_forces(&ctx(&curves), &state_of(x, r));
         assert_relative_eq!(s.force.x, 100.0, epsilon = 1e-9);
         assert_relative_eq!(s.moment.norm(), 0.0, epsilon = 1e-12);
+        // applied along the ramp: at t = 0.25, a quarter of it
+        let gradual = InitialStrain {
+            strain: shortening,
+            curve: Some(0),
+        };
+        let beam = Beam::new(1, [0, 1], x, r, Vec3::z(), section(c, 0.0), gradual).unwrap();
+        let mut at = ctx(&curves);
+        at.time = 0.25;
+        assert_relative_eq!(
+            beam.section_forces(&at, &state_of(x, r)).force.x,
+            25.0,
+            epsilon = 1e-9
+        );
     }
 
     #[test]
@@ -479,7 +515,16 @@ mod tests {
         let x = [Vec3::zeros(), Vec3::new(2.0, 0.0, 0.0)];
         let r = [Rotation::identity(); 2];
         let c = SectionStiffness::identity();
-        let beam = Beam::new(1, [0, 1], x, r, Vec3::z(), c, [0.0; 6], 3.0, Vec3::zeros()).unwrap();
+        let beam = Beam::new(
+            1,
+            [0, 1],
+            x,
+            r,
+            Vec3::z(),
+            section(c, 3.0),
+            InitialStrain::default(),
+        )
+        .unwrap();
         let curves = [];
         let (f, _) = eval(&beam, &ctx(&curves), &state_of(x, r));
         // residual = −f_ext = −(−m L g/2) in z: 3·2·9.81/2 = 29.43
@@ -490,31 +535,11 @@ mod tests {
     #[test]
     fn rejects_degenerate_geometry() {
         let r = [Rotation::identity(); 2];
-        let c = SectionStiffness::identity();
+        let c = section(SectionStiffness::identity(), 0.0);
         let p = Vec3::new(1.0, 1.0, 1.0);
-        assert!(Beam::new(
-            1,
-            [0, 1],
-            [p, p],
-            r,
-            Vec3::z(),
-            c,
-            [0.0; 6],
-            0.0,
-            Vec3::zeros()
-        )
-        .is_none());
-        assert!(Beam::new(
-            1,
-            [0, 1],
-            [Vec3::zeros(), Vec3::z()],
-            r,
-            Vec3::z(),
-            c,
-            [0.0; 6],
-            0.0,
-            Vec3::zeros()
-        )
-        .is_none());
+        let none = InitialStrain::default();
+        assert!(Beam::new(1, [0, 1], [p, p], r, Vec3::z(), c.clone(), none).is_none());
+        let along_z = [Vec3::zeros(), Vec3::z()];
+        assert!(Beam::new(1, [0, 1], along_z, r, Vec3::z(), c, none).is_none());
     }
 }

@@ -160,7 +160,7 @@ pub trait Element: Send + Sync {
     fn results(&self, _ctx: &EvalContext, _state: &State, _out: &mut [f64]) {}
 
     /// Elastic energy stored in the element (beams, springs).
-    fn strain_energy(&self, _state: &State) -> f64 {
+    fn strain_energy(&self, _ctx: &EvalContext, _state: &State) -> f64 {
         0.0
     }
 

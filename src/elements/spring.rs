@@ -223,7 +223,7 @@ impl Element for Spring {
     }
 
     /// `½ Σ kᵢ dᵢ²` of the spring's deformation.
-    fn strain_energy(&self, state: &State) -> f64 {
+    fn strain_energy(&self, _ctx: &EvalContext, state: &State) -> f64 {
         let (f, d) = self.force_and_deformation(state);
         0.5 * f.dot(&d)
     }

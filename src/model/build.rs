@@ -5,7 +5,7 @@ use std::collections::{HashMap, HashSet};
 use super::input::*;
 use super::{Model, ModelError, ModelErrorKind, ModelErrors, Prescribed, StaticSettings};
 use crate::curves::{Curve, CurveIndex};
-use crate::elements::beam::{Beam, SectionStiffness};
+use crate::elements::beam::{Beam, BeamSection, InitialStrain, SectionStiffness};
 use crate::elements::load::NodalLoad;
 use crate::elements::mass::RigidBody;
 use crate::elements::spring::Spring;
@@ -64,14 +64,6 @@ impl Checker {
 struct NodeData {
     x: Vec3,
     q: Rotation,
-}
-
-/// Section data after validation.
-#[derive(Clone)]
-struct Section {
-    stiffness: SectionStiffness,
-    mass_per_length: f64,
-    inertia_per_length: Vec3,
 }
 
 /// Default reference vector for local axis 2: global z, or global x for a
@@ -178,7 +170,7 @@ impl Model {
         }
 
         // ---------- sections ----------
-        let mut sections: HashMap<String, Section> = HashMap::new();
+        let mut sections: HashMap<String, BeamSection> = HashMap::new();
         let mut bad_sections: HashSet<String> = HashSet::new();
         for s in &input.sections {
             let entity = format!("section \"{}\"", s.name);
@@ -237,6 +229,7 @@ impl Model {
             section: String,
             orientation: Option<[f64; 3]>,
             initial_strain: [f64; 6],
+            initial_curve: Option<String>,
         }
         let mut beam_specs: Vec<BeamSpec> = Vec::new();
         for b in &input.beams {
@@ -260,6 +253,7 @@ impl Model {
                     section: b.section.clone(),
                     orientation: b.orientation,
                     initial_strain: b.initial_strain.unwrap_or([0.0; 6]),
+                    initial_curve: b.initial_strain_curve.clone(),
                 });
             }
         }
@@ -356,6 +350,7 @@ impl Model {
                         section: line.section.clone(),
                         orientation: line.orientation,
                         initial_strain: line.initial_strain.unwrap_or([0.0; 6]),
+                        initial_curve: line.initial_strain_curve.clone(),
                     });
                 }
                 eid += 1;
@@ -400,16 +395,21 @@ impl Model {
                 }
                 None => default_orientation(&axis),
             };
+            let initial = InitialStrain {
+                strain: spec.initial_strain,
+                curve: spec
+                    .initial_curve
+                    .as_ref()
+                    .map(|name| find_curve(&mut ck, entity, &Some(name.clone()))),
+            };
             match Beam::new(
                 spec.id,
                 [a, b],
                 [nodes[a].x, nodes[b].x],
                 [nodes[a].q, nodes[b].q],
                 orientation,
-                sec.stiffness,
-                spec.initial_strain,
-                sec.mass_per_length,
-                sec.inertia_per_length,
+                sec.clone(),
+                initial,
             ) {
                 Some(beam) => elements.push(Box::new(beam)),
                 None => ck.push(
@@ -683,6 +683,7 @@ impl Model {
         Ok(Model {
             title: input.title.clone().unwrap_or_default(),
             node_ids,
+            node_lookup: node_index,
             reference_x: nodes.iter().map(|n| n.x).collect(),
             reference_q: nodes.iter().map(|n| n.q).collect(),
             elements,
@@ -774,7 +775,7 @@ fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
 }
 
 /// Validated section properties.
-fn section(ck: &mut Checker, entity: &str, s: &SectionInput) -> Option<Section> {
+fn section(ck: &mut Checker, entity: &str, s: &SectionInput) -> Option<BeamSection> {
     let diagonal = [
         ("EA", s.ea),
         ("GA2", s.ga2),
@@ -878,7 +879,7 @@ fn section(ck: &mut Checker, entity: &str, s: &SectionInput) -> Option<Section> 
         );
         ok = false;
     }
-    ok.then(|| Section {
+    ok.then(|| BeamSection {
         stiffness,
         mass_per_length: mass,
         inertia_per_length: Vec3::from(inertia),

@@ -191,6 +191,10 @@ pub struct BeamInput {
     /// curvature 3). A negative axial value shortens the beam: pretension.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_strain: Option<[f64; 6]>,
+    /// Curve `f(t)` applying the initial strain gradually (`f(t) ε_init`);
+    /// default: all of it from `t = 0`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_strain_curve: Option<String>,
 }
 
 /// A line between two existing nodes, meshed into beam elements.
@@ -221,6 +225,9 @@ pub struct BeamLineInput {
     /// Initial strain of every element (as for beams).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_strain: Option<[f64; 6]>,
+    /// Curve applying the initial strain gradually (as for beams).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_strain_curve: Option<String>,
 }
 
 /// A rigid body carried by a node.
@@ -433,6 +440,7 @@ impl ModelInput {
             section: section.into(),
             orientation,
             initial_strain: None,
+            initial_strain_curve: None,
         });
         self
     }
@@ -455,6 +463,7 @@ impl ModelInput {
             first_element: None,
             arc_center: None,
             initial_strain: None,
+            initial_strain_curve: None,
         });
         self
     }

@@ -74,6 +74,8 @@ pub struct Model {
     pub title: String,
     /// Node ids, by node index.
     pub node_ids: Vec<Id>,
+    /// Node index of each id.
+    node_lookup: std::collections::HashMap<Id, usize>,
     /// Reference positions, by node index.
     pub reference_x: Vec<Vec3>,
     /// Reference orientations, by node index.
@@ -124,7 +126,7 @@ impl Model {
 
     /// Index of the node with id `id`.
     pub fn node_index(&self, id: Id) -> Option<usize> {
-        self.node_ids.iter().position(|&n| n == id)
+        self.node_lookup.get(&id).copied()
     }
 
     /// Gravity acceleration at load parameter `t`.

@@ -55,6 +55,7 @@ pub fn line(
         first_element: Some(1),
         arc_center: None,
         initial_strain: None,
+        initial_strain_curve: None,
     });
 }
 

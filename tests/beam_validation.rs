@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{line, node, run};
+use common::{example, line, node, run};
 use unfold::analysis::IncrementInfo;
 use unfold::elements::EvalContext;
 use unfold::model::input::{BeamLineInput, ModelInput};
@@ -236,13 +236,7 @@ fn newton_converges_quadratically_on_the_rollup() {
 /// Source: Newton's method with the exact tangent.
 #[test]
 fn newton_converges_quadratically_on_the_bend() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/bend_45.toml"
-    ))
-    .unwrap();
-    let input =
-        unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
+    let input = example("bend_45.toml");
     let judged = assert_quadratic(&input, 600.0, 600.0 * 100.0);
     assert_eq!(judged, 8);
 }
@@ -259,13 +253,7 @@ fn newton_converges_quadratically_on_the_bend() {
 /// the difference between 8-element discretisations.
 #[test]
 fn bend_45_matches_simo_vu_quoc() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/bend_45.toml"
-    ))
-    .unwrap();
-    let input =
-        unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
+    let input = example("bend_45.toml");
     let (model, outcome, increments) = run(&input);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     report("45° bend", &increments);
@@ -340,13 +328,7 @@ fn right_angle_frame_small_load() {
 #[test]
 fn rigid_motion_leaves_strains_and_forces_unchanged() {
     // a deformed 3-D state: the 45° bend at full load
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/bend_45.toml"
-    ))
-    .unwrap();
-    let input =
-        unfold::io::model_file::parse_model(&text, std::path::Path::new("bend_45.toml")).unwrap();
+    let input = example("bend_45.toml");
     let (model, outcome, _) = run(&input);
     let deformed = outcome.state;
     // superimposed rigid motion: large rotation and a translation

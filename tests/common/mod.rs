@@ -63,3 +63,10 @@ pub fn line(
 pub fn node(model: &Model, id: u64) -> usize {
     model.node_index(id).expect("node exists")
 }
+
+/// Reads a model file of `examples/`.
+pub fn example(name: &str) -> ModelInput {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").join(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    unfold::io::model_file::parse_model(&text, &path).unwrap()
+}

@@ -328,7 +328,8 @@ impl NewtonSolver {
             // divergence: forces and moments (over the model size) far
             // beyond those of the first iteration
             let magnitude = norms.residual_force + norms.residual_moment / length;
-            let reference = *first_flux.get_or_insert(norms.flux_force + norms.flux_moment / length);
+            let reference =
+                *first_flux.get_or_insert(norms.flux_force + norms.flux_moment / length);
             let reference = reference.max(floor.0 + floor.1 / length);
             if iteration > 0 && magnitude > DIVERGED_GROWTH * reference {
                 return Err(NewtonFailure::Diverging {

@@ -66,7 +66,9 @@ pub fn node(model: &Model, id: u64) -> usize {
 
 /// Reads a model file of `examples/`.
 pub fn example(name: &str) -> ModelInput {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").join(name);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(name);
     let text = std::fs::read_to_string(&path).unwrap();
     unfold::io::model_file::parse_model(&text, &path).unwrap()
 }

@@ -378,18 +378,9 @@ impl NewtonSolver {
         lu.solve_in_place(&mut self.rhs)
     }
 
-    /// The last assembled tangent as a dense matrix (rows, by equation);
-    /// for tests on small models.
-    pub fn tangent_dense(&self) -> Vec<Vec<f64>> {
-        let n = self.dofs.n_equations();
-        let m = &self.assembler.matrix;
-        (0..n)
-            .map(|i| {
-                (0..n)
-                    .map(|j| m.position(i, j).map_or(0.0, |p| m.values()[p]))
-                    .collect()
-            })
-            .collect()
+    /// The tangent of the last assembly (equation numbering).
+    pub fn tangent(&self) -> &crate::linalg::SparseMatrix {
+        &self.assembler.matrix
     }
 
     /// The correction `Δq` (by equation) of the last linear solve.

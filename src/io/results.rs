@@ -108,8 +108,19 @@ fn csv(path: &Path, header: &str) -> std::io::Result<BufWriter<File>> {
 
 impl ResultWriter {
     /// Creates `dir` (and `dir/vtk`) and the CSV files with their headers.
+    /// Grids left in `dir/vtk` by an earlier run are removed, so that the
+    /// directory holds one run only.
     pub fn create(dir: &Path, model: &Model) -> std::io::Result<Self> {
-        std::fs::create_dir_all(dir.join("vtk"))?;
+        let vtk_dir = dir.join("vtk");
+        std::fs::create_dir_all(&vtk_dir)?;
+        for entry in std::fs::read_dir(&vtk_dir)? {
+            let path = entry?.path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if name.starts_with("step_") && name.ends_with(".vtu") {
+                std::fs::remove_file(&path)?;
+            }
+        }
+        let _ = std::fs::remove_file(dir.join("summary.json"));
         let has = |k: ElementKind| model.elements.iter().any(|e| e.kind() == k);
         let supported: Vec<usize> = (0..model.n_nodes())
             .filter(|&i| model.fixed[i].iter().any(|&f| f))

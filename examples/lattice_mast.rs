@@ -11,8 +11,8 @@
 //! The mast (a 2 m class deployable boom in its deployed, locked state):
 //! - a triangular cross-section inscribed in a circle of radius 0.15 m
 //!   (side 0.26 m), bays 0.25 m high, 8 bays by default;
-//! - three longerons, a triangle of battens at every level, and one
-//!   diagonal per face and bay, all joined rigidly at the nodes;
+//! - three longerons, a triangle of battens at every level, and two
+//!   crossed diagonals per face and bay, all joined rigidly at the nodes;
 //! - longerons and battens: CFRP tubes Ø 12 × 1 mm (E = 120 GPa,
 //!   G = 5 GPa); diagonals: steel cables modelled as Ø 2 mm rods
 //!   (E = 200 GPa, G = 77 GPa), pretensioned by a 0.1 % shortening;
@@ -98,7 +98,8 @@ pub fn build(bays: usize) -> ModelInput {
     for j in 0..bays {
         for k in 0..3 {
             let k1 = (k + 1) % 3;
-            // longeron, batten of the upper triangle, diagonal of the face
+            // longeron, batten of the upper triangle, crossed diagonals of
+            // the face
             member(&mut m, corner(j, k), corner(j + 1, k), "cfrp_tube", None);
             member(
                 &mut m,
@@ -108,6 +109,7 @@ pub fn build(bays: usize) -> ModelInput {
                 None,
             );
             member(&mut m, corner(j, k), corner(j + 1, k1), "cable", pretension);
+            member(&mut m, corner(j, k1), corner(j + 1, k), "cable", pretension);
         }
     }
     // base battens

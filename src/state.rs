@@ -4,7 +4,7 @@
 use crate::so3::{Rotation, Vec3};
 
 /// Configuration of the model at time (load parameter) `time`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct State {
     /// Load parameter (pseudo-time in statics).
     pub time: f64,

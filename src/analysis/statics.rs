@@ -103,8 +103,9 @@ impl<'m> StaticAnalysis<'m> {
         let model = self.model;
         let s = &model.settings;
         let mut state = model.initial_state();
+        // the state is filled in by `finish`
         let mut outcome = StaticOutcome {
-            state: state.clone(),
+            state: State::default(),
             increments: 0,
             iterations: 0,
             wasted_iterations: 0,

@@ -54,6 +54,7 @@ pub mod curves;
 pub mod dofs;
 pub mod elements;
 pub mod io;
+pub mod joints;
 pub mod linalg;
 pub mod model;
 pub mod so3;

@@ -16,4 +16,7 @@ pub struct State {
     pub extra: Vec<f64>,
     /// Internal variables of elements.
     pub internal: Vec<f64>,
+    /// Node velocities `(ẋ, Ω)` (translation, material angular velocity);
+    /// empty when the model is at rest (quasi-static analyses).
+    pub velocity: Vec<[f64; 6]>,
 }

@@ -345,6 +345,7 @@ fn rigid_motion_leaves_strains_and_forces_unchanged() {
         gravity: Vec3::zeros(),
         need_tangent: false,
         dynamics: None,
+        scaling: Default::default(),
     };
     let mut worst: f64 = 0.0;
     let (mut a, mut b) = ([0.0; 6], [0.0; 6]);
@@ -441,6 +442,7 @@ fn natural_curvature_gives_a_stress_free_arc() {
         gravity: Vec3::zeros(),
         need_tangent: false,
         dynamics: None,
+        scaling: Default::default(),
     };
     let energy: f64 = model
         .elements

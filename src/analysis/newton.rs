@@ -29,7 +29,6 @@
 use super::{IterationInfo, Observer};
 use crate::assembly::Assembler;
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
-use crate::elements::EvalContext;
 use crate::linalg::{smallest_relative_pivot, SolveError, SparseLu};
 use crate::model::{Model, StaticSettings, COMPONENT_NAMES};
 use crate::so3::{self, Vec3};
@@ -186,13 +185,7 @@ impl NewtonSolver {
 
     /// Assembles residual (and tangent if asked) at `state` and `time`.
     pub fn assemble(&mut self, model: &Model, state: &State, time: f64, need_tangent: bool) {
-        let ctx = EvalContext {
-            time,
-            curves: &model.curves,
-            gravity: model.gravity_at(time),
-            need_tangent,
-            dynamics: None,
-        };
+        let ctx = model.context(time, need_tangent);
         self.assembler.assemble(model, &ctx, state);
     }
 

@@ -387,6 +387,7 @@ mod tests {
             gravity: Vec3::new(0.0, 0.0, -9.81),
             need_tangent: true,
             dynamics: None,
+            scaling: Default::default(),
         }
     }
 
@@ -426,6 +427,7 @@ mod tests {
             q: r.to_vec(),
             extra: Vec::new(),
             internal: Vec::new(),
+            velocity: Vec::new(),
         }
     }
 

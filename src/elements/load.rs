@@ -125,6 +125,7 @@ mod tests {
                 gravity: Vec3::zeros(),
                 need_tangent: true,
                 dynamics: None,
+                scaling: Default::default(),
             };
             let state = State {
                 time: 0.7,
@@ -132,6 +133,7 @@ mod tests {
                 q: vec![so3::exp(&Vec3::new(r.0, r.1, r.2))],
                 extra: vec![],
                 internal: vec![],
+                velocity: vec![],
             };
             for follower in [false, true] {
                 let l = NodalLoad::new(1, 0, Vec3::new(f.0, f.1, f.2), Vec3::new(m.0, m.1, m.2), follower, 0);

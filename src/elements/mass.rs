@@ -112,6 +112,7 @@ mod tests {
             q: vec![q],
             extra: vec![],
             internal: vec![],
+            velocity: vec![],
         }
     }
 
@@ -122,6 +123,7 @@ mod tests {
             gravity: Vec3::new(0.3, -0.2, -9.81),
             need_tangent: true,
             dynamics: None,
+            scaling: Default::default(),
         }
     }
 

@@ -47,6 +47,12 @@ pub enum ElementKind {
     /// Kinematic constraint enforced with Lagrange multipliers (its extra
     /// unknowns).
     Constraint,
+    /// Kinematic pair of the joint library.
+    Joint,
+    /// Spring or damper on a joint coordinate.
+    JointSpring,
+    /// Prescribed history of a joint coordinate or node component.
+    Driver,
 }
 
 impl ElementKind {
@@ -59,6 +65,9 @@ impl ElementKind {
             Self::Spring => "spring",
             Self::NodalLoad => "load",
             Self::Constraint => "constraint",
+            Self::Joint => "joint",
+            Self::JointSpring => "joint spring",
+            Self::Driver => "driver",
         }
     }
 
@@ -71,6 +80,9 @@ impl ElementKind {
             Self::Spring => 4,
             Self::NodalLoad => 5,
             Self::Constraint => 6,
+            Self::Joint => 7,
+            Self::JointSpring => 8,
+            Self::Driver => 9,
         }
     }
 }
@@ -110,6 +122,45 @@ pub struct EvalContext<'a> {
     pub need_tangent: bool,
     /// Integrator coefficients in dynamics, `None` in statics.
     pub dynamics: Option<DynamicsCoefficients>,
+    /// Scaling and penalty of constraint equations (eq. 17).
+    pub scaling: ConstraintScaling,
+}
+
+/// Scaling factor `k` and penalty `p` of the augmented Lagrangian
+/// `F* = F − k λ·Φ + ½ p |Φ|²` (paper eq. 17), for constraints on
+/// distances (`force`) and on angles (`moment`). Defaults are set by the
+/// analysis from the stiffness of the model (docs/joints.md §1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConstraintScaling {
+    /// `(k, p)` of distance constraints.
+    pub force: (f64, f64),
+    /// `(k, p)` of angle constraints.
+    pub moment: (f64, f64),
+}
+
+impl Default for ConstraintScaling {
+    fn default() -> Self {
+        Self {
+            force: (1.0, 1.0),
+            moment: (1.0, 1.0),
+        }
+    }
+}
+
+/// What an extra unknown is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ExtraKind {
+    /// A Lagrange multiplier; its equation is `−k Φ = 0` with the constraint
+    /// `Φ` a distance or an angle.
+    Multiplier {
+        /// The scaling `k` of its equation.
+        scale: f64,
+        /// Whether `Φ` is an angle (else a distance).
+        angular: bool,
+    },
+    /// A generalised coordinate (slider parameter, modal amplitude); its
+    /// equation is a generalised force.
+    Coordinate,
 }
 
 /// Where an element writes its contributions.
@@ -140,6 +191,24 @@ pub trait Element: Send + Sync {
     fn n_internal(&self) -> usize {
         0
     }
+
+    /// Tells the element where its extra unknowns and internal variables
+    /// start in [`State::extra`] and [`State::internal`] (called once when
+    /// the element joins a model).
+    fn set_offsets(&mut self, _extra: usize, _internal: usize) {}
+
+    /// Values of the extra unknowns in the reference state (zero by
+    /// default; a slider's curve parameter starts where the node is).
+    fn initial_extra(&self, _out: &mut [f64]) {}
+
+    /// What extra unknown `k` is, for convergence checks and messages.
+    fn extra_kind(&self, _ctx: &EvalContext, _k: usize) -> ExtraKind {
+        ExtraKind::Coordinate
+    }
+
+    /// New values of the internal variables after the state has converged
+    /// (unwrapped joint angles, hysteresis); `internal` holds the old ones.
+    fn update_internal(&self, _ctx: &EvalContext, _state: &State, _internal: &mut [f64]) {}
 
     /// Size of the local vector: 6 per node plus the extra unknowns.
     fn n_local(&self) -> usize {
@@ -205,6 +274,11 @@ pub(crate) mod testing {
     /// rule (translation added, rotation composed on the right).
     pub fn perturb(state: &State, nodes: &[usize], k: usize, h: f64) -> State {
         let mut s = state.clone();
+        if k >= 6 * nodes.len() {
+            // extra unknowns: the element's offset is 0 in these tests
+            s.extra[k - 6 * nodes.len()] += h;
+            return s;
+        }
         let node = nodes[k / 6];
         let c = k % 6;
         if c < 3 {
@@ -240,7 +314,7 @@ pub(crate) mod testing {
         let (_, k) = eval(e, ctx, state);
         let scale = k.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
         let mut worst = 0.0f64;
-        for j in 0..6 * e.nodes().len() {
+        for j in 0..n {
             let (rp, _) = eval(e, ctx, &perturb(state, e.nodes(), j, h));
             let (rm, _) = eval(e, ctx, &perturb(state, e.nodes(), j, -h));
             for i in 0..n {

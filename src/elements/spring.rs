@@ -251,6 +251,7 @@ mod tests {
             gravity: Vec3::zeros(),
             need_tangent: true,
             dynamics: None,
+            scaling: Default::default(),
         }
     }
 
@@ -261,6 +262,7 @@ mod tests {
             q: q.to_vec(),
             extra: vec![],
             internal: vec![],
+            velocity: vec![],
         }
     }
 

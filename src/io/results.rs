@@ -21,7 +21,7 @@ use serde::Serialize;
 
 use super::vtk;
 use crate::analysis::{IncrementInfo, Observer};
-use crate::elements::{ElementKind, EvalContext};
+use crate::elements::ElementKind;
 use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -195,13 +195,7 @@ impl ResultWriter {
                 model.node_ids[i], x.x, x.y, x.z, u.x, u.y, u.z, q.w, q.i, q.j, q.k
             )?;
         }
-        let ctx = EvalContext {
-            time: t,
-            curves: &model.curves,
-            gravity: model.gravity_at(t),
-            need_tangent: false,
-            dynamics: None,
-        };
+        let ctx = model.context(t, false);
         let mut values = [0.0; 6];
         for e in &model.elements {
             let file = match e.kind() {

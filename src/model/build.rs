@@ -2,6 +2,8 @@
 
 use std::collections::{HashMap, HashSet};
 
+mod joints;
+
 use super::input::*;
 use super::{Model, ModelError, ModelErrorKind, ModelErrors, Prescribed, StaticSettings};
 use crate::curves::{Curve, CurveIndex};
@@ -549,6 +551,19 @@ impl Model {
             }
         }
 
+        // ---------- joints, joint springs, drivers ----------
+        joints::build(
+            &mut joints::Context {
+                ck: &mut ck,
+                node_index: &node_index,
+                nodes: &nodes,
+                claim_id: &mut claim_id,
+                find_curve: &find_curve,
+                elements: &mut elements,
+            },
+            input,
+        );
+
         // ---------- gravity ----------
         let gravity = input.gravity.as_ref().and_then(|g| {
             let curve = find_curve(&mut ck, "gravity", &g.curve);
@@ -680,6 +695,12 @@ impl Model {
                 1.0
             }
         };
+        let (mut extra, mut internal) = (0, 0);
+        for e in &mut elements {
+            e.set_offsets(extra, internal);
+            extra += e.n_extra();
+            internal += e.n_internal();
+        }
         Ok(Model {
             title: input.title.clone().unwrap_or_default(),
             node_ids,
@@ -693,7 +714,12 @@ impl Model {
             gravity,
             settings,
             length_scale,
-        })
+            scaling: Default::default(),
+        }
+        .with_default_scaling(
+            input.analysis.constraint_scale,
+            input.analysis.constraint_penalty,
+        ))
     }
 }
 
@@ -972,7 +998,14 @@ fn check_restraint(
             connected[a] |= kind != crate::elements::ElementKind::PointMass
                 && kind != crate::elements::ElementKind::RigidBody;
         }
-        if kind == crate::elements::ElementKind::Spring && nodes.len() == 1 {
+        if nodes.len() == 1
+            && matches!(
+                kind,
+                crate::elements::ElementKind::Spring
+                    | crate::elements::ElementKind::Joint
+                    | crate::elements::ElementKind::Driver
+            )
+        {
             grounded[nodes[0]] = true;
         }
         for w in nodes.windows(2) {
@@ -985,7 +1018,7 @@ fn check_restraint(
             ck.push(
                 ModelErrorKind::Unrestrained,
                 format!("node {}", node_ids[i]),
-                "is not connected to any beam or spring and not fully fixed: it has no stiffness",
+                "is not connected to any beam, spring or joint and not fully fixed: it has no stiffness",
             );
         }
     }

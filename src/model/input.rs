@@ -56,6 +56,123 @@ pub struct ModelInput {
     /// Piecewise-linear load curves, referenced by name.
     #[serde(default)]
     pub curves: Vec<CurveInput>,
+    /// Kinematic pairs (docs/joints.md).
+    #[serde(default)]
+    pub joints: Vec<JointInput>,
+    /// Springs and dampers on joint coordinates.
+    #[serde(default)]
+    pub joint_springs: Vec<JointSpringInput>,
+    /// Prescribed histories of joint coordinates or node components.
+    #[serde(default)]
+    pub drivers: Vec<DriverInput>,
+}
+
+/// A kinematic pair between node A and node B (or the ground).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct JointInput {
+    /// Element id (unique among all elements).
+    pub id: Id,
+    /// `revolute`, `prismatic`, `cylindrical`, `spherical`, `planar`,
+    /// `universal`, `helical`, `slider`, `rigid` or `glue`.
+    #[serde(rename = "type")]
+    pub kind: crate::joints::JointType,
+    /// `[A, B]`, or `[A]` for a joint to the ground.
+    pub nodes: Vec<Id>,
+    /// Joint axis `e₃` (hinge, sliding or screw axis; normal of a planar
+    /// joint), reference configuration. Universal joints: the cross arm
+    /// carried by A.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<[f64; 3]>,
+    /// The same axis as carried by body B, when the model gives each body's
+    /// axis (paper eq. 19); must coincide with `axis`. Universal joints:
+    /// the cross arm carried by B, perpendicular to `axis`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis_b: Option<[f64; 3]>,
+    /// Direction from which angles are measured (`e₁`), default: a
+    /// direction normal to the axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_direction: Option<[f64; 3]>,
+    /// Joint point, default node A's position (node B's for `glue`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<[f64; 3]>,
+    /// Helical joints: axial advance per turn (signed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch: Option<f64>,
+    /// Glue: where node B is held, in A's material frame (default: where B
+    /// is in the reference configuration).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset: Option<[f64; 3]>,
+    /// Glue: whether B's rotations are locked to A's too (default true).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lock_rotations: Option<bool>,
+    /// Slider: the nodes the curve passes through, in order (at least 2).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub curve: Vec<Id>,
+    /// Slider: a C¹ spline (default) or a polyline (`false`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spline: Option<bool>,
+}
+
+/// A spring and/or a damper on a joint coordinate.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpringInput {
+    /// Element id.
+    pub id: Id,
+    /// The joint.
+    pub joint: Id,
+    /// Which coordinate (`angle`, `slide`, `angle1`...), default the joint's
+    /// first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Linear spring: stiffness (N/m or N·m/rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<f64>,
+    /// Linear spring: coordinate value at which it is unloaded (default 0,
+    /// the reference configuration).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_value: Option<f64>,
+    /// Nonlinear spring: points `[coordinate, force]` (force or moment),
+    /// interpolated linearly and extrapolated with the end slopes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub table: Vec<[f64; 2]>,
+    /// Linear damper: coefficient (N·s/m or N·m·s/rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
+    /// Nonlinear damper: points `[rate, force]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub damping_table: Vec<[f64; 2]>,
+}
+
+/// A prescribed history `value · f(t)` of a joint coordinate, or of a
+/// node's translation along or rotation about a direction, relative to the
+/// reference configuration.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DriverInput {
+    /// Element id.
+    pub id: Id,
+    /// The joint whose coordinate is driven...
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<Id>,
+    /// ...and which coordinate (default the joint's first).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Or the node that is driven...
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub node: Option<Id>,
+    /// ...along (translation) or about (rotation) this global direction...
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f64; 3]>,
+    /// ...`translation` (default) or `rotation`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<String>,
+    /// Value of the coordinate when the curve equals 1 (m or rad).
+    pub value: f64,
+    /// Curve `f(t)`, default the ramp `f(t) = t`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve: Option<String>,
 }
 
 /// Kind and parameters of the analysis.
@@ -93,6 +210,13 @@ pub struct AnalysisInput {
     /// last increment is always written.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output_every: Option<usize>,
+    /// Scaling factor `k` of constraint equations (eq. 17), default the
+    /// largest diagonal stiffness of the model (docs/joints.md §1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub constraint_scale: Option<f64>,
+    /// Penalty `p` of constraint equations (eq. 17), default as `k`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub constraint_penalty: Option<f64>,
 }
 
 fn default_analysis_type() -> String {
@@ -115,6 +239,8 @@ impl Default for AnalysisInput {
             displacement_tolerance: None,
             rotation_tolerance: None,
             output_every: None,
+            constraint_scale: None,
+            constraint_penalty: None,
         }
     }
 }

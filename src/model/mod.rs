@@ -11,7 +11,7 @@ pub mod input;
 use std::fmt;
 
 use crate::curves::{Curve, CurveIndex};
-use crate::elements::Element;
+use crate::elements::{ConstraintScaling, Element, EvalContext};
 use crate::so3::{Rotation, Vec3};
 use crate::state::State;
 use input::Id;
@@ -95,6 +95,8 @@ pub struct Model {
     /// Diagonal of the bounding box of the nodes (1 if zero): the length
     /// against which displacement tolerances are measured.
     pub length_scale: f64,
+    /// Scaling and penalty of the constraint equations.
+    pub scaling: ConstraintScaling,
 }
 
 impl fmt::Debug for Model {
@@ -115,12 +117,112 @@ impl Model {
 
     /// The reference (initial) state.
     pub fn initial_state(&self) -> State {
+        let mut extra = vec![0.0; self.elements.iter().map(|e| e.n_extra()).sum()];
+        let mut offset = 0;
+        for e in &self.elements {
+            e.initial_extra(&mut extra[offset..offset + e.n_extra()]);
+            offset += e.n_extra();
+        }
         State {
             time: 0.0,
             x: self.reference_x.clone(),
             q: self.reference_q.clone(),
-            extra: vec![0.0; self.elements.iter().map(|e| e.n_extra()).sum()],
+            extra,
             internal: vec![0.0; self.elements.iter().map(|e| e.n_internal()).sum()],
+            velocity: Vec::new(),
+        }
+    }
+
+    /// Adds an element, telling it where its extra unknowns and internal
+    /// variables are stored in the state.
+    pub fn push_element(&mut self, mut e: Box<dyn Element>) {
+        let extra = self.elements.iter().map(|e| e.n_extra()).sum();
+        let internal = self.elements.iter().map(|e| e.n_internal()).sum();
+        e.set_offsets(extra, internal);
+        self.elements.push(e);
+    }
+
+    /// The evaluation context at load parameter `time`.
+    pub fn context(&self, time: f64, need_tangent: bool) -> EvalContext<'_> {
+        EvalContext {
+            time,
+            curves: &self.curves,
+            gravity: self.gravity_at(time),
+            need_tangent,
+            dynamics: None,
+            scaling: self.scaling,
+        }
+    }
+
+    /// Updates the internal variables of every element after `state` has
+    /// converged (unwrapped joint angles).
+    pub fn update_internal(&self, state: &mut State) {
+        let ctx = self.context(state.time, false);
+        let mut offset = 0;
+        let mut buf = Vec::new();
+        for e in &self.elements {
+            let n = e.n_internal();
+            if n > 0 {
+                buf.clear();
+                buf.extend_from_slice(&state.internal[offset..offset + n]);
+                e.update_internal(&ctx, state, &mut buf);
+                state.internal[offset..offset + n].copy_from_slice(&buf);
+            }
+            offset += n;
+        }
+    }
+
+    /// Sets [`Model::scaling`] from [`Model::default_scaling`].
+    pub fn with_default_scaling(mut self, scale: Option<f64>, penalty: Option<f64>) -> Self {
+        self.scaling = self.default_scaling(scale, penalty);
+        self
+    }
+
+    /// Default scaling of constraint equations (docs/joints.md §1): `k` and
+    /// `p` equal to the largest diagonal stiffness of the elements' tangents
+    /// in the reference state, for translations and rotations separately
+    /// (1 when the model has no stiffness, e.g. rigid bodies and joints
+    /// only); `override_` replaces `(k, p)` of both when given.
+    pub fn default_scaling(&self, scale: Option<f64>, penalty: Option<f64>) -> ConstraintScaling {
+        let state = self.initial_state();
+        let ctx = EvalContext {
+            scaling: ConstraintScaling {
+                force: (0.0, 0.0),
+                moment: (0.0, 0.0),
+            },
+            ..self.context(0.0, true)
+        };
+        let (mut kf, mut km) = (0.0f64, 0.0f64);
+        for e in &self.elements {
+            if e.n_extra() > 0 {
+                continue;
+            }
+            let n = e.n_local();
+            let mut r = vec![0.0; n];
+            let mut t = vec![0.0; n * n];
+            e.evaluate(
+                &ctx,
+                &state,
+                &mut crate::elements::ElementOutput {
+                    residual: &mut r,
+                    tangent: &mut t,
+                },
+            );
+            for i in 0..6 * e.nodes().len() {
+                let d = t[i * n + i].abs();
+                if i % 6 < 3 {
+                    kf = kf.max(d);
+                } else {
+                    km = km.max(d);
+                }
+            }
+        }
+        let pick = |v: f64, user: Option<f64>| {
+            user.unwrap_or(if v > 0.0 && v.is_finite() { v } else { 1.0 })
+        };
+        ConstraintScaling {
+            force: (pick(kf, scale), pick(kf, penalty)),
+            moment: (pick(km, scale), pick(km, penalty)),
         }
     }
 

@@ -1,0 +1,49 @@
+//! A relative coordinate of a pair of bodies (a joint's angle or stroke, or
+//! a node's displacement or rotation relative to the ground), the quantity
+//! springs, dampers and drivers act on.
+
+use super::hyperdual::HyperDual;
+use super::kinematics::{Conf, Local, Pair};
+use super::types::Coordinate;
+use crate::state::State;
+
+/// A coordinate of a pair: which nodes, where the pair sits, which
+/// coordinate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairCoordinate {
+    /// Node A, and node B unless B is the ground.
+    pub nodes: Vec<usize>,
+    /// The pair's geometry.
+    pub pair: Pair,
+    /// The coordinate.
+    pub coordinate: Coordinate,
+}
+
+impl PairCoordinate {
+    /// Whether it is an angle (unwrapped with an internal variable).
+    pub fn is_angle(&self) -> bool {
+        self.coordinate.is_angle()
+    }
+
+    /// The coordinate as a function of the configuration, angles on the
+    /// branch nearest `reference`.
+    pub fn function(&self, reference: f64) -> impl Fn(&Conf, &mut [HyperDual]) + '_ {
+        move |c: &Conf, out: &mut [HyperDual]| {
+            out[0] = self.coordinate.unwrapped(&self.pair.frames(c), reference);
+        }
+    }
+
+    /// Value at `state`, angles on the branch nearest `reference`.
+    pub fn value(&self, state: &State, reference: f64) -> f64 {
+        let mut local = Local::default();
+        local.gather(state, &self.nodes, 0..0);
+        let mut v = [0.0];
+        local.value(1, &self.function(reference), &mut v);
+        v[0]
+    }
+
+    /// Local unknowns it depends on (all of its nodes' components).
+    pub fn active(&self) -> Vec<usize> {
+        (0..6 * self.nodes.len()).collect()
+    }
+}

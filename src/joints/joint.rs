@@ -1,0 +1,365 @@
+//! The joint element: a kinematic pair's constraints enforced by the
+//! augmented Lagrangian of paper eqs. 17–18, with the second-derivative
+//! term that eq. 18 leaves out (docs/joints.md §1):
+//!
+//! ```text
+//! r_q = Bᵀ(pΦ − kλ)                      r_λ = −kΦ
+//! K_qq = p BᵀB + Σᵢ (pΦᵢ − kλᵢ) ∂Bᵢ/∂q    K_qλ = −k Bᵀ,  K_λq = −k B,  K_λλ = 0
+//! ```
+//!
+//! with `B = ∂Φ/∂q` (one row per equation) taken along the update of the
+//! unknowns. `k` and `p` are per equation: distance constraints use the
+//! translational pair of [`ConstraintScaling`], angle constraints the
+//! rotational one.
+
+use super::hyperdual::HyperDual;
+use super::kinematics::{Conf, Local, Pair, MAX_OUT};
+use super::types::{
+    constraint_kinds, constraints, slider_constraints, Coordinate, Equation, JointParameters,
+    JointType,
+};
+use crate::elements::{
+    CellShape, ConstraintScaling, Element, ElementKind, ElementOutput, EvalContext, ExtraKind,
+};
+use crate::model::input::Id;
+use crate::so3::{self, Vec3};
+use crate::state::State;
+
+/// `(k, p)` of an equation kind.
+pub(crate) fn scale_of(s: &ConstraintScaling, e: Equation) -> (f64, f64) {
+    match e {
+        Equation::Force => s.force,
+        Equation::Moment => s.moment,
+    }
+}
+
+/// Adds the augmented-Lagrangian contributions of constraints `f` (with
+/// equation kinds `kinds`) to a local system laid out as
+/// `[q (nq = local.n() unknowns), λ (kinds.len())]`; `lambda` holds the
+/// multipliers. Returns nothing; `work` is scratch of length ≥ m·nq.
+pub(crate) fn add_constraints<F>(
+    ctx: &EvalContext,
+    local: &mut Local,
+    active: &[usize],
+    kinds: &[Equation],
+    f: &F,
+    lambda: &[f64],
+    out: &mut ElementOutput,
+) where
+    F: Fn(&Conf, &mut [HyperDual]),
+{
+    let m = kinds.len();
+    let nq = local.n();
+    let n = nq + m;
+    let mut phi = [0.0; MAX_OUT];
+    let mut grad = vec![0.0; m * nq];
+    local.gradient(m, active, f, &mut phi[..m], &mut grad);
+    let mut w = [0.0; MAX_OUT];
+    let mut kk = [0.0; MAX_OUT];
+    let mut pp = [0.0; MAX_OUT];
+    for i in 0..m {
+        let (k, p) = scale_of(&ctx.scaling, kinds[i]);
+        kk[i] = k;
+        pp[i] = p;
+        w[i] = p * phi[i] - k * lambda[i];
+        out.residual[nq + i] += -k * phi[i];
+        for &c in active {
+            out.residual[c] += grad[i * nq + c] * w[i];
+        }
+    }
+    if !ctx.need_tangent {
+        return;
+    }
+    let t = &mut *out.tangent;
+    for i in 0..m {
+        let g = &grad[i * nq..(i + 1) * nq];
+        for &c in active {
+            if g[c] == 0.0 {
+                continue;
+            }
+            t[(nq + i) * n + c] += -kk[i] * g[c];
+            t[c * n + nq + i] += -kk[i] * g[c];
+            let pg = pp[i] * g[c];
+            for &r in active {
+                t[c * n + r] += pg * g[r];
+            }
+        }
+    }
+    local.add_weighted_hessian(m, active, f, &w[..m], t, n);
+}
+
+/// A kinematic pair of the joint library.
+#[derive(Clone, Debug)]
+pub struct Joint {
+    id: Id,
+    joint_type: JointType,
+    /// Node A, node B (absent if B is the ground); for a slider the sliding
+    /// node then the curve's nodes.
+    nodes: Vec<usize>,
+    pair: Pair,
+    parameters: JointParameters,
+    kinds: &'static [Equation],
+    /// Local unknowns the constraints depend on.
+    active: Vec<usize>,
+    /// Offset of the slider parameter (if any) then the multipliers.
+    extra: usize,
+    /// Offset of the unwrap references of the angles.
+    internal: usize,
+    /// Reference value of the slider parameter.
+    s0: f64,
+}
+
+impl Joint {
+    /// A joint of type `joint_type` (not a slider) between node `a` and
+    /// node `b` (or the ground), placed by `pair`.
+    pub fn new(
+        id: Id,
+        joint_type: JointType,
+        a: usize,
+        b: Option<usize>,
+        pair: Pair,
+        parameters: JointParameters,
+    ) -> Self {
+        assert!(joint_type != JointType::Slider, "use Joint::slider");
+        let mut nodes = vec![a];
+        nodes.extend(b);
+        let active = (0..6 * nodes.len()).collect();
+        let kinds = constraint_kinds(joint_type, parameters.lock_rotations);
+        Self {
+            id,
+            joint_type,
+            nodes,
+            pair,
+            parameters,
+            kinds,
+            active,
+            extra: 0,
+            internal: 0,
+            s0: 0.0,
+        }
+    }
+
+    /// A slider: node `node` (joint point at offset `a` in its material
+    /// frame) on the curve through `curve_nodes`, starting at parameter
+    /// `s0`.
+    pub fn slider(
+        id: Id,
+        node: usize,
+        a: Vec3,
+        curve_nodes: &[usize],
+        spline: bool,
+        s0: f64,
+    ) -> Self {
+        let mut nodes = vec![node];
+        nodes.extend_from_slice(curve_nodes);
+        // the sliding node (all 6), the curve nodes' translations, s
+        let mut active: Vec<usize> = (0..6).collect();
+        for k in 1..nodes.len() {
+            active.extend(6 * k..6 * k + 3);
+        }
+        active.push(6 * nodes.len());
+        Self {
+            id,
+            joint_type: JointType::Slider,
+            nodes,
+            pair: Pair {
+                a,
+                ea: so3::Mat3::identity(),
+                b: Vec3::zeros(),
+                eb: so3::Mat3::identity(),
+                ground: None,
+                ground_is_a: false,
+            },
+            parameters: JointParameters {
+                lead: 0.0,
+                lock_rotations: false,
+                curve: Some(super::types::SliderCurve { spline }),
+            },
+            kinds: JointType::Slider.equations(),
+            active,
+            extra: 0,
+            internal: 0,
+            s0,
+        }
+    }
+
+    /// The joint type.
+    pub fn joint_type(&self) -> JointType {
+        self.joint_type
+    }
+
+    /// The pair (geometry on both bodies).
+    pub fn pair(&self) -> &Pair {
+        &self.pair
+    }
+
+    /// Number of coordinate unknowns (1 for a slider).
+    fn n_coords(&self) -> usize {
+        usize::from(self.joint_type == JointType::Slider)
+    }
+
+    fn angle_references<'s>(&self, state: &'s State) -> &'s [f64] {
+        &state.internal[self.internal..self.internal + self.n_internal()]
+    }
+
+    /// The constraint function of this joint.
+    fn phi<'a>(&'a self, refs: &'a [f64]) -> impl Fn(&Conf, &mut [HyperDual]) + 'a {
+        move |c: &Conf, out: &mut [HyperDual]| {
+            if let Some(curve) = &self.parameters.curve {
+                slider_constraints(&self.pair, curve, c, out);
+                return;
+            }
+            let f = self.pair.frames(c);
+            let angle = if self.joint_type == JointType::Helical {
+                Coordinate::Angle.unwrapped(&f, refs[0])
+            } else {
+                HyperDual::default()
+            };
+            constraints(self.joint_type, &f, angle, &self.parameters, out);
+        }
+    }
+
+    /// The joint's relative coordinates (angles unwrapped) at `state`.
+    pub fn coordinates(&self, state: &State, out: &mut [f64]) {
+        let coords = self.joint_type.coordinates();
+        if self.joint_type == JointType::Slider {
+            out[0] = state.extra[self.extra];
+            return;
+        }
+        let mut local = Local::default();
+        local.gather(state, &self.nodes, 0..0);
+        let refs = self.angle_references(state);
+        let mut ia = 0;
+        for (k, c) in coords.iter().enumerate() {
+            let r = if c.is_angle() {
+                ia += 1;
+                refs[ia - 1]
+            } else {
+                0.0
+            };
+            let mut v = [0.0];
+            let f =
+                |conf: &Conf, o: &mut [HyperDual]| o[0] = c.unwrapped(&self.pair.frames(conf), r);
+            local.value(1, &f, &mut v);
+            out[k] = v[0];
+        }
+    }
+
+    /// Load the joint applies to body A (force, and moment about the joint
+    /// point), global frame.
+    pub fn reaction(&self, ctx: &EvalContext, state: &State) -> (Vec3, Vec3) {
+        let n = self.n_local();
+        let mut r = vec![0.0; n];
+        let mut t = Vec::new();
+        let c = EvalContext {
+            need_tangent: false,
+            ..*ctx
+        };
+        self.evaluate(
+            &c,
+            state,
+            &mut ElementOutput {
+                residual: &mut r,
+                tangent: &mut t,
+            },
+        );
+        let node = self.nodes[0];
+        let f = -Vec3::new(r[0], r[1], r[2]);
+        let rm = so3::matrix(&state.q[node]);
+        let m_node = rm * -Vec3::new(r[3], r[4], r[5]);
+        let arm = rm * self.pair.a;
+        (f, m_node - arm.cross(&f))
+    }
+}
+
+/// Names of joint results: three coordinates (NaN when absent), then the
+/// reaction on body A in A's joint axes.
+pub const JOINT_RESULTS: [&str; 9] = ["c1", "c2", "c3", "F1", "F2", "F3", "M1", "M2", "M3"];
+
+impl Element for Joint {
+    fn kind(&self) -> ElementKind {
+        ElementKind::Joint
+    }
+    fn id(&self) -> Id {
+        self.id
+    }
+    fn nodes(&self) -> &[usize] {
+        &self.nodes
+    }
+    fn n_extra(&self) -> usize {
+        self.n_coords() + self.kinds.len()
+    }
+    fn n_internal(&self) -> usize {
+        self.joint_type
+            .coordinates()
+            .iter()
+            .filter(|c| c.is_angle())
+            .count()
+    }
+    fn set_offsets(&mut self, extra: usize, internal: usize) {
+        self.extra = extra;
+        self.internal = internal;
+    }
+    fn extra_kind(&self, ctx: &EvalContext, k: usize) -> ExtraKind {
+        if k < self.n_coords() {
+            return ExtraKind::Coordinate;
+        }
+        let e = self.kinds[k - self.n_coords()];
+        ExtraKind::Multiplier {
+            scale: scale_of(&ctx.scaling, e).0,
+            angular: e == Equation::Moment,
+        }
+    }
+    fn initial_extra(&self, out: &mut [f64]) {
+        if self.joint_type == JointType::Slider {
+            out[0] = self.s0;
+        }
+    }
+    fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
+        let nc = self.n_coords();
+        let mut local = Local::default();
+        local.gather(state, &self.nodes, self.extra..self.extra + nc);
+        let lambda = &state.extra[self.extra + nc..self.extra + nc + self.kinds.len()];
+        let refs = self.angle_references(state);
+        add_constraints(
+            ctx,
+            &mut local,
+            &self.active,
+            self.kinds,
+            &self.phi(refs),
+            lambda,
+            out,
+        );
+    }
+    fn update_internal(&self, _ctx: &EvalContext, state: &State, internal: &mut [f64]) {
+        let mut c = [0.0; 3];
+        self.coordinates(state, &mut c);
+        let mut ia = 0;
+        for (k, coord) in self.joint_type.coordinates().iter().enumerate() {
+            if coord.is_angle() {
+                internal[ia] = c[k];
+                ia += 1;
+            }
+        }
+    }
+    fn result_names(&self) -> &'static [&'static str] {
+        &JOINT_RESULTS
+    }
+    fn results(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
+        let mut c = [f64::NAN; 3];
+        self.coordinates(state, &mut c);
+        out[..3].copy_from_slice(&c);
+        let (f, m) = self.reaction(ctx, state);
+        let e = so3::matrix(&state.q[self.nodes[0]]) * self.pair.ea;
+        let (fl, ml) = (e.transpose() * f, e.transpose() * m);
+        out[3..6].copy_from_slice(fl.as_slice());
+        out[6..9].copy_from_slice(ml.as_slice());
+    }
+    fn cell_shape(&self) -> CellShape {
+        if self.nodes.len() >= 2 {
+            CellShape::Line
+        } else {
+            CellShape::Vertex
+        }
+    }
+}

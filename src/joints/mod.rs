@@ -1,0 +1,28 @@
+//! Kinematic pairs, the springs, dampers and drivers acting on their
+//! relative coordinates, and the treatment of redundant constraints
+//! (docs/joints.md).
+//!
+//! Every joint is a finite element whose extra unknowns are the Lagrange
+//! multipliers of its constraint equations `Φ(q) = 0`, enforced by the
+//! augmented Lagrangian of the reference paper (eqs. 17–18). Constraint
+//! formulas are written once over hyper-dual numbers ([`hyperdual`]), which
+//! gives the constraint gradient `B` and the second-derivative term
+//! `∂(Bᵀλ)/∂q` exactly ([`kinematics`]).
+
+pub mod coordinate;
+pub mod driver;
+pub mod hyperdual;
+pub mod joint;
+pub mod kinematics;
+pub mod spring;
+pub mod types;
+
+pub use coordinate::PairCoordinate;
+pub use driver::Driver;
+pub use joint::Joint;
+pub use kinematics::Pair;
+pub use spring::{JointSpring, Law};
+pub use types::{Coordinate, JointType};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,236 @@
+//! Tangents of every joint element (multiplier terms included) against
+//! central finite differences of their residuals, on random
+//! configurations: rotations of each node up to about 1 rad away from the
+//! reference, positions moved by up to 0.3 (model size ~1), random
+//! multipliers and scalings. Tolerance 1e-6 of the largest tangent entry
+//! (h = 1e-6: truncation ~1e-12·|third derivative|, round-off ~1e-10).
+
+use super::types::{Coordinate, JointParameters, SliderCurve};
+use super::*;
+use crate::elements::testing::{eval, tangent_error};
+use crate::elements::{ConstraintScaling, Element, EvalContext};
+use crate::so3::{self, Mat3, Rotation, Vec3};
+use crate::state::State;
+
+/// Deterministic pseudo-random numbers in [−1, 1].
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+    fn vec(&mut self, s: f64) -> Vec3 {
+        Vec3::new(self.next(), self.next(), self.next()) * s
+    }
+}
+
+fn ctx() -> EvalContext<'static> {
+    EvalContext {
+        time: 0.4,
+        curves: &[],
+        gravity: Vec3::zeros(),
+        need_tangent: true,
+        dynamics: None,
+        scaling: ConstraintScaling {
+            force: (3.0, 2.0),
+            moment: (5.0, 1.5),
+        },
+    }
+}
+
+/// Reference frames of two nodes and a joint triad.
+fn reference(rng: &mut Lcg) -> (Vec<Vec3>, Vec<Rotation>, Mat3, Vec3) {
+    let x = vec![rng.vec(1.0), rng.vec(1.0)];
+    let q = vec![so3::exp(&rng.vec(2.0)), so3::exp(&rng.vec(2.0))];
+    let e = so3::matrix(&so3::exp(&rng.vec(2.0)));
+    (x, q, e, rng.vec(1.0))
+}
+
+/// A state moved away from the reference, with random extras.
+fn moved(rng: &mut Lcg, x: &[Vec3], q: &[Rotation], n_extra: usize, n_internal: usize) -> State {
+    State {
+        time: 0.4,
+        x: x.iter().map(|x| x + rng.vec(0.3)).collect(),
+        q: q.iter().map(|q| q * so3::exp(&rng.vec(0.6))).collect(),
+        extra: (0..n_extra).map(|_| rng.next()).collect(),
+        internal: (0..n_internal).map(|_| 0.2 * rng.next()).collect(),
+        velocity: Vec::new(),
+    }
+}
+
+fn check(e: &dyn Element, s: &State, what: &str) {
+    let err = tangent_error(e, &ctx(), s, 1e-6);
+    assert!(err < 1e-6, "{what}: tangent error {err:.3e}");
+}
+
+const TYPES: [JointType; 9] = [
+    JointType::Revolute,
+    JointType::Prismatic,
+    JointType::Cylindrical,
+    JointType::Spherical,
+    JointType::Planar,
+    JointType::Universal,
+    JointType::Helical,
+    JointType::Rigid,
+    JointType::Glue,
+];
+
+#[test]
+fn joint_tangents_match_finite_differences() {
+    let mut rng = Lcg(7);
+    let mut worst = 0.0f64;
+    for t in TYPES {
+        for grounded in [false, true] {
+            if grounded && matches!(t, JointType::Rigid | JointType::Glue) {
+                continue;
+            }
+            for _ in 0..16 {
+                let (x, q, e, p) = reference(&mut rng);
+                let ra = so3::matrix(&q[0]);
+                let rb = so3::matrix(&q[1]);
+                let b = (!grounded).then_some((&x[1], &rb));
+                let pair = Pair::from_reference(&p, &e, (&x[0], &ra), b);
+                let params = JointParameters {
+                    lead: 0.05,
+                    lock_rotations: true,
+                    curve: None,
+                };
+                let j = Joint::new(1, t, 0, (!grounded).then_some(1), pair, params);
+                let nn = if grounded { 1 } else { 2 };
+                let s = moved(&mut rng, &x[..nn], &q[..nn], j.n_extra(), j.n_internal());
+                let err = tangent_error(&j, &ctx(), &s, 1e-6);
+                worst = worst.max(err);
+                assert!(
+                    err < 1e-6,
+                    "{} (grounded {grounded}): tangent error {err:.3e}",
+                    t.name()
+                );
+            }
+        }
+    }
+    println!("worst joint tangent error {worst:.2e}");
+}
+
+#[test]
+fn slider_tangents_match_finite_differences() {
+    let mut rng = Lcg(11);
+    for spline in [false, true] {
+        for _ in 0..16 {
+            // a wavy curve of 5 nodes along x, the sliding node near it
+            let mut x: Vec<Vec3> = (0..5)
+                .map(|k| Vec3::new(k as f64 * 0.5, 0.2 * (k as f64).sin(), 0.0) + rng.vec(0.05))
+                .collect();
+            x.insert(0, Vec3::new(0.9, 0.1, 0.0));
+            let q: Vec<Rotation> = (0..6).map(|_| so3::exp(&rng.vec(1.0))).collect();
+            let a = rng.vec(0.1);
+            let j = Joint::slider(2, 0, a, &[1, 2, 3, 4, 5], spline, 0.9);
+            let mut s = moved(&mut rng, &x, &q, j.n_extra(), 0);
+            // s inside the curve, away from the nodes' parameters
+            s.extra[0] = 0.3 + 1.3 * (0.5 + 0.5 * rng.next());
+            check(&j, &s, &format!("slider (spline {spline})"));
+        }
+    }
+}
+
+fn revolute_coordinate(
+    rng: &mut Lcg,
+    grounded: bool,
+    c: Coordinate,
+) -> (PairCoordinate, Vec<Vec3>, Vec<Rotation>) {
+    let (x, q, e, p) = reference(rng);
+    let ra = so3::matrix(&q[0]);
+    let rb = so3::matrix(&q[1]);
+    let b = (!grounded).then_some((&x[1], &rb));
+    let nodes = if grounded { vec![0] } else { vec![0, 1] };
+    (
+        PairCoordinate {
+            nodes,
+            pair: Pair::from_reference(&p, &e, (&x[0], &ra), b),
+            coordinate: c,
+        },
+        x,
+        q,
+    )
+}
+
+#[test]
+fn driver_and_spring_tangents_match_finite_differences() {
+    let mut rng = Lcg(5);
+    let curves = [crate::curves::Curve::ramp()];
+    let ctx = EvalContext {
+        curves: &curves,
+        ..ctx()
+    };
+    let coords = [
+        Coordinate::Angle,
+        Coordinate::Slide1,
+        Coordinate::Slide3,
+        Coordinate::Cardan1,
+        Coordinate::Cardan2,
+    ];
+    for c in coords {
+        for grounded in [false, true] {
+            for _ in 0..8 {
+                let (src, x, q) = revolute_coordinate(&mut rng, grounded, c);
+                let nn = src.nodes.len();
+                let d = Driver::new(3, src.clone(), 0.7, 0);
+                let s = moved(&mut rng, &x[..nn], &q[..nn], 1, d.n_internal());
+                let err = tangent_error(&d, &ctx, &s, 1e-6);
+                assert!(err < 1e-6, "driver on {}: {err:.3e}", c.name());
+
+                let table = Law::Table(vec![(-2.0, -3.0), (-0.1, -0.5), (0.3, 0.2), (2.0, 4.0)]);
+                for law in [Law::Linear { k: 2.5, x0: 0.1 }, table] {
+                    let sp = JointSpring::new(
+                        4,
+                        src.clone(),
+                        Some(law),
+                        Some(Law::Linear { k: 0.7, x0: 0.0 }),
+                    );
+                    let mut s = moved(&mut rng, &x[..nn], &q[..nn], 0, sp.n_internal());
+                    // nodes moving: the damper contributes too
+                    s.velocity = (0..nn)
+                        .map(|_| std::array::from_fn(|_| rng.next()))
+                        .collect();
+                    let err = tangent_error(&sp, &ctx, &s, 1e-6);
+                    assert!(err < 1e-6, "spring on {}: {err:.3e}", c.name());
+                }
+            }
+        }
+    }
+}
+
+/// A node driver measures the node's own motion along a fixed direction.
+#[test]
+fn node_driver_coordinate_is_the_displacement_along_its_direction() {
+    let x = Vec3::new(1.0, 2.0, 3.0);
+    let r = so3::matrix(&so3::exp(&Vec3::new(0.3, -0.2, 0.5)));
+    let dir = Vec3::new(0.0, 0.6, 0.8);
+    let e = Mat3::from_columns(&[Vec3::x(), dir.cross(&Vec3::x()), dir]);
+    let src = PairCoordinate {
+        nodes: vec![0],
+        pair: Pair::node_to_ground(&x, &r, &e),
+        coordinate: Coordinate::Slide3,
+    };
+    let s = State {
+        x: vec![x + Vec3::new(0.5, 1.0, -2.0)],
+        q: vec![so3::from_matrix(&r) * so3::exp(&Vec3::new(0.4, 0.1, 0.0))],
+        ..State::default()
+    };
+    assert!((src.value(&s, 0.0) - (0.6 - 1.6)).abs() < 1e-14);
+    // rotation about dir by 0.3 rad (applied in the global frame)
+    let rot = PairCoordinate {
+        coordinate: Coordinate::Angle,
+        ..src
+    };
+    let s = State {
+        x: vec![x],
+        q: vec![so3::exp(&(dir * 0.3)) * so3::from_matrix(&r)],
+        ..State::default()
+    };
+    assert!((rot.value(&s, 0.0) - 0.3).abs() < 1e-14);
+    let _ = eval;
+    let _ = SliderCurve { spline: true };
+}

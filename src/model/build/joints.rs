@@ -1,0 +1,591 @@
+//! Validation and construction of joints, joint springs and drivers.
+
+use std::collections::HashMap;
+
+use super::{Checker, NodeData};
+use crate::curves::CurveIndex;
+use crate::elements::Element;
+use crate::joints::types::{Coordinate, JointParameters};
+use crate::joints::{Driver, Joint, JointSpring, JointType, Law, Pair, PairCoordinate};
+use crate::model::input::{DriverInput, Id, JointInput, JointSpringInput, ModelInput};
+use crate::model::ModelErrorKind;
+use crate::so3::{self, Mat3, Vec3};
+
+/// Angle below which two axes count as parallel (rad).
+const PARALLEL: f64 = 1e-6;
+
+/// What the joint builder needs from the model builder.
+pub(super) struct Context<'a> {
+    pub ck: &'a mut Checker,
+    pub node_index: &'a HashMap<Id, usize>,
+    pub nodes: &'a [NodeData],
+    pub claim_id: &'a mut dyn FnMut(&mut Checker, &str, Id) -> bool,
+    pub find_curve: &'a dyn Fn(&mut Checker, &str, &Option<String>) -> CurveIndex,
+    pub elements: &'a mut Vec<Box<dyn Element>>,
+}
+
+impl Context<'_> {
+    fn node(&mut self, entity: &str, id: Id) -> Option<usize> {
+        let found = self.node_index.get(&id).copied();
+        if found.is_none() {
+            self.ck.push(
+                ModelErrorKind::UnknownNode,
+                entity,
+                format!("node {id} does not exist"),
+            );
+        }
+        found
+    }
+
+    fn unit(&mut self, entity: &str, what: &str, v: [f64; 3]) -> Option<Vec3> {
+        let v = Vec3::from(v);
+        let n = v.norm();
+        if v.iter().all(|c| c.is_finite()) && n > 0.0 {
+            Some(v / n)
+        } else {
+            self.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "{what} must be a non-zero finite vector, got {:?}",
+                    v.as_slice()
+                ),
+            );
+            None
+        }
+    }
+}
+
+/// A joint as built, for joint springs and drivers to refer to.
+struct Built {
+    joint_type: JointType,
+    nodes: Vec<usize>,
+    pair: Pair,
+}
+
+/// Builds every joint, joint spring and driver of `input`.
+pub(super) fn build(cx: &mut Context, input: &ModelInput) {
+    let mut built: HashMap<Id, Built> = HashMap::new();
+    for j in &input.joints {
+        let entity = format!("joint {}", j.id);
+        let id_ok = (cx.claim_id)(cx.ck, &entity, j.id);
+        if let Some(joint) = joint(cx, &entity, j) {
+            if id_ok {
+                built.insert(
+                    j.id,
+                    Built {
+                        joint_type: joint.joint_type(),
+                        nodes: joint.nodes().to_vec(),
+                        pair: joint.pair().clone(),
+                    },
+                );
+                cx.elements.push(Box::new(joint));
+            }
+        }
+    }
+    for s in &input.joint_springs {
+        let entity = format!("joint spring {}", s.id);
+        let id_ok = (cx.claim_id)(cx.ck, &entity, s.id);
+        if let (Some(e), true) = (joint_spring(cx, &entity, s, &built), id_ok) {
+            cx.elements.push(Box::new(e));
+        }
+    }
+    for d in &input.drivers {
+        let entity = format!("driver {}", d.id);
+        let id_ok = (cx.claim_id)(cx.ck, &entity, d.id);
+        if let (Some(e), true) = (driver(cx, &entity, d, &built), id_ok) {
+            cx.elements.push(Box::new(e));
+        }
+    }
+}
+
+/// A triad with `e₃ = axis` and `e₁` along the projection of `reference`
+/// (or any normal direction).
+fn triad(axis: &Vec3, reference: Option<&Vec3>) -> Option<Mat3> {
+    let guess = |a: &Vec3| {
+        if a.x.abs() < 0.9 {
+            Vec3::x()
+        } else {
+            Vec3::y()
+        }
+    };
+    let r = reference.copied().unwrap_or_else(|| guess(axis));
+    let e1 = r - axis * axis.dot(&r);
+    if e1.norm() < 1e-9 {
+        return None;
+    }
+    let e1 = e1.normalize();
+    let e2 = axis.cross(&e1);
+    Some(Mat3::from_columns(&[e1, e2, *axis]))
+}
+
+fn joint(cx: &mut Context, entity: &str, j: &JointInput) -> Option<Joint> {
+    let t = j.kind;
+    let ok_count = if t == JointType::Glue || t == JointType::Rigid {
+        j.nodes.len() == 2
+    } else {
+        matches!(j.nodes.len(), 1 | 2)
+    };
+    if !ok_count {
+        let want = if t == JointType::Glue || t == JointType::Rigid {
+            "two nodes"
+        } else {
+            "one node (joint to the ground) or two nodes"
+        };
+        cx.ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!("a {} joint needs {want}, got {}", t.name(), j.nodes.len()),
+        );
+        return None;
+    }
+    if j.nodes.len() == 2 && j.nodes[0] == j.nodes[1] {
+        cx.ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!("joins node {} to itself", j.nodes[0]),
+        );
+        return None;
+    }
+    let idx: Vec<Option<usize>> = j.nodes.iter().map(|&n| cx.node(entity, n)).collect();
+    let idx: Vec<usize> = idx.into_iter().collect::<Option<_>>()?;
+    let a = idx[0];
+    let b = idx.get(1).copied();
+    let (xa, ra) = (cx.nodes[a].x, so3::matrix(&cx.nodes[a].q));
+
+    // fields that only some types take
+    let needs_axis = matches!(
+        t,
+        JointType::Revolute
+            | JointType::Prismatic
+            | JointType::Cylindrical
+            | JointType::Planar
+            | JointType::Universal
+            | JointType::Helical
+    );
+    let unexpected = |field: &str, present: bool, cx: &mut Context| {
+        if present {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("`{field}` does not apply to a {} joint", t.name()),
+            );
+        }
+    };
+    unexpected("pitch", j.pitch.is_some() && t != JointType::Helical, cx);
+    unexpected("offset", j.offset.is_some() && t != JointType::Glue, cx);
+    unexpected(
+        "lock_rotations",
+        j.lock_rotations.is_some() && t != JointType::Glue,
+        cx,
+    );
+    unexpected("curve", !j.curve.is_empty() && t != JointType::Slider, cx);
+    unexpected("spline", j.spline.is_some() && t != JointType::Slider, cx);
+    unexpected("axis", j.axis.is_some() && !needs_axis, cx);
+    unexpected("axis_b", j.axis_b.is_some() && !needs_axis, cx);
+
+    if t == JointType::Slider {
+        if j.curve.len() < 2 {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                "a slider needs `curve` with at least two nodes",
+            );
+            return None;
+        }
+        if b.is_some() {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                "a slider takes one node in `nodes` (the sliding node) and its path in `curve`",
+            );
+            return None;
+        }
+        let curve: Vec<usize> = j
+            .curve
+            .iter()
+            .map(|&n| cx.node(entity, n))
+            .collect::<Option<_>>()?;
+        if curve.contains(&a) {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("the sliding node {} is also on its curve", j.nodes[0]),
+            );
+            return None;
+        }
+        for w in curve.windows(2) {
+            if (cx.nodes[w[1]].x - cx.nodes[w[0]].x).norm() == 0.0 {
+                cx.ck.push(
+                    ModelErrorKind::ZeroLength,
+                    entity,
+                    "two consecutive curve nodes coincide",
+                );
+                return None;
+            }
+        }
+        let p = j.position.map_or(xa, Vec3::from);
+        let pts: Vec<Vec3> = curve.iter().map(|&c| cx.nodes[c].x).collect();
+        let s0 = project_on_polyline(&pts, &p);
+        return Some(Joint::slider(
+            j.id,
+            a,
+            ra.transpose() * (p - xa),
+            &curve,
+            j.spline.unwrap_or(true),
+            s0,
+        ));
+    }
+
+    // joint axes
+    let e = if needs_axis {
+        let Some(axis) = j.axis else {
+            cx.ck.push(
+                ModelErrorKind::Missing,
+                entity,
+                format!("a {} joint needs `axis`", t.name()),
+            );
+            return None;
+        };
+        let axis = cx.unit(entity, "axis", axis)?;
+        let axis_b = match j.axis_b {
+            Some(v) => Some(cx.unit(entity, "axis_b", v)?),
+            None => None,
+        };
+        if t == JointType::Universal {
+            // e₁ = arm on A, e₂ = arm on B
+            let arm_b = match axis_b {
+                Some(v) => v,
+                None => {
+                    cx.ck.push(ModelErrorKind::Missing, entity, "a universal joint needs `axis` (the cross arm on A) and `axis_b` (the arm on B)");
+                    return None;
+                }
+            };
+            if axis.dot(&arm_b).abs() > PARALLEL {
+                cx.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!(
+                        "the cross arms `axis` and `axis_b` must be perpendicular (angle {:.3}°)",
+                        axis.dot(&arm_b).acos().to_degrees()
+                    ),
+                );
+                return None;
+            }
+            Mat3::from_columns(&[axis, arm_b, axis.cross(&arm_b)])
+        } else {
+            if let Some(ab) = axis_b {
+                let angle = axis.cross(&ab).norm().asin();
+                if angle > PARALLEL || axis.dot(&ab) < 0.0 {
+                    cx.ck.push(ModelErrorKind::Invalid, entity, format!("the axes of the {} joint must coincide: `axis` and `axis_b` differ by {:.4}°", t.name(), axis.dot(&ab).clamp(-1.0, 1.0).acos().to_degrees()));
+                    return None;
+                }
+            }
+            let r = match j.reference_direction {
+                Some(v) => Some(cx.unit(entity, "reference_direction", v)?),
+                None => None,
+            };
+            match triad(&axis, r.as_ref()) {
+                Some(m) => m,
+                None => {
+                    cx.ck.push(
+                        ModelErrorKind::Invalid,
+                        entity,
+                        "`reference_direction` is parallel to `axis`",
+                    );
+                    return None;
+                }
+            }
+        }
+    } else {
+        Mat3::identity()
+    };
+
+    let mut parameters = JointParameters {
+        lead: 0.0,
+        lock_rotations: j.lock_rotations.unwrap_or(true),
+        curve: None,
+    };
+    if t == JointType::Helical {
+        match j.pitch {
+            Some(p) if p.is_finite() => parameters.lead = p / std::f64::consts::TAU,
+            Some(p) => {
+                cx.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!("pitch must be finite, got {p}"),
+                );
+                return None;
+            }
+            None => {
+                cx.ck.push(
+                    ModelErrorKind::Missing,
+                    entity,
+                    "a helical joint needs `pitch` (advance per turn)",
+                );
+                return None;
+            }
+        }
+    }
+
+    let bb = b.map(|b| (cx.nodes[b].x, so3::matrix(&cx.nodes[b].q)));
+    let pair = if t == JointType::Glue {
+        let b = b.expect("checked: two nodes");
+        let (xb, rb) = bb.expect("two nodes");
+        let a_off = match j.offset {
+            Some(o) if o.iter().all(|v| v.is_finite()) => Vec3::from(o),
+            Some(o) => {
+                cx.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!("offset must be finite, got {o:?}"),
+                );
+                return None;
+            }
+            None => ra.transpose() * (xb - xa),
+        };
+        let _ = b;
+        Pair {
+            a: a_off,
+            ea: ra.transpose(),
+            b: Vec3::zeros(),
+            eb: rb.transpose(),
+            ground: None,
+            ground_is_a: false,
+        }
+    } else {
+        let p = match j.position {
+            Some(p) if p.iter().all(|v| v.is_finite()) => Vec3::from(p),
+            Some(p) => {
+                cx.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!("position must be finite, got {p:?}"),
+                );
+                return None;
+            }
+            None => xa,
+        };
+        Pair::from_reference(&p, &e, (&xa, &ra), bb.as_ref().map(|(x, r)| (x, r)))
+    };
+    Some(Joint::new(j.id, t, a, b, pair, parameters))
+}
+
+/// Parameter (distance along the polygon) of the point of the polyline
+/// `pts` nearest to `p`.
+fn project_on_polyline(pts: &[Vec3], p: &Vec3) -> f64 {
+    let (mut best, mut best_s, mut start) = (f64::INFINITY, 0.0, 0.0);
+    for w in pts.windows(2) {
+        let d = w[1] - w[0];
+        let l = d.norm();
+        let t = ((p - w[0]).dot(&d) / (l * l)).clamp(0.0, 1.0);
+        let dist = (w[0] + d * t - p).norm();
+        if dist < best {
+            best = dist;
+            best_s = start + t * l;
+        }
+        start += l;
+    }
+    best_s
+}
+
+/// Resolves `coordinate` of joint `joint` into a pair coordinate.
+fn joint_coordinate(
+    cx: &mut Context,
+    entity: &str,
+    joint: Id,
+    coordinate: &Option<String>,
+    built: &HashMap<Id, Built>,
+) -> Option<PairCoordinate> {
+    let Some(b) = built.get(&joint) else {
+        cx.ck.push(
+            ModelErrorKind::UnknownNode,
+            entity,
+            format!("joint {joint} does not exist (or is invalid)"),
+        );
+        return None;
+    };
+    let coords = b.joint_type.coordinates();
+    let usable: Vec<Coordinate> = coords
+        .iter()
+        .copied()
+        .filter(|c| *c != Coordinate::CurveParameter)
+        .collect();
+    let names: Vec<&str> = usable.iter().map(|c| c.name()).collect();
+    let c = match coordinate {
+        None => usable.first().copied(),
+        Some(n) => usable.iter().copied().find(|c| c.name() == n),
+    };
+    match c {
+        Some(c) => Some(PairCoordinate {
+            nodes: b.nodes.clone(),
+            pair: b.pair.clone(),
+            coordinate: c,
+        }),
+        None => {
+            let msg = if names.is_empty() {
+                format!(
+                    "joint {joint} ({}) has no coordinate that springs or drivers can act on",
+                    b.joint_type.name()
+                )
+            } else {
+                format!(
+                    "joint {joint} ({}) has no coordinate {:?}; it has {}",
+                    b.joint_type.name(),
+                    coordinate.as_deref().unwrap_or(""),
+                    names.join(", ")
+                )
+            };
+            cx.ck.push(ModelErrorKind::Invalid, entity, msg);
+            None
+        }
+    }
+}
+
+/// A law from a linear coefficient or a table.
+fn law(
+    cx: &mut Context,
+    entity: &str,
+    what: &str,
+    linear: Option<f64>,
+    x0: f64,
+    table: &[[f64; 2]],
+) -> Result<Option<Law>, ()> {
+    match (linear, table.is_empty()) {
+        (Some(_), false) => {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("give either a linear {what} coefficient or a {what} table, not both"),
+            );
+            Err(())
+        }
+        (Some(k), true) => {
+            if !(k.is_finite() && k >= 0.0) {
+                cx.ck.push(
+                    ModelErrorKind::NonPositive,
+                    entity,
+                    format!("{what} must be zero or positive, got {k}"),
+                );
+                return Err(());
+            }
+            Ok(Some(Law::Linear { k, x0 }))
+        }
+        (None, false) => {
+            if table.len() < 2
+                || table
+                    .iter()
+                    .any(|p| !(p[0].is_finite() && p[1].is_finite()))
+                || table.windows(2).any(|w| w[1][0] <= w[0][0])
+            {
+                cx.ck.push(ModelErrorKind::Invalid, entity, format!("the {what} table needs at least two finite points with strictly increasing abscissae"));
+                return Err(());
+            }
+            Ok(Some(Law::Table(
+                table.iter().map(|p| (p[0], p[1])).collect(),
+            )))
+        }
+        (None, true) => Ok(None),
+    }
+}
+
+fn joint_spring(
+    cx: &mut Context,
+    entity: &str,
+    s: &JointSpringInput,
+    built: &HashMap<Id, Built>,
+) -> Option<JointSpring> {
+    let source = joint_coordinate(cx, entity, s.joint, &s.coordinate, built);
+    let x0 = s.free_value.unwrap_or(0.0);
+    if !x0.is_finite() {
+        cx.ck
+            .push(ModelErrorKind::Invalid, entity, "free_value must be finite");
+        return None;
+    }
+    let spring = law(cx, entity, "stiffness", s.stiffness, x0, &s.table).ok()?;
+    let damper = law(cx, entity, "damping", s.damping, 0.0, &s.damping_table).ok()?;
+    if spring.is_none() && damper.is_none() {
+        cx.ck.push(
+            ModelErrorKind::Missing,
+            entity,
+            "needs a stiffness, a table, a damping or a damping_table",
+        );
+        return None;
+    }
+    Some(JointSpring::new(s.id, source?, spring, damper))
+}
+
+fn driver(
+    cx: &mut Context,
+    entity: &str,
+    d: &DriverInput,
+    built: &HashMap<Id, Built>,
+) -> Option<Driver> {
+    let curve = (cx.find_curve)(cx.ck, entity, &d.curve);
+    if !d.value.is_finite() {
+        cx.ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!("value must be finite, got {}", d.value),
+        );
+        return None;
+    }
+    let source = match (d.joint, d.node) {
+        (Some(j), None) => {
+            if d.direction.is_some() || d.motion.is_some() {
+                cx.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    "`direction` and `motion` apply to node drivers, not joint drivers",
+                );
+                return None;
+            }
+            joint_coordinate(cx, entity, j, &d.coordinate, built)?
+        }
+        (None, Some(n)) => {
+            if d.coordinate.is_some() {
+                cx.ck.push(ModelErrorKind::Invalid, entity, "`coordinate` applies to joint drivers; a node driver takes `direction` and `motion`");
+                return None;
+            }
+            let node = cx.node(entity, n)?;
+            let Some(dir) = d.direction else {
+                cx.ck.push(
+                    ModelErrorKind::Missing,
+                    entity,
+                    "a node driver needs `direction`",
+                );
+                return None;
+            };
+            let dir = cx.unit(entity, "direction", dir)?;
+            let coordinate = match d.motion.as_deref() {
+                None | Some("translation") => Coordinate::Slide3,
+                Some("rotation") => Coordinate::Angle,
+                Some(m) => {
+                    cx.ck.push(
+                        ModelErrorKind::Invalid,
+                        entity,
+                        format!("motion must be \"translation\" or \"rotation\", got \"{m}\""),
+                    );
+                    return None;
+                }
+            };
+            let (x, r) = (cx.nodes[node].x, so3::matrix(&cx.nodes[node].q));
+            let e = triad(&dir, None).expect("a unit vector has a normal");
+            let pair = Pair::node_to_ground(&x, &r, &e);
+            PairCoordinate {
+                nodes: vec![node],
+                pair,
+                coordinate,
+            }
+        }
+        _ => {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                "give either `joint` (and `coordinate`) or `node` (with `direction` and `motion`)",
+            );
+            return None;
+        }
+    };
+    Some(Driver::new(d.id, source, d.value, curve))
+}

@@ -43,6 +43,13 @@ pub struct DofMap {
 impl DofMap {
     /// Numbers the free dofs of `model`.
     pub fn new(model: &Model) -> Self {
+        Self::with_suppressed(model, &[])
+    }
+
+    /// Numbers the free dofs of `model`, leaving out the extra unknowns
+    /// listed in `suppressed` (indices into the extra block): the
+    /// multipliers of redundant constraints, which stay at zero.
+    pub fn with_suppressed(model: &Model, suppressed: &[usize]) -> Self {
         let n_nodes = model.n_nodes();
         let mut extra_offset = Vec::with_capacity(model.elements.len());
         let mut n_extra = 0;
@@ -62,6 +69,9 @@ impl DofMap {
             }
         }
         for k in 0..n_extra {
+            if suppressed.contains(&k) {
+                continue;
+            }
             equation[6 * n_nodes + k] = dof.len();
             dof.push(6 * n_nodes + k);
         }

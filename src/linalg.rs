@@ -112,6 +112,14 @@ impl SparseMatrix {
         }
     }
 
+    /// Every stored entry as `(row, col, value)`.
+    pub fn entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        let ptr = self.symbolic.col_ptr();
+        let rows = self.symbolic.row_idx();
+        (0..self.dim())
+            .flat_map(move |j| (ptr[j]..ptr[j + 1]).map(move |k| (rows[k], j, self.values[k])))
+    }
+
     /// Largest absolute value in column `j`.
     pub fn column_max_abs(&self, j: usize) -> f64 {
         let ptr = self.symbolic.col_ptr();

@@ -99,12 +99,15 @@ fn main() -> ExitCode {
 fn describe(model: &Model) -> String {
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
     format!(
-        "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} loads",
+        "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
         model.n_nodes(),
         count(ElementKind::Beam),
         count(ElementKind::RigidBody),
         count(ElementKind::PointMass),
         count(ElementKind::Spring),
+        count(ElementKind::Joint),
+        count(ElementKind::JointSpring),
+        count(ElementKind::Driver),
         count(ElementKind::NodalLoad),
     )
 }
@@ -198,6 +201,10 @@ impl Observer for RunObserver {
         self.writer.increment(info, model, state, reactions)
     }
 
+    fn note(&mut self, text: &str) {
+        self.line(&format!("note: {text}"));
+    }
+
     fn cutback(&mut self, info: &CutbackInfo) {
         self.line(&format!(
             "increment {:4}  from t = {:.6}: step {:.3e} failed ({}); retrying with {:.3e}",
@@ -243,10 +250,15 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
         end_time: model.settings.end_time,
     };
     observer.line(&format!(
-        "{}: {}; {} unknowns; static analysis to t = {}",
+        "{}: {}; {} unknowns; {} analysis to t = {}",
         path.display(),
         describe(&model),
         analysis.n_equations(),
+        if model.settings.kinematic {
+            "kinematic"
+        } else {
+            "static"
+        },
         model.settings.end_time
     ));
     let outcome = analysis.run(&mut observer);
@@ -269,6 +281,16 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
             .elements
             .iter()
             .filter(|e| e.kind() == ElementKind::Beam)
+            .count(),
+        joints: model
+            .elements
+            .iter()
+            .filter(|e| e.kind() == ElementKind::Joint)
+            .count(),
+        drivers: model
+            .elements
+            .iter()
+            .filter(|e| e.kind() == ElementKind::Driver)
             .count(),
         dofs: analysis.n_equations(),
         nonzeros: analysis.solver().nnz(),
@@ -306,7 +328,11 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
     if let Some(m) = message {
         eprintln!("error: {}: {m}", path.display());
         // a model that is singular from the start is invalid input
-        if let Some(StaticError::Initial(NewtonFailure::Singular { .. })) = outcome.error {
+        if let Some(
+            StaticError::Initial(NewtonFailure::Singular { .. })
+            | StaticError::Indeterminate { .. },
+        ) = outcome.error
+        {
             return ExitCode::from(EXIT_INPUT);
         }
         eprintln!(

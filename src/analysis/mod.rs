@@ -6,6 +6,7 @@
 //! every cut-back. The library never prints; the command-line tool turns
 //! these events into log lines, a progress bar and result files.
 
+pub mod constraints;
 pub mod newton;
 pub mod statics;
 
@@ -82,6 +83,9 @@ pub trait Observer {
 
     /// When an increment is cut back.
     fn cutback(&mut self, _info: &CutbackInfo) {}
+
+    /// A remark worth showing the user (redundant constraints removed).
+    fn note(&mut self, _text: &str) {}
 }
 
 /// An observer that ignores everything.

@@ -26,9 +26,11 @@
 //! equilibrium, so that a singular tangent (a mechanism, a missing support)
 //! is found before the analysis starts.
 
+use super::constraints::{self, ConstraintRank};
 use super::{IterationInfo, Observer};
 use crate::assembly::Assembler;
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
+use crate::elements::ExtraKind;
 use crate::linalg::{smallest_relative_pivot, SolveError, SparseLu};
 use crate::model::{Model, StaticSettings, COMPONENT_NAMES};
 use crate::so3::{self, Vec3};
@@ -66,8 +68,9 @@ pub struct ConvergenceNorms {
     /// `max(‖r_F‖/ref_F, ‖r_M‖/ref_M)` with `ref = max(‖flux‖, floor/ε_r)`:
     /// the residual criterion holds when this is at most `ε_r`.
     pub relative_residual: f64,
-    /// `max|r|` over the equations of extra unknowns (constraint
-    /// violations of joints), 0 without them.
+    /// Largest constraint violation relative to its tolerance (`ε_u·L`
+    /// for distances, `ε_θ` for angles); the constraints hold when it is at
+    /// most 1. Zero without constraints.
     pub residual_constraint: f64,
     /// `max|Δx|` of the last correction (0 before the first).
     pub displacement_correction: f64,
@@ -136,6 +139,10 @@ pub struct NewtonSolver {
     /// solve always makes one correction, even from equilibrium, so that a
     /// singular model (a mechanism) is caught at the start.
     tangent_checked: bool,
+    /// What each extra unknown is (multiplier or coordinate).
+    extra_kinds: Vec<ExtraKind>,
+    /// Multipliers of redundant constraints, left out of the system.
+    redundant: Vec<usize>,
 }
 
 impl NewtonSolver {
@@ -144,6 +151,13 @@ impl NewtonSolver {
         let dofs = DofMap::new(model);
         let assembler = Assembler::new(model, &dofs);
         let n = dofs.n_equations();
+        let ctx = model.context(0.0, false);
+        let extra_kinds = model
+            .elements
+            .iter()
+            .flat_map(|e| (0..e.n_extra()).map(move |k| (e, k)))
+            .map(|(e, k)| e.extra_kind(&ctx, k))
+            .collect();
         Self {
             dofs,
             assembler,
@@ -151,7 +165,45 @@ impl NewtonSolver {
             rhs: vec![0.0; n],
             stiffness_scale: None,
             tangent_checked: false,
+            extra_kinds,
+            redundant: Vec::new(),
         }
+    }
+
+    /// Whether each equation is a multiplier's.
+    fn multiplier_equations(&self) -> Vec<bool> {
+        let first_extra = self.dofs.n_dofs() - self.extra_kinds.len();
+        (0..self.dofs.n_equations())
+            .map(|eq| {
+                let d = self.dofs.dof(eq);
+                d >= first_extra
+                    && matches!(
+                        self.extra_kinds[d - first_extra],
+                        ExtraKind::Multiplier { .. }
+                    )
+            })
+            .collect()
+    }
+
+    /// Rank analysis of the constraints at `state` (docs/joints.md §5):
+    /// redundant constraints are removed from the numbering (their
+    /// multipliers stay zero) and the free motions are counted.
+    pub fn constraint_rank(&mut self, model: &Model, state: &State) -> ConstraintRank {
+        self.assemble(model, state, state.time, true);
+        let rank = constraints::analyse(
+            &self.dofs,
+            &self.assembler.matrix,
+            &self.multiplier_equations(),
+        );
+        self.redundant.clone_from(&rank.redundant);
+        if !rank.redundant.is_empty() {
+            self.dofs = DofMap::with_suppressed(model, &rank.redundant);
+            self.assembler = Assembler::new(model, &self.dofs);
+            self.lu = None;
+            self.rhs = vec![0.0; self.dofs.n_equations()];
+            self.stiffness_scale = None;
+        }
+        rank
     }
 
     /// Residual at every dof after the last evaluation: at fixed dofs, the
@@ -189,13 +241,72 @@ impl NewtonSolver {
         self.assembler.assemble(model, &ctx, state);
     }
 
+    /// The constraint left out as redundant that is violated the most at
+    /// `state`, with its violation relative to the tolerance, if above 1:
+    /// the constraints then contradict each other (two drivers imposing
+    /// incompatible motions) instead of repeating each other.
+    pub fn violated_redundant(
+        &self,
+        model: &Model,
+        state: &State,
+        settings: &StaticSettings,
+    ) -> Option<(String, f64)> {
+        if self.redundant.is_empty() {
+            return None;
+        }
+        let ctx = model.context(state.time, false);
+        let mut worst: Option<(String, f64)> = None;
+        let mut offset = 0;
+        for e in &model.elements {
+            let ne = e.n_extra();
+            let mine: Vec<usize> = self
+                .redundant
+                .iter()
+                .filter(|&&k| k >= offset && k < offset + ne)
+                .map(|&k| k - offset)
+                .collect();
+            if !mine.is_empty() {
+                let n = e.n_local();
+                let mut r = vec![0.0; n];
+                let mut t = Vec::new();
+                e.evaluate(
+                    &ctx,
+                    state,
+                    &mut crate::elements::ElementOutput {
+                        residual: &mut r,
+                        tangent: &mut t,
+                    },
+                );
+                for k in mine {
+                    if let ExtraKind::Multiplier { scale, angular } = e.extra_kind(&ctx, k) {
+                        let tol = if angular {
+                            settings.rotation_tolerance
+                        } else {
+                            settings.displacement_tolerance * model.length_scale
+                        };
+                        let v = r[6 * e.nodes().len() + k].abs() / scale / tol;
+                        if v > 1.0 && worst.as_ref().is_none_or(|w| v > w.1) {
+                            worst = Some((
+                                format!("{} {} equation {}", e.kind().name(), e.id(), k + 1),
+                                v,
+                            ));
+                        }
+                    }
+                }
+            }
+            offset += ne;
+        }
+        worst
+    }
+
     /// Residual and flux norms of the last assembly. The relative residual
     /// is measured against `max(flux, floor/ε_r)`, so that it is below
     /// `ε_r` exactly when the residual criterion holds.
-    fn norms(&self, floor: (f64, f64), tol: f64) -> ConvergenceNorms {
+    fn norms(&self, floor: (f64, f64), tol: f64, constraint_tol: (f64, f64)) -> ConvergenceNorms {
         let (mut rf, mut rm, mut ff, mut fm, mut rc) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
         let res = &self.assembler.residual;
         let flux = &self.assembler.flux;
+        let first_extra = self.dofs.n_dofs() - self.extra_kinds.len();
         for dof in 0..res.len() {
             let free = self.dofs.equation(dof) != NO_EQUATION;
             let r2 = if free { res[dof] * res[dof] } else { 0.0 };
@@ -208,11 +319,22 @@ impl NewtonSolver {
                     rm += r2;
                     fm += flux[dof] * flux[dof];
                 }
-                DofKind::Extra => {
-                    if free {
-                        rc = rc.max(res[dof].abs());
+                DofKind::Extra => match self.extra_kinds[dof - first_extra] {
+                    ExtraKind::Multiplier { scale, angular } => {
+                        if free {
+                            let t = if angular {
+                                constraint_tol.1
+                            } else {
+                                constraint_tol.0
+                            };
+                            rc = rc.max(res[dof].abs() / scale / t);
+                        }
                     }
-                }
+                    ExtraKind::Coordinate => {
+                        rf += r2;
+                        ff += flux[dof] * flux[dof];
+                    }
+                },
             }
         }
         let (rf, rm, ff, fm) = (rf.sqrt(), rm.sqrt(), ff.sqrt(), fm.sqrt());
@@ -275,7 +397,11 @@ impl NewtonSolver {
             let scale = self.stiffness_scale.expect("set above");
             let tol = settings.residual_tolerance;
             let floor = (RESIDUAL_FLOOR * scale.0 * length, RESIDUAL_FLOOR * scale.1);
-            let mut norms = self.norms(floor, tol);
+            let constraint_tol = (
+                settings.displacement_tolerance * length,
+                settings.rotation_tolerance,
+            );
+            let mut norms = self.norms(floor, tol, constraint_tol);
             if let Some((dx, dth)) = last_correction {
                 norms.displacement_correction = dx;
                 norms.rotation_correction = dth;
@@ -294,7 +420,7 @@ impl NewtonSolver {
             // convergence: residual, and the next correction estimated as the
             // last one scaled by the residual ratio, |Δq_k+1| ≈ |Δq_k| r_k/r_k-1
             let residual_ok = norms.relative_residual <= tol
-                && norms.residual_constraint <= settings.displacement_tolerance * length
+                && norms.residual_constraint <= 1.0
                 && self.tangent_checked;
             let ratio = match residuals.len() {
                 n if n >= 2 && residuals[n - 2] > 0.0 => {

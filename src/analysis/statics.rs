@@ -46,6 +46,25 @@ pub enum StaticError {
     /// Equilibrium could not be found in the initial configuration.
     #[error("no equilibrium in the initial configuration (t = 0): {0}")]
     Initial(NewtonFailure),
+    /// A kinematic analysis whose joints and drivers leave motions free.
+    #[error("the joints and drivers do not make the mechanism determinate: {free} motion(s) are left free (least constrained: {dofs}); add drivers or supports, or run a kinetostatic analysis")]
+    Indeterminate {
+        /// Number of free motions.
+        free: usize,
+        /// The least constrained unknowns.
+        dofs: String,
+    },
+    /// Constraints removed as redundant turned out violated: they
+    /// contradict the others.
+    #[error("inconsistent constraints at t = {time:.6}: {constraint} was found redundant at the start but is now violated ({violation:.1e} × its tolerance); two joints or drivers impose incompatible motions")]
+    Inconsistent {
+        /// Load parameter.
+        time: f64,
+        /// The violated constraint.
+        constraint: String,
+        /// Violation relative to the tolerance.
+        violation: f64,
+    },
     /// A result file could not be written.
     #[error("writing results: {0}")]
     Output(#[from] std::io::Error),
@@ -121,10 +140,33 @@ impl<'m> StaticAnalysis<'m> {
             o
         };
 
-        // initial equilibrium, increment 0
+        // rank of the constraints: redundant ones out, determinacy
         model.apply_prescribed(&mut state, 0.0);
+        let rank = self.solver.constraint_rank(model, &state);
+        if !rank.redundant.is_empty() {
+            observer.note(&format!(
+                "{} redundant constraint equation(s) removed (over-constrained loops); their multipliers are zero and the others carry the loads",
+                rank.redundant.len()
+            ));
+        }
+        if s.kinematic && rank.degrees_of_freedom() > 0 {
+            let dofs: Vec<String> = rank
+                .freedom
+                .iter()
+                .take(rank.degrees_of_freedom().min(6))
+                .map(|&(d, _)| self.solver.dof_label(model, d))
+                .collect();
+            let error = StaticError::Indeterminate {
+                free: rank.degrees_of_freedom(),
+                dofs: dofs.join(", "),
+            };
+            return finish(outcome, state, Some(error));
+        }
+
+        // initial equilibrium, increment 0
         match self.solver.solve(model, s, &mut state, 0.0, 0, observer) {
             Ok(r) => {
+                model.update_internal(&mut state);
                 outcome.iterations += r.iterations;
                 let info = IncrementInfo {
                     increment: 0,
@@ -161,6 +203,17 @@ impl<'m> StaticAnalysis<'m> {
                 .solve(model, s, &mut state, t_new, increment, observer)
             {
                 Ok(r) => {
+                    model.update_internal(&mut state);
+                    if let Some((constraint, violation)) =
+                        self.solver.violated_redundant(model, &state, s)
+                    {
+                        let error = StaticError::Inconsistent {
+                            time: t_new,
+                            constraint,
+                            violation,
+                        };
+                        return finish(outcome, backup, Some(error));
+                    }
                     t = if t_new >= s.end_time {
                         s.end_time
                     } else {

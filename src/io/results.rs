@@ -4,6 +4,11 @@
 //! - `beams.csv`: section forces and moments of every beam;
 //! - `springs.csv`: force and deformation of every spring;
 //! - `reactions.csv`: support reactions (forces and moments, global frame);
+//! - `joints.csv`: relative coordinates of every joint and the load it
+//!   applies to its first body, in the joint axes;
+//! - `drivers.csv`: driven coordinate, its target and the actuator load;
+//! - `joint_springs.csv`: coordinate, rate and force of joint springs and
+//!   dampers;
 //! - `steps.csv`: one line per output step (increment, load parameter,
 //!   iterations, final relative residual);
 //! - `vtk/step_NNNNN.vtu` and `unfold.pvd`: the configurations for ParaView;
@@ -59,6 +64,10 @@ pub struct Summary {
     pub elements: usize,
     /// Number of beam elements.
     pub beams: usize,
+    /// Number of joints.
+    pub joints: usize,
+    /// Number of drivers.
+    pub drivers: usize,
     /// Free unknowns (equations).
     pub dofs: usize,
     /// Non-zeros of the system matrix.
@@ -91,6 +100,9 @@ pub struct ResultWriter {
     nodes: BufWriter<File>,
     beams: Option<BufWriter<File>>,
     springs: Option<BufWriter<File>>,
+    joints: Option<BufWriter<File>>,
+    drivers: Option<BufWriter<File>>,
+    joint_springs: Option<BufWriter<File>>,
     reactions: Option<BufWriter<File>>,
     steps: BufWriter<File>,
     pvd: Vec<(f64, String)>,
@@ -139,6 +151,30 @@ impl ResultWriter {
                     csv(
                         &dir.join("springs.csv"),
                         "step,time,element,F1,F2,F3,D1,D2,D3",
+                    )
+                })
+                .transpose()?,
+            joints: has(ElementKind::Joint)
+                .then(|| {
+                    csv(
+                        &dir.join("joints.csv"),
+                        "step,time,joint,c1,c2,c3,F1,F2,F3,M1,M2,M3",
+                    )
+                })
+                .transpose()?,
+            drivers: has(ElementKind::Driver)
+                .then(|| {
+                    csv(
+                        &dir.join("drivers.csv"),
+                        "step,time,driver,coordinate,target,load",
+                    )
+                })
+                .transpose()?,
+            joint_springs: has(ElementKind::JointSpring)
+                .then(|| {
+                    csv(
+                        &dir.join("joint_springs.csv"),
+                        "step,time,element,coordinate,rate,spring,damper",
                     )
                 })
                 .transpose()?,
@@ -196,18 +232,27 @@ impl ResultWriter {
             )?;
         }
         let ctx = model.context(t, false);
-        let mut values = [0.0; 6];
+        let mut values = [0.0; 9];
         for e in &model.elements {
             let file = match e.kind() {
                 ElementKind::Beam => self.beams.as_mut(),
                 ElementKind::Spring => self.springs.as_mut(),
+                ElementKind::Joint => self.joints.as_mut(),
+                ElementKind::Driver => self.drivers.as_mut(),
+                ElementKind::JointSpring => self.joint_springs.as_mut(),
                 _ => None,
             };
             if let Some(w) = file {
-                e.results(&ctx, state, &mut values);
+                let n = e.result_names().len();
+                e.results(&ctx, state, &mut values[..n]);
                 write!(w, "{step},{t:.12e},{}", e.id())?;
-                for v in values {
-                    write!(w, ",{v:.9e}")?;
+                for v in &values[..n] {
+                    // absent quantities (a joint with fewer coordinates) are empty
+                    if v.is_nan() {
+                        write!(w, ",")?;
+                    } else {
+                        write!(w, ",{v:.9e}")?;
+                    }
                 }
                 writeln!(w)?;
             }
@@ -242,6 +287,9 @@ impl ResultWriter {
             Some(&mut self.steps),
             self.beams.as_mut(),
             self.springs.as_mut(),
+            self.joints.as_mut(),
+            self.drivers.as_mut(),
+            self.joint_springs.as_mut(),
             self.reactions.as_mut(),
         ]
         .into_iter()

@@ -81,7 +81,7 @@ pub fn write_vtu(
         kinds.push(e.kind().code());
         ids.push(e.id());
         results.fill(0.0);
-        if !e.result_names().is_empty() {
+        if matches!(e.kind(), ElementKind::Beam | ElementKind::Spring) {
             e.results(ctx, state, &mut results);
         }
         let (b, s) = match e.kind() {

@@ -741,11 +741,14 @@ fn component_set(name: &str) -> Option<&'static [usize]> {
 
 /// Analysis settings with defaults (docs/model-format.md).
 fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
-    if a.kind != "static" {
+    if !matches!(a.kind.as_str(), "static" | "kinetostatic" | "kinematic") {
         ck.push(
             ModelErrorKind::Invalid,
             "analysis",
-            format!("unknown analysis type \"{}\" (available: static)", a.kind),
+            format!(
+                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic)",
+                a.kind
+            ),
         );
     }
     let end = a.end_time;
@@ -762,6 +765,7 @@ fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
         rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
         output_every: a.output_every.unwrap_or(1),
+        kinematic: a.kind == "kinematic",
     };
     ck.positive("analysis", "initial_increment", s.initial_increment);
     ck.positive("analysis", "min_increment", s.min_increment);

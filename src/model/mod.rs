@@ -66,6 +66,9 @@ pub struct StaticSettings {
     pub rotation_tolerance: f64,
     /// Results are written every this many increments.
     pub output_every: usize,
+    /// Kinematic analysis: the joints and drivers must determine every
+    /// unknown (docs/joints.md §6).
+    pub kinematic: bool,
 }
 
 /// A validated model.

@@ -3,7 +3,7 @@
 //! springs, dampers and drivers act on.
 
 use super::hyperdual::HyperDual;
-use super::kinematics::{Conf, Local, Pair};
+use super::kinematics::{with_scratch, Conf, Pair};
 use super::types::Coordinate;
 use crate::state::State;
 
@@ -35,11 +35,12 @@ impl PairCoordinate {
 
     /// Value at `state`, angles on the branch nearest `reference`.
     pub fn value(&self, state: &State, reference: f64) -> f64 {
-        let mut local = Local::default();
-        local.gather(state, &self.nodes, 0..0);
-        let mut v = [0.0];
-        local.value(1, &self.function(reference), &mut v);
-        v[0]
+        with_scratch(|sc| {
+            sc.local.gather(state, &self.nodes, 0..0);
+            let mut v = [0.0];
+            sc.local.value(1, &self.function(reference), &mut v);
+            v[0]
+        })
     }
 
     /// Local unknowns it depends on (all of its nodes' components).

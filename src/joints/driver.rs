@@ -7,7 +7,7 @@
 
 use super::coordinate::PairCoordinate;
 use super::joint::{add_constraints, scale_of};
-use super::kinematics::{Conf, Local};
+use super::kinematics::{with_scratch, Conf};
 use super::types::Equation;
 use crate::curves::CurveIndex;
 use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext, ExtraKind};
@@ -95,8 +95,6 @@ impl Element for Driver {
         }
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
-        let mut local = Local::default();
-        local.gather(state, &self.source.nodes, 0..0);
         let target = self.target(ctx);
         let c = self.source.function(self.reference(state));
         let phi = |conf: &Conf, o: &mut [super::hyperdual::HyperDual]| {
@@ -104,15 +102,19 @@ impl Element for Driver {
             o[0] = o[0] + (-target);
         };
         let lambda = &state.extra[self.extra..self.extra + 1];
-        add_constraints(
-            ctx,
-            &mut local,
-            &self.active,
-            &[self.kind_of_equation()],
-            &phi,
-            lambda,
-            out,
-        );
+        with_scratch(|sc| {
+            sc.local.gather(state, &self.source.nodes, 0..0);
+            add_constraints(
+                ctx,
+                &mut sc.local,
+                &mut sc.grad,
+                &self.active,
+                &[self.kind_of_equation()],
+                &phi,
+                lambda,
+                out,
+            );
+        });
     }
     fn update_internal(&self, _ctx: &EvalContext, state: &State, internal: &mut [f64]) {
         if self.source.is_angle() {

@@ -13,7 +13,7 @@
 //! rotational one.
 
 use super::hyperdual::HyperDual;
-use super::kinematics::{Conf, Local, Pair, MAX_OUT};
+use super::kinematics::{with_scratch, Conf, Local, Pair, MAX_OUT};
 use super::types::{
     constraint_kinds, constraints, slider_constraints, Coordinate, Equation, JointParameters,
     JointType,
@@ -40,6 +40,7 @@ pub(crate) fn scale_of(s: &ConstraintScaling, e: Equation) -> (f64, f64) {
 pub(crate) fn add_constraints<F>(
     ctx: &EvalContext,
     local: &mut Local,
+    grad: &mut Vec<f64>,
     active: &[usize],
     kinds: &[Equation],
     f: &F,
@@ -52,8 +53,9 @@ pub(crate) fn add_constraints<F>(
     let nq = local.n();
     let n = nq + m;
     let mut phi = [0.0; MAX_OUT];
-    let mut grad = vec![0.0; m * nq];
-    local.gradient(m, active, f, &mut phi[..m], &mut grad);
+    grad.clear();
+    grad.resize(m * nq, 0.0);
+    local.gradient(m, active, f, &mut phi[..m], grad);
     let mut w = [0.0; MAX_OUT];
     let mut kk = [0.0; MAX_OUT];
     let mut pp = [0.0; MAX_OUT];
@@ -317,19 +319,22 @@ impl Element for Joint {
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         let nc = self.n_coords();
-        let mut local = Local::default();
-        local.gather(state, &self.nodes, self.extra..self.extra + nc);
         let lambda = &state.extra[self.extra + nc..self.extra + nc + self.kinds.len()];
         let refs = self.angle_references(state);
-        add_constraints(
-            ctx,
-            &mut local,
-            &self.active,
-            self.kinds,
-            &self.phi(refs),
-            lambda,
-            out,
-        );
+        with_scratch(|sc| {
+            sc.local
+                .gather(state, &self.nodes, self.extra..self.extra + nc);
+            add_constraints(
+                ctx,
+                &mut sc.local,
+                &mut sc.grad,
+                &self.active,
+                self.kinds,
+                &self.phi(refs),
+                lambda,
+                out,
+            );
+        });
     }
     fn update_internal(&self, _ctx: &EvalContext, state: &State, internal: &mut [f64]) {
         let mut c = [0.0; 3];

@@ -187,6 +187,33 @@ impl Local {
     }
 }
 
+/// Work buffers of joint elements, one set per thread, so that no
+/// evaluation allocates once the buffers have grown to size.
+#[derive(Default)]
+pub struct Scratch {
+    /// The local configuration.
+    pub local: Local,
+    /// Gradients, `m × n`.
+    pub grad: Vec<f64>,
+    /// A second-derivative matrix, `n × n`.
+    pub hess: Vec<f64>,
+    /// Local velocities.
+    pub vel: Vec<f64>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
+/// Runs `f` with this thread's work buffers (fresh ones if they are
+/// already in use further up the stack).
+pub fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
+    SCRATCH.with(|s| match s.try_borrow_mut() {
+        Ok(mut s) => f(&mut s),
+        Err(_) => f(&mut Scratch::default()),
+    })
+}
+
 /// Largest number of outputs of one joint formula.
 pub const MAX_OUT: usize = 8;
 

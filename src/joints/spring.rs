@@ -6,7 +6,7 @@
 //! (docs/joints.md §4). In quasi-static analyses `ċ = 0`.
 
 use super::coordinate::PairCoordinate;
-use super::kinematics::Local;
+use super::kinematics::{with_scratch, Local};
 use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext};
 use crate::model::input::Id;
 use crate::state::State;
@@ -159,37 +159,43 @@ impl Element for JointSpring {
         self.internal = internal;
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
-        let mut local = Local::default();
-        local.gather(state, &self.source.nodes, 0..0);
-        let n = local.n();
-        let f = self.source.function(self.reference(state));
-        let mut c = [0.0];
-        let mut g = vec![0.0; n];
-        local.gradient(1, &self.active, &f, &mut c, &mut g);
-        let mut v = Vec::new();
-        self.velocities(state, &mut v);
-        let rate: f64 = g.iter().zip(&v).map(|(a, b)| a * b).sum();
-        let (fs, ks) = self.spring.as_ref().map_or((0.0, 0.0), |l| l.eval(c[0]));
-        let (fd, kd) = self.damper.as_ref().map_or((0.0, 0.0), |l| l.eval(rate));
-        let total = fs + fd;
-        for r in 0..n {
-            out.residual[r] += total * g[r];
-        }
-        if !ctx.need_tangent {
-            return;
-        }
-        // H = ∂g/∂q, column-major n×n
-        let mut h = vec![0.0; n * n];
-        local.add_weighted_hessian(1, &self.active, &f, &[1.0], &mut h, n);
-        let gamma = ctx.dynamics.map_or(0.0, |d| d.damping);
-        for col in 0..n {
-            // ∂ċ/∂q_col at fixed q̇: Σ_r v_r H[r, col]
-            let dc = (0..n).map(|r| v[r] * h[col * n + r]).sum::<f64>();
+        with_scratch(|sc| {
+            let local = &mut sc.local;
+            local.gather(state, &self.source.nodes, 0..0);
+            let n = local.n();
+            let f = self.source.function(self.reference(state));
+            let mut c = [0.0];
+            let g = &mut sc.grad;
+            g.clear();
+            g.resize(n, 0.0);
+            local.gradient(1, &self.active, &f, &mut c, g);
+            let v = &mut sc.vel;
+            self.velocities(state, v);
+            let rate: f64 = g.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
+            let (fs, ks) = self.spring.as_ref().map_or((0.0, 0.0), |l| l.eval(c[0]));
+            let (fd, kd) = self.damper.as_ref().map_or((0.0, 0.0), |l| l.eval(rate));
+            let total = fs + fd;
             for r in 0..n {
-                out.tangent[col * n + r] +=
-                    (ks + gamma * kd) * g[r] * g[col] + total * h[col * n + r] + kd * g[r] * dc;
+                out.residual[r] += total * g[r];
             }
-        }
+            if !ctx.need_tangent {
+                return;
+            }
+            // H = ∂g/∂q, column-major n×n
+            let h = &mut sc.hess;
+            h.clear();
+            h.resize(n * n, 0.0);
+            local.add_weighted_hessian(1, &self.active, &f, &[1.0], h, n);
+            let gamma = ctx.dynamics.map_or(0.0, |d| d.damping);
+            for col in 0..n {
+                // ∂ċ/∂q_col at fixed q̇: Σ_r v_r H[r, col]
+                let dc = (0..n).map(|r| v[r] * h[col * n + r]).sum::<f64>();
+                for r in 0..n {
+                    out.tangent[col * n + r] +=
+                        (ks + gamma * kd) * g[r] * g[col] + total * h[col * n + r] + kd * g[r] * dc;
+                }
+            }
+        });
     }
     fn update_internal(&self, _ctx: &EvalContext, state: &State, internal: &mut [f64]) {
         if self.source.is_angle() {

@@ -258,39 +258,27 @@ impl SliderCurve {
     /// the end segments are extended).
     pub fn point(&self, c: &[V3<HyperDual>], s: HyperDual) -> V3<HyperDual> {
         let n = c.len();
-        let len: Vec<HyperDual> = (0..n - 1).map(|k| c[k + 1].sub(&c[k]).norm()).collect();
+        let len = |k: usize| c[k + 1].sub(&c[k]).norm();
         // segment from the real part
         let mut k = 0;
         let mut start = HyperDual::cst(0.0);
-        while k + 2 < n && (start + len[k]).re <= s.re {
-            start = start + len[k];
+        let mut lk = len(0);
+        while k + 2 < n && (start + lk).re <= s.re {
+            start = start + lk;
             k += 1;
+            lk = len(k);
         }
-        let t = (s - start) / len[k];
+        let t = (s - start) / lk;
         let chord = c[k + 1].sub(&c[k]);
         if !self.spline || n < 3 {
             return c[k].add(&chord.scale(t));
         }
-        // Hermite segment with chord-length Catmull–Rom tangents (in t)
-        let tangent = |i: usize| -> V3<HyperDual> {
-            if i == 0 {
-                c[1].sub(&c[0])
-            } else if i == n - 1 {
-                c[n - 1].sub(&c[n - 2])
-            } else {
-                c[i + 1]
-                    .sub(&c[i - 1])
-                    .scale(len[k] / (len[i - 1] + len[i]))
-            }
-        };
-        let (t0, t1) = if k == 0 {
-            (chord, tangent(1))
-        } else if k + 2 == n {
-            (tangent(k), chord)
-        } else {
-            (tangent(k), tangent(k + 1))
-        };
-        // in the end segments the end tangent is scaled to the segment
+        // Hermite segment with chord-length Catmull–Rom tangents (in t):
+        // at an interior node i, dC/dt = L_k (c[i+1] − c[i−1])/(L[i−1] + L[i]),
+        // which makes dC/ds continuous; end segments use the chord
+        let tangent = |i: usize| c[i + 1].sub(&c[i - 1]).scale(lk / (len(i - 1) + len(i)));
+        let t0 = if k == 0 { chord } else { tangent(k) };
+        let t1 = if k + 2 == n { chord } else { tangent(k + 1) };
         let t2 = t * t;
         let t3 = t2 * t;
         let h00 = t3 * 2.0 - t2 * 3.0 + 1.0;

@@ -343,3 +343,118 @@ fn other_inconsistencies_are_named() {
     );
     assert_rejected("self_beam", &text, &["beam 2", "both ends are node 2"]);
 }
+
+/// A hinged link: the cantilever's tip joined to a rigid link (node 4) by a
+/// revolute joint about y.
+fn hinged(extra: &str) -> String {
+    format!(
+        "{CANTILEVER}\n[[nodes]]\nid = 4\nx = [1.0, 0.0, 0.0]\n\n[[rigid_bodies]]\nid = 20\nnode = 4\nmass = 1.0\n\n{extra}"
+    )
+}
+
+#[test]
+fn bad_joint_definitions() {
+    let joint = |body: &str| hinged(&format!("[[joints]]\nid = 30\n{body}\n"));
+    assert_rejected(
+        "joint_unknown_node",
+        &joint("type = \"revolute\"\nnodes = [3, 44]\naxis = [0, 1, 0]"),
+        &["joint 30", "node 44 does not exist"],
+    );
+    assert_rejected(
+        "joint_self",
+        &joint("type = \"revolute\"\nnodes = [3, 3]\naxis = [0, 1, 0]"),
+        &["joint 30", "joins node 3 to itself"],
+    );
+    assert_rejected(
+        "joint_axes_not_coincident",
+        &joint("type = \"revolute\"\nnodes = [3, 4]\naxis = [0, 1, 0]\naxis_b = [0, 0.8, 0.6]"),
+        &["joint 30", "axes of the revolute joint must coincide"],
+    );
+    assert_rejected(
+        "joint_missing_axis",
+        &joint("type = \"revolute\"\nnodes = [3, 4]"),
+        &["joint 30", "needs `axis`"],
+    );
+    assert_rejected(
+        "joint_zero_axis",
+        &joint("type = \"prismatic\"\nnodes = [3, 4]\naxis = [0, 0, 0]"),
+        &["joint 30", "axis must be a non-zero finite vector"],
+    );
+    assert_rejected(
+        "helical_without_pitch",
+        &joint("type = \"helical\"\nnodes = [3, 4]\naxis = [1, 0, 0]"),
+        &["joint 30", "needs `pitch`"],
+    );
+    assert_rejected(
+        "universal_arms",
+        &joint("type = \"universal\"\nnodes = [3, 4]\naxis = [0, 1, 0]\naxis_b = [0, 1, 0.1]"),
+        &["joint 30", "must be perpendicular"],
+    );
+    assert_rejected(
+        "unknown_joint_type",
+        &joint("type = \"hinge\"\nnodes = [3, 4]\naxis = [0, 1, 0]"),
+        &["unknown variant `hinge`"],
+    );
+    let ok = "type = \"revolute\"\nnodes = [3, 4]\naxis = [0, 1, 0]";
+    assert_rejected(
+        "spring_on_missing_joint",
+        &joint(&format!("{ok}\n\n[[joint_springs]]\nid = 31\njoint = 99\nstiffness = 1.0")),
+        &["joint spring 31", "joint 99 does not exist"],
+    );
+    assert_rejected(
+        "spring_negative",
+        &joint(&format!("{ok}\n\n[[joint_springs]]\nid = 31\njoint = 30\nstiffness = -1.0")),
+        &["joint spring 31", "stiffness must be zero or positive"],
+    );
+    assert_rejected(
+        "spring_bad_coordinate",
+        &joint(&format!("{ok}\n\n[[joint_springs]]\nid = 31\njoint = 30\ncoordinate = \"slide\"\nstiffness = 1.0")),
+        &["joint spring 31", "has no coordinate \"slide\"", "angle"],
+    );
+    assert_rejected(
+        "spring_table_not_increasing",
+        &joint(&format!("{ok}\n\n[[joint_springs]]\nid = 31\njoint = 30\ntable = [[0.0, 0.0], [0.0, 1.0]]")),
+        &["joint spring 31", "strictly increasing"],
+    );
+    assert_rejected(
+        "driver_both_targets",
+        &joint(&format!("{ok}\n\n[[drivers]]\nid = 32\njoint = 30\nnode = 4\nvalue = 1.0")),
+        &["driver 32", "give either `joint`"],
+    );
+    assert_rejected(
+        "driver_node_without_direction",
+        &joint(&format!("{ok}\n\n[[drivers]]\nid = 32\nnode = 4\nvalue = 1.0")),
+        &["driver 32", "needs `direction`"],
+    );
+}
+
+/// The hinged link is a mechanism without a spring or a driver: a static
+/// analysis reports the singular tangent at the start (exit code 2); a
+/// kinematic analysis with no driver reports the free motion; with a
+/// driver on the hinge it runs.
+#[test]
+fn mechanism_without_driver_is_reported() {
+    let ok = "[[joints]]\nid = 30\ntype = \"revolute\"\nnodes = [3, 4]\naxis = [0, 1, 0]\n";
+    let (_, _, err) = {
+        let dir = scratch("free_hinge");
+        run_model(&dir, "free_hinge.toml", &hinged(ok))
+    };
+    assert!(err.contains("singular tangent"), "{err}");
+
+    // a kinematic analysis of the rigid link alone, hinged to the ground
+    let link = "[analysis]\ntype = \"kinematic\"\n\n[[nodes]]\nid = 1\nx = [0.0, 0.0, 0.0]\n\n[[joints]]\nid = 1\ntype = \"revolute\"\nnodes = [1]\naxis = [0, 0, 1]\n";
+    assert_rejected(
+        "kinematic_free",
+        link,
+        &["do not make the mechanism determinate", "1 motion(s) are left free", "node 1 rz"],
+    );
+    let dir = scratch("kinematic_driven");
+    let driven = format!("{link}\n[[drivers]]\nid = 2\njoint = 1\nvalue = 1.0\n");
+    let (code, out, err) = run_model(&dir, "driven.toml", &driven);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("completed"), "{out}");
+    let drivers = std::fs::read_to_string(dir.join("out").join("drivers.csv")).unwrap();
+    let last = drivers.lines().last().unwrap();
+    // the link turned by the driven 1 rad
+    assert!(last.contains(",2,1.000000000e0,1.000000000e0,"), "{last}");
+}

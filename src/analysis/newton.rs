@@ -105,6 +105,13 @@ pub enum NewtonFailure {
         /// Iteration at which they appeared.
         iteration: usize,
     },
+    /// Arc-length control: the constraint on the arc length has no real
+    /// root (the arc is too long for the curvature of the path).
+    #[error("arc-length constraint without a real root at iteration {iteration}")]
+    NoArcRoot {
+        /// Iteration.
+        iteration: usize,
+    },
     /// The tangent is singular.
     #[error("singular tangent: no stiffness for {dof} (relative pivot {pivot:.1e}); the structure is a mechanism or is not restrained there")]
     Singular {
@@ -470,6 +477,232 @@ impl NewtonSolver {
             self.tangent_checked = true;
 
             // update: x ← x + Δx, R ← R exp(ΔΘ~), extras additively
+            self.update(model, state);
+            last_correction = Some((dx, dth));
+        }
+        unreachable!("the loop returns at max_iterations")
+    }
+
+    /// Weights of the arc-length norm, by equation: `1/L` for
+    /// translations, 1 for rotations, 0 for extra unknowns.
+    fn arc_weights(&self, length: f64) -> Vec<f64> {
+        (0..self.dofs.n_equations())
+            .map(|eq| match self.dofs.kind(self.dofs.dof(eq)) {
+                DofKind::Translation => 1.0 / length,
+                DofKind::Rotation => 1.0,
+                DofKind::Extra => 0.0,
+            })
+            .collect()
+    }
+
+    /// `∂r/∂t` by a forward difference of the residual (loads, gravity and
+    /// drivers move with `t`), by equation; the residual of the last
+    /// assembly at `t` is kept.
+    fn load_derivative(&mut self, model: &Model, state: &State, t: f64, out: &mut [f64]) {
+        let h = 1e-7 * t.abs().max(1.0);
+        let r0: Vec<f64> = self.assembler.residual.clone();
+        let ctx = model.context(t + h, false);
+        self.assembler.assemble(model, &ctx, state);
+        for (eq, o) in out.iter_mut().enumerate() {
+            let d = self.dofs.dof(eq);
+            *o = (self.assembler.residual[d] - r0[d]) / h;
+        }
+        self.assembler.residual.copy_from_slice(&r0);
+    }
+
+    /// Weighted length of the tangent predictor `Δt·q_t` at `state`, `t`:
+    /// the arc of a first load increment `Δt` (1 if it cannot be
+    /// computed; the first increment then cuts back as needed).
+    pub fn tangent_arc(&mut self, model: &Model, state: &State, t: f64, dt: f64) -> f64 {
+        self.assemble(model, state, t, true);
+        let n = self.dofs.n_equations();
+        let mut qt = vec![0.0; n];
+        self.load_derivative(model, state, t, &mut qt);
+        let w = self.arc_weights(model.length_scale);
+        self.rhs.iter_mut().zip(&qt).for_each(|(r, q)| *r = -q);
+        let ok = self.analyze().is_ok()
+            && self.lu.as_mut().is_some_and(|lu| {
+                lu.factor(&self.assembler.matrix).is_ok()
+                    && lu.solve_in_place(&mut self.rhs).is_ok()
+            });
+        let norm: f64 = self
+            .rhs
+            .iter()
+            .zip(&w)
+            .map(|(v, w)| (v * w).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        if ok && norm.is_finite() && norm > 0.0 {
+            norm * dt
+        } else {
+            1.0
+        }
+    }
+
+    /// Arc-length (Crisfield's cylindrical) iterations of one increment
+    /// (docs/theory.md §9): the load parameter `t` is an unknown and the
+    /// increment `Δq` from the last converged state keeps the weighted
+    /// length `‖Δq‖ = arc`. `direction` is the previous increment (by
+    /// equation, weighted), used to choose the predictor's sign and the
+    /// root of the constraint; it is replaced by this increment.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_arc(
+        &mut self,
+        model: &Model,
+        settings: &StaticSettings,
+        state: &mut State,
+        t: &mut f64,
+        arc: f64,
+        direction: &mut Vec<f64>,
+        increment: usize,
+        observer: &mut dyn Observer,
+    ) -> Result<NewtonResult, NewtonFailure> {
+        let length = model.length_scale;
+        let n = self.dofs.n_equations();
+        let w = self.arc_weights(length);
+        let wdot = |a: &[f64], b: &[f64]| -> f64 {
+            a.iter()
+                .zip(b)
+                .zip(&w)
+                .map(|((x, y), w)| x * y * w * w)
+                .sum()
+        };
+        let mut dq = vec![0.0; n];
+        let mut qt = vec![0.0; n];
+        let mut residuals = Vec::new();
+        let mut last_correction = None::<(f64, f64)>;
+        let mut first_flux = None::<f64>;
+        if direction.len() != n {
+            direction.clear();
+            direction.resize(n, 0.0);
+        }
+        for iteration in 0..=settings.max_iterations {
+            self.assemble(model, state, *t, true);
+            if self.stiffness_scale.is_none() {
+                self.stiffness_scale = Some(self.diagonal_scale());
+            }
+            let scale = self.stiffness_scale.expect("set above");
+            let tol = settings.residual_tolerance;
+            let floor = (RESIDUAL_FLOOR * scale.0 * length, RESIDUAL_FLOOR * scale.1);
+            let constraint_tol = (
+                settings.displacement_tolerance * length,
+                settings.rotation_tolerance,
+            );
+            let mut norms = self.norms(floor, tol, constraint_tol);
+            if let Some((dx, dth)) = last_correction {
+                norms.displacement_correction = dx;
+                norms.rotation_correction = dth;
+            }
+            residuals.push(norms.relative_residual);
+            observer.iteration(&IterationInfo {
+                increment,
+                iteration,
+                time: *t,
+                norms,
+            });
+            if !(norms.residual_force.is_finite() && norms.residual_moment.is_finite()) {
+                return Err(NewtonFailure::NonFinite { iteration });
+            }
+            if iteration > 0 {
+                let ratio = match residuals.len() {
+                    k if k >= 2 && residuals[k - 2] > 0.0 => {
+                        (residuals[k - 1] / residuals[k - 2]).min(1.0)
+                    }
+                    _ => 1.0,
+                };
+                let residual_ok =
+                    norms.relative_residual <= tol && norms.residual_constraint <= 1.0;
+                let correction_ok = last_correction.is_none_or(|(dx, dth)| {
+                    dx * ratio <= settings.displacement_tolerance * length
+                        && dth * ratio <= settings.rotation_tolerance
+                });
+                if residual_ok && correction_ok {
+                    direction.copy_from_slice(&dq);
+                    return Ok(NewtonResult {
+                        iterations: iteration,
+                        residuals,
+                    });
+                }
+                if iteration == settings.max_iterations {
+                    return Err(NewtonFailure::MaxIterations {
+                        iterations: iteration,
+                        relative_residual: norms.relative_residual,
+                    });
+                }
+                let magnitude = norms.residual_force + norms.residual_moment / length;
+                let reference =
+                    *first_flux.get_or_insert(norms.flux_force + norms.flux_moment / length);
+                if magnitude > DIVERGED_GROWTH * reference.max(floor.0 + floor.1 / length) {
+                    return Err(NewtonFailure::Diverging {
+                        iteration,
+                        relative_residual: norms.relative_residual,
+                    });
+                }
+            }
+
+            // q_t: K q_t = −∂r/∂t, and q_r: K q_r = −r, one factorisation
+            self.load_derivative(model, state, *t, &mut qt);
+            if self.solve_linear_system().is_err() {
+                return Err(self.diagnose(model, iteration));
+            }
+            let qr = std::mem::take(&mut self.rhs);
+            self.rhs = qt.iter().map(|v| -v).collect();
+            let solved = self
+                .lu
+                .as_mut()
+                .expect("factored above")
+                .solve_in_place(&mut self.rhs);
+            let qt_sol = std::mem::replace(&mut self.rhs, qr);
+            if solved.is_err() {
+                return Err(self.diagnose(model, iteration));
+            }
+            self.tangent_checked = true;
+            let dt = if iteration == 0 {
+                // predictor along the tangent, in the direction of the last
+                // increment (forward at the first)
+                let norm = wdot(&qt_sol, &qt_sol).sqrt();
+                if !(norm > 0.0 && norm.is_finite()) {
+                    return Err(self.diagnose(model, iteration));
+                }
+                let sign = if wdot(&qt_sol, direction) < 0.0 {
+                    -1.0
+                } else {
+                    1.0
+                };
+                self.rhs.iter_mut().for_each(|v| *v = 0.0);
+                sign * arc / norm
+            } else {
+                // ‖Δq + q_r + δt q_t‖ = arc
+                let a: Vec<f64> = dq.iter().zip(&self.rhs).map(|(d, r)| d + r).collect();
+                let (aa, ab, bb) = (wdot(&a, &a), wdot(&a, &qt_sol), wdot(&qt_sol, &qt_sol));
+                let disc = ab * ab - bb * (aa - arc * arc);
+                if disc < 0.0 || bb == 0.0 {
+                    return Err(NewtonFailure::NoArcRoot { iteration });
+                }
+                let roots = [(-ab + disc.sqrt()) / bb, (-ab - disc.sqrt()) / bb];
+                // the root whose increment stays closest to the current one
+                let score = |r: f64| -> f64 {
+                    let v: Vec<f64> = a.iter().zip(&qt_sol).map(|(x, y)| x + r * y).collect();
+                    wdot(&v, &dq)
+                };
+                if score(roots[0]) >= score(roots[1]) {
+                    roots[0]
+                } else {
+                    roots[1]
+                }
+            };
+            for (r, q) in self.rhs.iter_mut().zip(&qt_sol) {
+                *r += dt * q;
+            }
+            *t += dt;
+            let (dx, dth) = correction_size(&self.dofs, &self.rhs);
+            if !(dx <= RUNAWAY_CORRECTION * length && dth <= RUNAWAY_CORRECTION) {
+                return Err(self.diagnose(model, iteration));
+            }
+            for (d, r) in dq.iter_mut().zip(&self.rhs) {
+                *d += r;
+            }
+            state.time = *t;
             self.update(model, state);
             last_correction = Some((dx, dth));
         }

@@ -65,6 +65,14 @@ pub enum StaticError {
         /// Violation relative to the tolerance.
         violation: f64,
     },
+    /// Arc-length control used its increments before reaching `end_time`.
+    #[error("arc-length control: end_time not reached in {increments} increments (t = {time:.6}); raise max_increments or the increment sizes")]
+    ArcLengthLimit {
+        /// Increments allowed.
+        increments: usize,
+        /// Load parameter reached.
+        time: f64,
+    },
     /// A result file could not be written.
     #[error("writing results: {0}")]
     Output(#[from] std::io::Error),
@@ -183,6 +191,11 @@ impl<'m> StaticAnalysis<'m> {
             Err(f) => return finish(outcome, state, Some(StaticError::Initial(f))),
         }
 
+        if s.arc_length {
+            let error = self.arc_length(&mut state, &mut outcome, observer);
+            return finish(outcome, state, error);
+        }
+
         let mut t = 0.0;
         let mut dt = s.initial_increment;
         let mut backup = state.clone();
@@ -246,6 +259,7 @@ impl<'m> StaticAnalysis<'m> {
                         NewtonFailure::Diverging { iteration, .. }
                         | NewtonFailure::NonFinite { iteration } => *iteration,
                         NewtonFailure::Singular { .. } => 0,
+                        NewtonFailure::NoArcRoot { iteration } => *iteration,
                     };
                     state.clone_from(&backup);
                     let next = step * CUTBACK;
@@ -274,5 +288,127 @@ impl<'m> StaticAnalysis<'m> {
             }
         }
         finish(outcome, state, None)
+    }
+
+    /// Arc-length path control (docs/theory.md §9) from the converged
+    /// initial state: increments of a fixed arc length in the space of the
+    /// unknowns, `t` found with them, until `t` reaches `end_time` (the
+    /// last increment is then redone in load control to land on it).
+    fn arc_length(
+        &mut self,
+        state: &mut State,
+        outcome: &mut StaticOutcome,
+        observer: &mut dyn Observer,
+    ) -> Option<StaticError> {
+        let model = self.model;
+        let s = &model.settings;
+        // the first arc: the tangent predictor of a load increment
+        // initial_increment; its bounds scale like the load increments
+        let arc0 = self
+            .solver
+            .tangent_arc(model, state, 0.0, s.initial_increment);
+        let (arc_min, arc_max) = (
+            arc0 * s.min_increment / s.initial_increment,
+            arc0 * s.max_increment / s.initial_increment,
+        );
+        let mut arc = arc0;
+        let mut direction = Vec::new();
+        let mut t = 0.0;
+        let mut backup = state.clone();
+        let mut increment = 1;
+        while increment <= s.max_increments {
+            backup.clone_from(state);
+            let (t_start, dir_backup) = (t, direction.clone());
+            match self.solver.solve_arc(
+                model,
+                s,
+                state,
+                &mut t,
+                arc,
+                &mut direction,
+                increment,
+                observer,
+            ) {
+                Ok(mut r) => {
+                    let mut step = t - t_start;
+                    if t >= s.end_time {
+                        // land on end_time with a load-controlled increment
+                        let mut landed = backup.clone();
+                        landed.time = s.end_time;
+                        if let Ok(r2) = self.solver.solve(
+                            model,
+                            s,
+                            &mut landed,
+                            s.end_time,
+                            increment,
+                            observer,
+                        ) {
+                            *state = landed;
+                            t = s.end_time;
+                            step = t - t_start;
+                            r = r2;
+                        }
+                    }
+                    model.update_internal(state);
+                    outcome.increments += 1;
+                    outcome.iterations += r.iterations;
+                    outcome.time = t;
+                    let done = t >= s.end_time;
+                    let info = IncrementInfo {
+                        increment,
+                        time: t,
+                        step,
+                        iterations: r.iterations,
+                        residuals: r.residuals,
+                        output: increment % s.output_every == 0 || done,
+                    };
+                    if let Err(e) = observer.increment(&info, model, state, self.solver.residual())
+                    {
+                        return Some(e.into());
+                    }
+                    if done {
+                        return None;
+                    }
+                    if r.iterations <= EASY_ITERATIONS {
+                        arc = (arc * GROWTH).min(arc_max);
+                    }
+                    increment += 1;
+                }
+                Err(reason) => {
+                    outcome.wasted_iterations += match &reason {
+                        NewtonFailure::MaxIterations { iterations, .. } => *iterations,
+                        NewtonFailure::Diverging { iteration, .. }
+                        | NewtonFailure::NonFinite { iteration }
+                        | NewtonFailure::NoArcRoot { iteration } => *iteration,
+                        NewtonFailure::Singular { .. } => 0,
+                    };
+                    state.clone_from(&backup);
+                    t = t_start;
+                    direction = dir_backup;
+                    let next = arc * CUTBACK;
+                    if next < arc_min {
+                        return Some(StaticError::Diverged {
+                            increment,
+                            time: t,
+                            step: arc,
+                            reason,
+                        });
+                    }
+                    outcome.cutbacks += 1;
+                    observer.cutback(&CutbackInfo {
+                        increment,
+                        time: t,
+                        failed_step: arc,
+                        next_step: next,
+                        reason,
+                    });
+                    arc = next;
+                }
+            }
+        }
+        Some(StaticError::ArcLengthLimit {
+            increments: s.max_increments,
+            time: t,
+        })
     }
 }

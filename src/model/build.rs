@@ -666,6 +666,14 @@ impl Model {
             }
         }
 
+        if settings.arc_length && !input.prescribed.is_empty() {
+            ck.push(
+                ModelErrorKind::Invalid,
+                "analysis",
+                "arc-length control does not take prescribed motions: use drivers instead",
+            );
+        }
+
         // ---------- global checks ----------
         if ck.errors.is_empty() {
             if elements
@@ -766,7 +774,36 @@ fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
         output_every: a.output_every.unwrap_or(1),
         kinematic: a.kind == "kinematic",
+        arc_length: a.control.as_deref() == Some("arc_length"),
+        max_increments: a.max_increments.unwrap_or(1000),
     };
+    if !matches!(
+        a.control.as_deref(),
+        None | Some("load") | Some("arc_length")
+    ) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            "analysis",
+            format!(
+                "unknown control \"{}\" (available: load, arc_length)",
+                a.control.as_deref().unwrap_or("")
+            ),
+        );
+    }
+    if s.arc_length && s.kinematic {
+        ck.push(
+            ModelErrorKind::Invalid,
+            "analysis",
+            "a kinematic analysis follows its drivers: arc-length control does not apply",
+        );
+    }
+    if s.max_increments == 0 {
+        ck.push(
+            ModelErrorKind::Invalid,
+            "analysis",
+            "max_increments must be at least 1",
+        );
+    }
     ck.positive("analysis", "initial_increment", s.initial_increment);
     ck.positive("analysis", "min_increment", s.min_increment);
     ck.positive("analysis", "max_increment", s.max_increment);

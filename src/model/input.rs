@@ -217,6 +217,15 @@ pub struct AnalysisInput {
     /// Penalty `p` of constraint equations (eq. 17), default as `k`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub constraint_penalty: Option<f64>,
+    /// Path control: `load` (default; increments of `t`) or `arc_length`
+    /// (increments of the arc length of the path in the space of
+    /// displacements, `t` becomes an unknown: passes limit points of the
+    /// load, docs/theory.md §9).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control: Option<String>,
+    /// Arc-length control: largest number of increments, default 1000.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_increments: Option<usize>,
 }
 
 fn default_analysis_type() -> String {
@@ -241,6 +250,8 @@ impl Default for AnalysisInput {
             output_every: None,
             constraint_scale: None,
             constraint_penalty: None,
+            control: None,
+            max_increments: None,
         }
     }
 }

@@ -69,6 +69,10 @@ pub struct StaticSettings {
     /// Kinematic analysis: the joints and drivers must determine every
     /// unknown (docs/joints.md §6).
     pub kinematic: bool,
+    /// Arc-length path control instead of load increments.
+    pub arc_length: bool,
+    /// Arc-length control: largest number of increments.
+    pub max_increments: usize,
 }
 
 /// A validated model.

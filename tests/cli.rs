@@ -398,12 +398,16 @@ fn bad_joint_definitions() {
     let ok = "type = \"revolute\"\nnodes = [3, 4]\naxis = [0, 1, 0]";
     assert_rejected(
         "spring_on_missing_joint",
-        &joint(&format!("{ok}\n\n[[joint_springs]]\nid = 31\njoint = 99\nstiffness = 1.0")),
+        &joint(&format!(
+            "{ok}\n\n[[joint_springs]]\nid = 31\njoint = 99\nstiffness = 1.0"
+        )),
         &["joint spring 31", "joint 99 does not exist"],
     );
     assert_rejected(
         "spring_negative",
-        &joint(&format!("{ok}\n\n[[joint_springs]]\nid = 31\njoint = 30\nstiffness = -1.0")),
+        &joint(&format!(
+            "{ok}\n\n[[joint_springs]]\nid = 31\njoint = 30\nstiffness = -1.0"
+        )),
         &["joint spring 31", "stiffness must be zero or positive"],
     );
     assert_rejected(
@@ -413,17 +417,23 @@ fn bad_joint_definitions() {
     );
     assert_rejected(
         "spring_table_not_increasing",
-        &joint(&format!("{ok}\n\n[[joint_springs]]\nid = 31\njoint = 30\ntable = [[0.0, 0.0], [0.0, 1.0]]")),
+        &joint(&format!(
+            "{ok}\n\n[[joint_springs]]\nid = 31\njoint = 30\ntable = [[0.0, 0.0], [0.0, 1.0]]"
+        )),
         &["joint spring 31", "strictly increasing"],
     );
     assert_rejected(
         "driver_both_targets",
-        &joint(&format!("{ok}\n\n[[drivers]]\nid = 32\njoint = 30\nnode = 4\nvalue = 1.0")),
+        &joint(&format!(
+            "{ok}\n\n[[drivers]]\nid = 32\njoint = 30\nnode = 4\nvalue = 1.0"
+        )),
         &["driver 32", "give either `joint`"],
     );
     assert_rejected(
         "driver_node_without_direction",
-        &joint(&format!("{ok}\n\n[[drivers]]\nid = 32\nnode = 4\nvalue = 1.0")),
+        &joint(&format!(
+            "{ok}\n\n[[drivers]]\nid = 32\nnode = 4\nvalue = 1.0"
+        )),
         &["driver 32", "needs `direction`"],
     );
 }
@@ -446,7 +456,11 @@ fn mechanism_without_driver_is_reported() {
     assert_rejected(
         "kinematic_free",
         link,
-        &["do not make the mechanism determinate", "1 motion(s) are left free", "node 1 rz"],
+        &[
+            "do not make the mechanism determinate",
+            "1 motion(s) are left free",
+            "node 1 rz",
+        ],
     );
     let dir = scratch("kinematic_driven");
     let driven = format!("{link}\n[[drivers]]\nid = 2\njoint = 1\nvalue = 1.0\n");

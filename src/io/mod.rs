@@ -5,8 +5,10 @@
 //! - [`results`]: writes per-step CSV histories, `summary.json`, and VTK
 //!   files through an [`crate::analysis::Observer`];
 //! - [`vtk`]: the VTK unstructured-grid (`.vtu`) and collection (`.pvd`)
-//!   writers.
+//!   writers;
+//! - [`plot`]: line charts as SVG files (result histories).
 
 pub mod model_file;
+pub mod plot;
 pub mod results;
 pub mod vtk;

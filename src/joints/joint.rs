@@ -170,7 +170,6 @@ impl Joint {
                 b: Vec3::zeros(),
                 eb: so3::Mat3::identity(),
                 ground: None,
-                ground_is_a: false,
             },
             parameters: JointParameters {
                 lead: 0.0,
@@ -247,8 +246,9 @@ impl Joint {
         }
     }
 
-    /// Load the joint applies to body A (force, and moment about the joint
-    /// point), global frame.
+    /// Load the joint applies to the element's first node (body A, or
+    /// the node of a joint to the ground, or a slider's sliding node):
+    /// force, and moment about the joint point, global frame.
     pub fn reaction(&self, ctx: &EvalContext, state: &State) -> (Vec3, Vec3) {
         let n = self.n_local();
         let mut r = vec![0.0; n];
@@ -269,13 +269,25 @@ impl Joint {
         let f = -Vec3::new(r[0], r[1], r[2]);
         let rm = so3::matrix(&state.q[node]);
         let m_node = rm * -Vec3::new(r[3], r[4], r[5]);
-        let arm = rm * self.pair.a;
+        let offset = if self.pair.ground.is_some() { self.pair.b } else { self.pair.a };
+        let arm = rm * offset;
         (f, m_node - arm.cross(&f))
+    }
+
+    /// The joint axes of body A at `state` (global components, columns);
+    /// the global axes for a slider.
+    pub fn axes(&self, state: &State) -> so3::Mat3 {
+        match (&self.pair.ground, self.joint_type) {
+            (_, JointType::Slider) => so3::Mat3::identity(),
+            (Some((_, e)), _) => *e,
+            (None, _) => so3::matrix(&state.q[self.nodes[0]]) * self.pair.ea,
+        }
     }
 }
 
 /// Names of joint results: three coordinates (NaN when absent), then the
-/// reaction on body A in A's joint axes.
+/// load the joint applies to its first node, in the joint axes of body A
+/// (see [`Joint::reaction`] and [`Joint::axes`]).
 pub const JOINT_RESULTS: [&str; 9] = ["c1", "c2", "c3", "F1", "F2", "F3", "M1", "M2", "M3"];
 
 impl Element for Joint {
@@ -355,7 +367,7 @@ impl Element for Joint {
         self.coordinates(state, &mut c);
         out[..3].copy_from_slice(&c);
         let (f, m) = self.reaction(ctx, state);
-        let e = so3::matrix(&state.q[self.nodes[0]]) * self.pair.ea;
+        let e = self.axes(state);
         let (fl, ml) = (e.transpose() * f, e.transpose() * m);
         out[3..6].copy_from_slice(fl.as_slice());
         out[6..9].copy_from_slice(ml.as_slice());

@@ -217,12 +217,15 @@ pub fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
 /// Largest number of outputs of one joint formula.
 pub const MAX_OUT: usize = 8;
 
-/// Where a joint sits on its two bodies: body A is the element's first
-/// node, body B its second node or the ground. Each body carries a point
+/// Where a joint sits on its two bodies A and B. Each body carries a point
 /// (offset in the body's material frame) and a triad of joint axes
 /// `e₁, e₂, e₃` (columns, material frame); in the reference configuration
-/// both triads coincide, and so do both points unless the joint allows a
-/// relative translation there.
+/// both triads coincide, and so do both points. Coordinates measure B
+/// relative to A.
+///
+/// Between two nodes, A is the element's first node and B its second. For
+/// a joint to the ground, A is the ground (a fixed frame) and B the node
+/// (the element's only node), so coordinates measure the node's motion.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pair {
     /// Offset of the joint point on A, A's material frame.
@@ -233,12 +236,8 @@ pub struct Pair {
     pub b: Vec3,
     /// Joint axes carried by B, B's material frame.
     pub eb: Mat3,
-    /// Position and orientation of the ground when one body is the ground
-    /// (B, or A if [`Pair::ground_is_a`]).
+    /// When A is the ground: its joint point and axes (global).
     pub ground: Option<(Vec3, Mat3)>,
-    /// Whether the ground is body A (node drivers: the node, local node 0,
-    /// is then body B and moves relative to a fixed frame).
-    pub ground_is_a: bool,
 }
 
 /// The joint points and triads in the global frame.
@@ -256,43 +255,35 @@ pub struct Frames {
 
 impl Pair {
     /// Builds a pair from the reference configuration: the joint point `p`
-    /// and the global joint triad `e` (columns `e₁, e₂, e₃`), for bodies at
-    /// `(xa, ra)` and `(xb, rb)` (B = ground when `None`).
-    pub fn from_reference(
-        p: &Vec3,
-        e: &Mat3,
-        (xa, ra): (&Vec3, &Mat3),
-        b: Option<(&Vec3, &Mat3)>,
-    ) -> Self {
-        let (bp, be, ground) = match b {
-            Some((xb, rb)) => (rb.transpose() * (p - xb), rb.transpose() * e, None),
-            None => (Vec3::zeros(), Mat3::identity(), Some((*p, *e))),
-        };
-        Self {
-            a: ra.transpose() * (p - xa),
-            ea: ra.transpose() * e,
-            b: bp,
-            eb: be,
-            ground,
-            ground_is_a: false,
+    /// and the global joint triad `e` (columns `e₁, e₂, e₃`), for the
+    /// element's first node at `(x1, r1)` and its second at `(x2, r2)`;
+    /// without a second node, the first is B and the ground is A.
+    pub fn from_reference(p: &Vec3, e: &Mat3, (x1, r1): (&Vec3, &Mat3), second: Option<(&Vec3, &Mat3)>) -> Self {
+        match second {
+            Some((x2, r2)) => Self {
+                a: r1.transpose() * (p - x1),
+                ea: r1.transpose() * e,
+                b: r2.transpose() * (p - x2),
+                eb: r2.transpose() * e,
+                ground: None,
+            },
+            None => Self {
+                a: Vec3::zeros(),
+                ea: Mat3::identity(),
+                b: r1.transpose() * (p - x1),
+                eb: r1.transpose() * e,
+                ground: Some((*p, *e)),
+            },
         }
     }
 
-    /// A node (as body B) against a fixed frame (body A) with axes `e`
-    /// (columns), both at the node's reference position `x` and
-    /// orientation `r`: coordinates measure the node's motion.
+    /// A node against a fixed frame with axes `e` (columns), both at the
+    /// node's reference position `x` and orientation `r`.
     pub fn node_to_ground(x: &Vec3, r: &Mat3, e: &Mat3) -> Self {
-        Self {
-            a: Vec3::zeros(),
-            ea: Mat3::identity(),
-            b: Vec3::zeros(),
-            eb: r.transpose() * e,
-            ground: Some((*x, *e)),
-            ground_is_a: true,
-        }
+        Self::from_reference(x, e, (x, r), None)
     }
 
-    /// Number of nodes (1 if B is the ground).
+    /// Number of nodes (1 for a joint to the ground).
     pub fn n_nodes(&self) -> usize {
         if self.ground.is_some() {
             1
@@ -301,24 +292,28 @@ impl Pair {
         }
     }
 
-    /// Joint points and triads of configuration `c` (nodes A then B).
-    pub fn frames(&self, c: &Conf) -> Frames {
-        if self.ground_is_a {
-            let (p, e) = self.ground.as_ref().expect("ground_is_a needs a ground");
-            return Frames {
-                pa: V3::cst(p),
-                ea: M3::cst(e),
-                pb: c.x[0].add(&c.r[0].apply(&self.b)),
-                eb: c.r[0].mul_cst(&self.eb),
-            };
+    /// Local node of body B.
+    pub fn node_b(&self) -> usize {
+        if self.ground.is_some() {
+            0
+        } else {
+            1
         }
-        let pa = c.x[0].add(&c.r[0].apply(&self.a));
-        let ea = c.r[0].mul_cst(&self.ea);
-        let (pb, eb) = match &self.ground {
+    }
+
+    /// Joint points and triads of configuration `c`.
+    pub fn frames(&self, c: &Conf) -> Frames {
+        let (pa, ea) = match &self.ground {
             Some((p, e)) => (V3::cst(p), M3::cst(e)),
-            None => (c.x[1].add(&c.r[1].apply(&self.b)), c.r[1].mul_cst(&self.eb)),
+            None => (c.x[0].add(&c.r[0].apply(&self.a)), c.r[0].mul_cst(&self.ea)),
         };
-        Frames { pa, ea, pb, eb }
+        let nb = self.node_b();
+        Frames {
+            pa,
+            ea,
+            pb: c.x[nb].add(&c.r[nb].apply(&self.b)),
+            eb: c.r[nb].mul_cst(&self.eb),
+        }
     }
 }
 

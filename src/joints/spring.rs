@@ -27,8 +27,9 @@ pub enum Law {
 }
 
 impl Law {
-    /// `(f(x), f'(x))`; at a table point the slope of the segment to its
-    /// right is used.
+    /// `(f(x), f'(x))`; at an interior table point the slope of the
+    /// segment to its right is used, at and beyond the end points the
+    /// slope of the end segments.
     pub fn eval(&self, x: f64) -> (f64, f64) {
         match self {
             Self::Linear { k, x0 } => (k * (x - x0), *k),

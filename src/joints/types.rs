@@ -270,7 +270,10 @@ impl SliderCurve {
         }
         let t = (s - start) / lk;
         let chord = c[k + 1].sub(&c[k]);
-        if !self.spline || n < 3 {
+        // beyond the ends: the straight extension of the end segment (the
+        // spline's end tangents are the end chords)
+        let outside = (k == 0 && t.re < 0.0) || (k + 2 == n && t.re > 1.0);
+        if !self.spline || n < 3 || outside {
             return c[k].add(&chord.scale(t));
         }
         // Hermite segment with chord-length Catmull–Rom tangents (in t):

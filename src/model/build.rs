@@ -797,6 +797,14 @@ fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
             "a kinematic analysis follows its drivers: arc-length control does not apply",
         );
     }
+    for (name, v) in [
+        ("constraint_scale", a.constraint_scale),
+        ("constraint_penalty", a.constraint_penalty),
+    ] {
+        if let Some(v) = v {
+            ck.positive("analysis", name, v);
+        }
+    }
     if s.max_increments == 0 {
         ck.push(
             ModelErrorKind::Invalid,

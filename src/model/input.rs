@@ -93,7 +93,8 @@ pub struct JointInput {
     /// direction normal to the axis.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_direction: Option<[f64; 3]>,
-    /// Joint point, default node A's position (node B's for `glue`).
+    /// Joint point, default the first node's position (not for `glue`,
+    /// whose point is set by `offset`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub position: Option<[f64; 3]>,
     /// Helical joints: axial advance per turn (signed).
@@ -179,7 +180,9 @@ pub struct DriverInput {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AnalysisInput {
-    /// Analysis type; only `"static"` (nonlinear statics) so far.
+    /// Analysis type: `"static"` (default) or its alias `"kinetostatic"`
+    /// (nonlinear statics, loads and drivers), or `"kinematic"` (the
+    /// joints and drivers must determine every unknown).
     #[serde(rename = "type", default = "default_analysis_type")]
     pub kind: String,
     /// Final value of the load parameter `t` (pseudo-time), default 1.
@@ -191,7 +194,7 @@ pub struct AnalysisInput {
     /// Smallest increment before the analysis gives up, default `end_time · 1e-6`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_increment: Option<f64>,
-    /// Largest increment, default `end_time / 4`... or the initial increment if larger.
+    /// Largest increment, default the initial increment.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_increment: Option<f64>,
     /// Newton iterations allowed per increment before it is cut back, default 25.

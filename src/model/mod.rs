@@ -189,7 +189,8 @@ impl Model {
     /// `p` equal to the largest diagonal stiffness of the elements' tangents
     /// in the reference state, for translations and rotations separately
     /// (1 when the model has no stiffness, e.g. rigid bodies and joints
-    /// only); `override_` replaces `(k, p)` of both when given.
+    /// only); `scale` and `penalty`, when given, replace `k` and `p` of
+    /// both kinds.
     pub fn default_scaling(&self, scale: Option<f64>, penalty: Option<f64>) -> ConstraintScaling {
         let state = self.initial_state();
         let ctx = EvalContext {

@@ -183,6 +183,12 @@ fn joint(cx: &mut Context, entity: &str, j: &JointInput) -> Option<Joint> {
     unexpected("spline", j.spline.is_some() && t != JointType::Slider, cx);
     unexpected("axis", j.axis.is_some() && !needs_axis, cx);
     unexpected("axis_b", j.axis_b.is_some() && !needs_axis, cx);
+    unexpected(
+        "reference_direction",
+        j.reference_direction.is_some() && (!needs_axis || t == JointType::Universal),
+        cx,
+    );
+    unexpected("position", j.position.is_some() && t == JointType::Glue, cx);
 
     if t == JointType::Slider {
         if j.curve.len() < 2 {
@@ -226,13 +232,14 @@ fn joint(cx: &mut Context, entity: &str, j: &JointInput) -> Option<Joint> {
         }
         let p = j.position.map_or(xa, Vec3::from);
         let pts: Vec<Vec3> = curve.iter().map(|&c| cx.nodes[c].x).collect();
-        let s0 = project_on_polyline(&pts, &p);
+        let spline = j.spline.unwrap_or(true);
+        let s0 = project_on_curve(&pts, &p, spline);
         return Some(Joint::slider(
             j.id,
             a,
             ra.transpose() * (p - xa),
             &curve,
-            j.spline.unwrap_or(true),
+            spline,
             s0,
         ));
     }
@@ -351,7 +358,6 @@ fn joint(cx: &mut Context, entity: &str, j: &JointInput) -> Option<Joint> {
             b: Vec3::zeros(),
             eb: rb.transpose(),
             ground: None,
-            ground_is_a: false,
         }
     } else {
         let p = match j.position {
@@ -369,6 +375,35 @@ fn joint(cx: &mut Context, entity: &str, j: &JointInput) -> Option<Joint> {
         Pair::from_reference(&p, &e, (&xa, &ra), bb.as_ref().map(|(x, r)| (x, r)))
     };
     Some(Joint::new(j.id, t, a, b, pair, parameters))
+}
+
+/// Parameter of the point of the slider curve through `pts` nearest to
+/// `p`: the nearest point of the polygon, refined on the spline by Newton
+/// iterations on `(C(s) − p)·C'(s) = 0`.
+fn project_on_curve(pts: &[Vec3], p: &Vec3, spline: bool) -> f64 {
+    use crate::joints::hyperdual::{HyperDual, V3};
+    use crate::joints::types::SliderCurve;
+    let mut s = project_on_polyline(pts, p);
+    if !spline {
+        return s;
+    }
+    let curve = SliderCurve { spline: true };
+    let c: Vec<V3<HyperDual>> = pts.iter().map(V3::cst).collect();
+    for _ in 0..20 {
+        // f(s) = ½|C(s) − p|², f' and f'' from one hyper-dual evaluation
+        let x = HyperDual::new(s, 1.0, 1.0);
+        let d = curve.point(&c, x).sub(&V3::cst(p));
+        let f = d.dot(&d) * 0.5;
+        if f.e12.abs() < 1e-300 {
+            break;
+        }
+        let step = f.e1 / f.e12;
+        s -= step;
+        if step.abs() < 1e-14 * (1.0 + s.abs()) {
+            break;
+        }
+    }
+    s
 }
 
 /// Parameter (distance along the polygon) of the point of the polyline
@@ -472,6 +507,17 @@ fn law(
             Ok(Some(Law::Linear { k, x0 }))
         }
         (None, false) => {
+            if what == "damping" && table.len() >= 2 {
+                let l = Law::Table(table.iter().map(|p| (p[0], p[1])).collect());
+                if l.eval(0.0).0 != 0.0 {
+                    cx.ck.push(
+                        ModelErrorKind::Invalid,
+                        entity,
+                        "the damping table must give zero force at zero rate",
+                    );
+                    return Err(());
+                }
+            }
             if table.len() < 2
                 || table
                     .iter()

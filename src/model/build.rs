@@ -797,12 +797,16 @@ fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
             "a kinematic analysis follows its drivers: arc-length control does not apply",
         );
     }
-    for (name, v) in [
-        ("constraint_scale", a.constraint_scale),
-        ("constraint_penalty", a.constraint_penalty),
-    ] {
-        if let Some(v) = v {
-            ck.positive("analysis", name, v);
+    if let Some(k) = a.constraint_scale {
+        ck.positive("analysis", "constraint_scale", k);
+    }
+    if let Some(p) = a.constraint_penalty {
+        if !(p.is_finite() && p >= 0.0) {
+            ck.push(
+                ModelErrorKind::NonPositive,
+                "analysis",
+                format!("constraint_penalty must be zero or positive, got {p}"),
+            );
         }
     }
     if s.max_increments == 0 {

@@ -37,6 +37,7 @@ pub(crate) fn scale_of(s: &ConstraintScaling, e: Equation) -> (f64, f64) {
 /// equation kinds `kinds`) to a local system laid out as
 /// `[q (nq = local.n() unknowns), λ (kinds.len())]`; `lambda` holds the
 /// multipliers. Returns nothing; `work` is scratch of length ≥ m·nq.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn add_constraints<F>(
     ctx: &EvalContext,
     local: &mut Local,

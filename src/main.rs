@@ -292,6 +292,7 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
             .iter()
             .filter(|e| e.kind() == ElementKind::Driver)
             .count(),
+        redundant_constraints: outcome.redundant_constraints,
         dofs: analysis.n_equations(),
         nonzeros: analysis.solver().nnz(),
         increments: outcome.increments,

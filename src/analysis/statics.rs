@@ -91,6 +91,8 @@ pub struct StaticOutcome {
     pub wasted_iterations: usize,
     /// Number of cut-backs.
     pub cutbacks: usize,
+    /// Constraint equations removed as redundant (docs/joints.md §5).
+    pub redundant_constraints: usize,
     /// Load parameter reached.
     pub time: f64,
     /// Wall-clock time in seconds.
@@ -137,6 +139,7 @@ impl<'m> StaticAnalysis<'m> {
             iterations: 0,
             wasted_iterations: 0,
             cutbacks: 0,
+            redundant_constraints: 0,
             time: 0.0,
             wall_time: 0.0,
             error: None,
@@ -151,6 +154,7 @@ impl<'m> StaticAnalysis<'m> {
         // rank of the constraints: redundant ones out, determinacy
         model.apply_prescribed(&mut state, 0.0);
         let rank = self.solver.constraint_rank(model, &state);
+        outcome.redundant_constraints = rank.redundant.len();
         if !rank.redundant.is_empty() {
             observer.note(&format!(
                 "{} redundant constraint equation(s) removed (over-constrained loops); their multipliers are zero and the others carry the loads",

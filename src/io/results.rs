@@ -68,6 +68,8 @@ pub struct Summary {
     pub joints: usize,
     /// Number of drivers.
     pub drivers: usize,
+    /// Constraint equations removed as redundant.
+    pub redundant_constraints: usize,
     /// Free unknowns (equations).
     pub dofs: usize,
     /// Non-zeros of the system matrix.

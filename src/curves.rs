@@ -1,13 +1,76 @@
 //! Load curves: scalar functions `f(t)` of the load parameter (pseudo-time
-//! in statics) that scale loads, gravity and prescribed motions.
+//! in statics) that scale loads, gravity, prescribed motions and drivers:
+//! piecewise-linear tables or simple functions.
 
-/// A piecewise-linear curve through points `(tᵢ, fᵢ)` with strictly
-/// increasing `tᵢ`, held constant before the first and after the last point.
-/// The built-in [`Curve::ramp`] is `f(t) = t` for every `t`.
+/// A simple function of `t`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Function {
+    /// `offset + slope·t`.
+    Linear {
+        /// Value at `t = 0`.
+        offset: f64,
+        /// Slope.
+        slope: f64,
+    },
+    /// `offset + amplitude·sin(2π·frequency·t + phase)`.
+    Sine {
+        /// Mean value.
+        offset: f64,
+        /// Amplitude.
+        amplitude: f64,
+        /// Frequency (cycles per unit of `t`).
+        frequency: f64,
+        /// Phase (rad).
+        phase: f64,
+    },
+    /// From `from` at `t ≤ start` to `to` at `t ≥ end` along the quintic
+    /// `s(τ) = τ³(10 − 15τ + 6τ²)`, `τ = (t − start)/(end − start)`: zero
+    /// rate and acceleration at both ends (a smooth actuator stroke).
+    SmoothStep {
+        /// Start of the transition.
+        start: f64,
+        /// End of the transition.
+        end: f64,
+        /// Value before.
+        from: f64,
+        /// Value after.
+        to: f64,
+    },
+}
+
+impl Function {
+    /// Evaluates the function.
+    pub fn value(&self, t: f64) -> f64 {
+        match *self {
+            Self::Linear { offset, slope } => offset + slope * t,
+            Self::Sine {
+                offset,
+                amplitude,
+                frequency,
+                phase,
+            } => offset + amplitude * (std::f64::consts::TAU * frequency * t + phase).sin(),
+            Self::SmoothStep {
+                start,
+                end,
+                from,
+                to,
+            } => {
+                let tau = ((t - start) / (end - start)).clamp(0.0, 1.0);
+                from + (to - from) * tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+            }
+        }
+    }
+}
+
+/// A curve `f(t)`: a piecewise-linear table through points `(tᵢ, fᵢ)` with
+/// strictly increasing `tᵢ`, held constant before the first and after the
+/// last point, or a [`Function`]. The built-in [`Curve::ramp`] is
+/// `f(t) = t` for every `t`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Curve {
     name: String,
     points: Vec<(f64, f64)>,
+    function: Option<Function>,
 }
 
 impl Curve {
@@ -19,6 +82,7 @@ impl Curve {
         Self {
             name: Self::RAMP.to_string(),
             points: Vec::new(),
+            function: None,
         }
     }
 
@@ -30,6 +94,17 @@ impl Curve {
         Self {
             name: name.into(),
             points,
+            function: None,
+        }
+    }
+
+    /// A curve given by a function. The caller guarantees finite
+    /// parameters (and `start < end` for a smooth step).
+    pub fn function(name: impl Into<String>, function: Function) -> Self {
+        Self {
+            name: name.into(),
+            points: Vec::new(),
+            function: Some(function),
         }
     }
 
@@ -40,6 +115,9 @@ impl Curve {
 
     /// Evaluates `f(t)`.
     pub fn value(&self, t: f64) -> f64 {
+        if let Some(f) = &self.function {
+            return f.value(t);
+        }
         let p = &self.points;
         if p.is_empty() {
             return t;
@@ -64,6 +142,36 @@ pub type CurveIndex = usize;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn functions() {
+        let s = Function::SmoothStep {
+            start: 1.0,
+            end: 3.0,
+            from: 2.0,
+            to: -1.0,
+        };
+        assert_eq!(s.value(0.0), 2.0);
+        assert_eq!(s.value(1.0), 2.0);
+        assert_eq!(s.value(2.0), 0.5);
+        assert_eq!(s.value(3.0), -1.0);
+        assert_eq!(s.value(9.0), -1.0);
+        // zero slope at the ends
+        let h = 1e-6;
+        assert!((s.value(1.0 + h) - s.value(1.0)).abs() < 1e-12);
+        let w = Function::Sine {
+            offset: 1.0,
+            amplitude: 2.0,
+            frequency: 0.25,
+            phase: 0.0,
+        };
+        assert!((w.value(1.0) - 3.0).abs() < 1e-15);
+        let l = Function::Linear {
+            offset: 1.0,
+            slope: -2.0,
+        };
+        assert_eq!(Curve::function("l", l).value(2.0), -3.0);
+    }
 
     #[test]
     fn ramp_is_identity() {

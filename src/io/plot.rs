@@ -101,8 +101,8 @@ fn padded(lo: f64, hi: f64) -> (f64, f64) {
 }
 
 /// Draws the series as lines on one pair of linear axes, with a title,
-/// axis labels and a legend, and returns the SVG text. Non-finite points
-/// are skipped.
+/// axis labels and a legend (upper right, above the curves), and returns
+/// the SVG text. Non-finite points are skipped.
 pub fn line_chart_svg_string(
     title: &str,
     x_label: &str,
@@ -124,7 +124,14 @@ pub fn line_chart_svg_string(
         padded(lo, hi)
     };
     let (x0, x1) = range(|p| p.0);
-    let (y0, y1) = range(|p| p.1);
+    let (y0, mut y1) = range(|p| p.1);
+    // headroom for the legend in the upper right corner, about 20 px per
+    // line of a plot area about 450 px high, so that it covers no curve
+    let labelled = series.iter().any(|s| !s.label.is_empty());
+    if labelled {
+        let f = ((20 * series.len() + 15) as f64 / 450.0).min(0.6);
+        y1 += (y1 - y0) * f / (1.0 - f);
+    }
 
     let mut svg = String::new();
     {
@@ -158,7 +165,7 @@ pub fn line_chart_svg_string(
                     PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
                 });
         }
-        if series.iter().any(|s| !s.label.is_empty()) {
+        if labelled {
             chart
                 .configure_series_labels()
                 .label_font(("sans-serif", 14))

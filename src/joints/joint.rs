@@ -270,7 +270,11 @@ impl Joint {
         let f = -Vec3::new(r[0], r[1], r[2]);
         let rm = so3::matrix(&state.q[node]);
         let m_node = rm * -Vec3::new(r[3], r[4], r[5]);
-        let offset = if self.pair.ground.is_some() { self.pair.b } else { self.pair.a };
+        let offset = if self.pair.ground.is_some() {
+            self.pair.b
+        } else {
+            self.pair.a
+        };
         let arm = rm * offset;
         (f, m_node - arm.cross(&f))
     }

@@ -258,7 +258,12 @@ impl Pair {
     /// and the global joint triad `e` (columns `e₁, e₂, e₃`), for the
     /// element's first node at `(x1, r1)` and its second at `(x2, r2)`;
     /// without a second node, the first is B and the ground is A.
-    pub fn from_reference(p: &Vec3, e: &Mat3, (x1, r1): (&Vec3, &Mat3), second: Option<(&Vec3, &Mat3)>) -> Self {
+    pub fn from_reference(
+        p: &Vec3,
+        e: &Mat3,
+        (x1, r1): (&Vec3, &Mat3),
+        second: Option<(&Vec3, &Mat3)>,
+    ) -> Self {
         match second {
             Some((x2, r2)) => Self {
                 a: r1.transpose() * (p - x1),

@@ -128,6 +128,11 @@ pub struct Design {
     /// Whether the vertical displacement of the top corners is imposed in
     /// stage (b) as well as the knees' (three more drivers).
     pub drive_top: bool,
+    /// Whether the knee drivers are released at the end of stage (a), so
+    /// that stage (b) is driven by the top alone (with `drive_top`): its
+    /// three corners lowered and one corner turned about the axis (the
+    /// paper's seven constraints in all).
+    pub release_knees: bool,
 }
 
 impl Default for Design {
@@ -155,6 +160,7 @@ impl Default for Design {
             corner_mass: (0.15, 1.5e-4),
             elements: (7, 3, 2),
             drive_top: false,
+            release_knees: false,
         }
     }
 }
@@ -584,6 +590,7 @@ pub fn build_design(d: &Design, increments: usize) -> Result<ModelInput, Box<dyn
             direction: Some(g.inward[k].into()),
             value: knee_final,
             curve: Some(KNEE_CURVE.into()),
+            active: d.release_knees.then_some([0.0, 1.0]),
             ..DriverInput::default()
         });
     }
@@ -599,6 +606,25 @@ pub fn build_design(d: &Design, increments: usize) -> Result<ModelInput, Box<dyn
                 direction: Some([0.0, 0.0, 1.0]),
                 value: drop,
                 curve: Some(TOP_CURVE.into()),
+                active: d.release_knees.then_some([1.0, f64::INFINITY]),
+                ..DriverInput::default()
+            });
+        }
+        if d.release_knees {
+            // the seventh constraint: the top's rotation about the axis,
+            // as the straight longerons would turn it
+            m.curves.push(CurveInput {
+                name: "turn_top".into(),
+                points: vec![[1.0, 0.0], [2.0, 1.0]],
+            });
+            m.drivers.push(DriverInput {
+                id: 2021,
+                node: Some(corner(1, 0)),
+                direction: Some([0.0, 0.0, 1.0]),
+                motion: Some("rotation".into()),
+                value: g.twist,
+                curve: Some("turn_top".into()),
+                active: Some([1.0, 1.9]),
                 ..DriverInput::default()
             });
         }
@@ -939,6 +965,9 @@ fn main() -> Result<(), Box<dyn Error>> {
     for a in std::env::args().skip(1) {
         if a == "--drive-top" {
             design.drive_top = true;
+        } else if a == "--lower-top" {
+            design.drive_top = true;
+            design.release_knees = true;
         } else {
             positional.push(a);
         }

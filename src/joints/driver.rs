@@ -1,9 +1,17 @@
-//! Drivers: a prescribed history `c(t) = c_ref + value·f(t)` of a joint
-//! coordinate or of a node's displacement or rotation along an axis,
-//! enforced as one more constraint `Φ = c(q) − value·f(t)` with its own
-//! multiplier (the "additional constraints that control the motion" of the
-//! paper, section 6.1). The multiplier gives the force or moment the driver
-//! applies: the actuator load.
+//! Drivers: a prescribed history `c(t) = value·f(t)` of a joint
+//! coordinate or of a node's displacement or rotation along an axis
+//! (measured from the reference configuration), enforced as one more
+//! constraint `Φ = c(q) − value·f(t)` with its own multiplier (the
+//! "additional constraints that control the motion" of the paper, section
+//! 6.1). The multiplier gives the force or moment the driver applies: the
+//! actuator load.
+//!
+//! A driver may act during a window `[start, end]` of `t` only
+//! (docs/joints.md §6.1). Outside it the constraint is released: its
+//! equation becomes `k λ = 0`, so it applies no load. A driver that starts
+//! at `start > 0` takes over the coordinate where it is then,
+//! `Φ = c(q) − c_start − value·(f(t) − f(start))`, with `c_start` the value
+//! at the last converged state before `start` (an internal variable).
 
 use super::coordinate::PairCoordinate;
 use super::joint::{add_constraints, scale_of};
@@ -22,6 +30,8 @@ pub struct Driver {
     value: f64,
     curve: CurveIndex,
     active: Vec<usize>,
+    /// Acting window `[start, end]` of `t`.
+    window: (f64, f64),
     extra: usize,
     internal: usize,
 }
@@ -40,9 +50,31 @@ impl Driver {
             value,
             curve,
             active,
+            window: (f64::NEG_INFINITY, f64::INFINITY),
             extra: 0,
             internal: 0,
         }
+    }
+
+    /// Acts only while `start ≤ t ≤ end` (see the module documentation).
+    pub fn with_window(mut self, start: f64, end: f64) -> Self {
+        self.window = (start, end);
+        self
+    }
+
+    /// Whether the driver acts at `t`.
+    pub fn is_active(&self, t: f64) -> bool {
+        t >= self.window.0 && t <= self.window.1
+    }
+
+    /// Whether it takes over the coordinate where it finds it.
+    fn takes_over(&self) -> bool {
+        self.window.0 > 0.0
+    }
+
+    /// Index of `c_start` in the internal variables.
+    fn start_slot(&self) -> usize {
+        self.internal + usize::from(self.source.is_angle())
     }
 
     fn kind_of_equation(&self) -> Equation {
@@ -61,9 +93,14 @@ impl Driver {
         }
     }
 
-    /// Target value at `ctx.time`.
-    pub fn target(&self, ctx: &EvalContext) -> f64 {
-        self.value * ctx.curves[self.curve].value(ctx.time)
+    /// Target value of the coordinate at `ctx.time` (while active).
+    pub fn target(&self, ctx: &EvalContext, state: &State) -> f64 {
+        let f = &ctx.curves[self.curve];
+        if self.takes_over() {
+            state.internal[self.start_slot()] + self.value * (f.value(ctx.time) - f.value(self.window.0))
+        } else {
+            self.value * f.value(ctx.time)
+        }
     }
 }
 
@@ -81,7 +118,7 @@ impl Element for Driver {
         1
     }
     fn n_internal(&self) -> usize {
-        usize::from(self.source.is_angle())
+        usize::from(self.source.is_angle()) + 1
     }
     fn set_offsets(&mut self, extra: usize, internal: usize) {
         self.extra = extra;
@@ -95,7 +132,17 @@ impl Element for Driver {
         }
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
-        let target = self.target(ctx);
+        if !self.is_active(ctx.time) {
+            // released: k λ = 0
+            let k = scale_of(&ctx.scaling, self.kind_of_equation()).0;
+            let nq = 6 * self.source.nodes.len();
+            out.residual[nq] += k * state.extra[self.extra];
+            if ctx.need_tangent {
+                out.tangent[nq * (nq + 1) + nq] += k;
+            }
+            return;
+        }
+        let target = self.target(ctx, state);
         let c = self.source.function(self.reference(state));
         let phi = |conf: &Conf, o: &mut [super::hyperdual::HyperDual]| {
             c(conf, o);
@@ -117,8 +164,15 @@ impl Element for Driver {
         });
     }
     fn update_internal(&self, _ctx: &EvalContext, state: &State, internal: &mut [f64]) {
+        let mut c = 0.0;
         if self.source.is_angle() {
-            internal[0] = self.source.value(state, internal[0]);
+            c = self.source.value(state, internal[0]);
+            internal[0] = c;
+        } else if state.time < self.window.0 {
+            c = self.source.value(state, 0.0);
+        }
+        if state.time < self.window.0 {
+            internal[internal.len() - 1] = c;
         }
     }
     fn result_names(&self) -> &'static [&'static str] {
@@ -126,9 +180,14 @@ impl Element for Driver {
     }
     fn results(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
         let c = self.source.value(state, self.reference(state));
-        let target = self.target(ctx);
-        let (k, p) = scale_of(&ctx.scaling, self.kind_of_equation());
         out[0] = c;
+        if !self.is_active(ctx.time) {
+            out[1] = f64::NAN;
+            out[2] = 0.0;
+            return;
+        }
+        let target = self.target(ctx, state);
+        let (k, p) = scale_of(&ctx.scaling, self.kind_of_equation());
         out[1] = target;
         // generalised load applied along the coordinate: −(pΦ − kλ)
         out[2] = k * state.extra[self.extra] - p * (c - target);

@@ -174,6 +174,11 @@ pub struct DriverInput {
     /// Curve `f(t)`, default the ramp `f(t) = t`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve: Option<String>,
+    /// `[start, end]`: the driver acts only while `start ≤ t ≤ end` and is
+    /// released outside (`end` may be `inf`); one starting at `start > 0`
+    /// takes over the coordinate where it is then. Default: always.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub active: Option<[f64; 2]>,
 }
 
 /// Kind and parameters of the analysis.

@@ -633,5 +633,19 @@ fn driver(
             return None;
         }
     };
-    Some(Driver::new(d.id, source, d.value, curve))
+    let driver = Driver::new(d.id, source, d.value, curve);
+    match d.active {
+        None => Some(driver),
+        Some([start, end]) if !start.is_nan() && !end.is_nan() && start < end => {
+            Some(driver.with_window(start, end))
+        }
+        Some(w) => {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("active must be [start, end] with start < end, got {w:?}"),
+            );
+            None
+        }
+    }
 }

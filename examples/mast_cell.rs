@@ -582,6 +582,7 @@ pub fn build_design(d: &Design, increments: usize) -> Result<ModelInput, Box<dyn
     m.curves.push(CurveInput {
         name: KNEE_CURVE.into(),
         points: push,
+        ..Default::default()
     });
     for k in 0..3 {
         m.drivers.push(DriverInput {
@@ -598,6 +599,7 @@ pub fn build_design(d: &Design, increments: usize) -> Result<ModelInput, Box<dyn
         m.curves.push(CurveInput {
             name: TOP_CURVE.into(),
             points: lower,
+            ..Default::default()
         });
         for k in 0..3 {
             m.drivers.push(DriverInput {
@@ -616,6 +618,7 @@ pub fn build_design(d: &Design, increments: usize) -> Result<ModelInput, Box<dyn
             m.curves.push(CurveInput {
                 name: "turn_top".into(),
                 points: vec![[1.0, 0.0], [2.0, 1.0]],
+                ..Default::default()
             });
             m.drivers.push(DriverInput {
                 id: 2021,

@@ -539,6 +539,7 @@ fn results_do_not_depend_on_the_load_path() {
             input.curves.push(unfold::model::input::CurveInput {
                 name: "uneven".into(),
                 points: vec![[0.0, 0.0], [0.5, 0.3], [0.7, 0.9], [1.0, 1.0]],
+                ..Default::default()
             });
             input.loads[0].curve = Some("uneven".into());
         }

@@ -472,3 +472,36 @@ fn mechanism_without_driver_is_reported() {
     // the link turned by the driven 1 rad
     assert!(last.contains(",2,1.000000000e0,1.000000000e0,"), "{last}");
 }
+
+#[test]
+fn bad_function_curves() {
+    let curve = |body: &str| format!("{CANTILEVER}\n[[curves]]\nname = \"c\"\n{body}\n");
+    assert_rejected(
+        "curve_unknown_function",
+        &curve("function = \"cosine\""),
+        &["curve \"c\"", "unknown function \"cosine\""],
+    );
+    assert_rejected(
+        "sine_without_frequency",
+        &curve("function = \"sine\"\namplitude = 2.0"),
+        &["curve \"c\"", "needs `frequency`"],
+    );
+    assert_rejected(
+        "step_backwards",
+        &curve("function = \"smooth_step\"\nstart = 2.0\nend = 1.0"),
+        &["curve \"c\"", "start must be before end"],
+    );
+    assert_rejected(
+        "function_and_points",
+        &curve("function = \"linear\"\npoints = [[0.0, 0.0], [1.0, 1.0]]"),
+        &["curve \"c\"", "either points or a function"],
+    );
+    assert_rejected(
+        "misplaced_parameter",
+        &curve("function = \"linear\"\nfrequency = 3.0"),
+        &[
+            "curve \"c\"",
+            "`frequency` does not apply to a linear curve",
+        ],
+    );
+}

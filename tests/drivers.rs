@@ -122,3 +122,70 @@ fn driver_acts_in_its_window_only() {
         );
     }
 }
+
+/// A hinge driven along a smooth step (a quintic, zero rate and
+/// acceleration at both ends) in a kinematic analysis: the angle follows
+/// `value·s(τ)` exactly (tolerance 1e-10 rad, the constraint tolerance).
+#[test]
+fn smooth_step_curve_drives_a_hinge() {
+    let text = r#"
+[analysis]
+type = "kinematic"
+end_time = 2.0
+initial_increment = 0.1
+displacement_tolerance = 1e-12
+rotation_tolerance = 1e-12
+
+[[curves]]
+name = "stroke"
+function = "smooth_step"
+start = 0.5
+end = 1.5
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[joints]]
+id = 1
+type = "revolute"
+nodes = [1]
+axis = [0.0, 0.0, 1.0]
+
+[[drivers]]
+id = 2
+joint = 1
+value = 1.2
+curve = "stroke"
+"#;
+    let input = unfold::io::model_file::parse_model(text, std::path::Path::new("smooth.toml"))
+        .expect("valid model file");
+    let model = Model::from_input(&input).expect("valid model");
+    #[derive(Default)]
+    struct Angles(Vec<(f64, f64)>);
+    impl Observer for Angles {
+        fn increment(
+            &mut self,
+            info: &IncrementInfo,
+            model: &Model,
+            s: &State,
+            _: &[f64],
+        ) -> std::io::Result<()> {
+            let mut v = [0.0; 9];
+            model.elements[0].results(&model.context(info.time, false), s, &mut v);
+            self.0.push((info.time, v[0]));
+            Ok(())
+        }
+    }
+    let mut a = Angles::default();
+    let outcome = StaticAnalysis::new(&model).run(&mut a);
+    assert!(outcome.error.is_none(), "{:?}", outcome.error);
+    for (t, angle) in a.0 {
+        let tau = ((t - 0.5) / 1.0f64).clamp(0.0, 1.0);
+        let expected = 1.2 * tau.powi(3) * (10.0 - 15.0 * tau + 6.0 * tau * tau);
+        assert!(
+            (angle - expected).abs() < 1e-10,
+            "t = {t}: {angle} vs {expected}"
+        );
+    }
+}

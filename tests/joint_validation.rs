@@ -194,6 +194,7 @@ fn constant_curve(m: &mut ModelInput) {
     m.curves.push(CurveInput {
         name: "constant".into(),
         points: vec![[0.0, 1.0], [1.0, 1.0]],
+        ..Default::default()
     });
 }
 

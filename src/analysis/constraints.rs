@@ -79,7 +79,9 @@ pub fn analyse(dofs: &DofMap, matrix: &SparseMatrix, multiplier: &[bool]) -> Con
             Some(&(c, _)) => groups.entry(find(&mut parent, c)).or_default().push(eq),
             // a released driver (`k λ = 0`: a diagonal entry, no gradient)
             // is not a constraint now, nor a redundant one
-            None if matrix.position(eq, eq).is_some_and(|p| matrix.values()[p] != 0.0) => {}
+            None if matrix
+                .position(eq, eq)
+                .is_some_and(|p| matrix.values()[p] != 0.0) => {}
             None => redundant_eq.push(eq),
         }
     }

@@ -97,7 +97,8 @@ impl Driver {
     pub fn target(&self, ctx: &EvalContext, state: &State) -> f64 {
         let f = &ctx.curves[self.curve];
         if self.takes_over() {
-            state.internal[self.start_slot()] + self.value * (f.value(ctx.time) - f.value(self.window.0))
+            state.internal[self.start_slot()]
+                + self.value * (f.value(ctx.time) - f.value(self.window.0))
         } else {
             self.value * f.value(ctx.time)
         }

@@ -103,11 +103,18 @@ impl Model {
                 ck.push(ModelErrorKind::DuplicateId, &entity, msg);
                 continue;
             }
+            if let Some(f) = &c.function {
+                if let Some(function) = curve_function(&mut ck, &entity, f, c) {
+                    curve_index.insert(c.name.clone(), curves.len());
+                    curves.push(Curve::function(&c.name, function));
+                }
+                continue;
+            }
             if c.points.is_empty() {
                 ck.push(
                     ModelErrorKind::Missing,
                     &entity,
-                    "needs at least one point [t, f]",
+                    "needs at least one point [t, f], or a function",
                 );
                 continue;
             }
@@ -729,6 +736,104 @@ impl Model {
             input.analysis.constraint_penalty,
         ))
     }
+}
+
+/// The function of a curve given by `function` and its parameters.
+fn curve_function(
+    ck: &mut Checker,
+    entity: &str,
+    name: &str,
+    c: &CurveInput,
+) -> Option<crate::curves::Function> {
+    use crate::curves::Function;
+    if !c.points.is_empty() {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            "give either points or a function, not both",
+        );
+        return None;
+    }
+    let given: [(&str, Option<f64>); 9] = [
+        ("offset", c.offset),
+        ("slope", c.slope),
+        ("amplitude", c.amplitude),
+        ("frequency", c.frequency),
+        ("phase", c.phase),
+        ("start", c.start),
+        ("end", c.end),
+        ("from", c.from),
+        ("to", c.to),
+    ];
+    let allowed: &[&str] = match name {
+        "linear" => &["offset", "slope"],
+        "sine" => &["offset", "amplitude", "frequency", "phase"],
+        "smooth_step" => &["start", "end", "from", "to"],
+        _ => {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("unknown function \"{name}\" (available: linear, sine, smooth_step)"),
+            );
+            return None;
+        }
+    };
+    let mut ok = true;
+    for (key, v) in given {
+        if let Some(v) = v {
+            if !allowed.contains(&key) {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!("`{key}` does not apply to a {name} curve"),
+                );
+                ok = false;
+            } else {
+                ok &= ck.finite(entity, key, &[v]);
+            }
+        }
+    }
+    let required = |ck: &mut Checker, key: &str, v: Option<f64>| {
+        if v.is_none() {
+            ck.push(
+                ModelErrorKind::Missing,
+                entity,
+                format!("a {name} curve needs `{key}`"),
+            );
+        }
+        v
+    };
+    let f = match name {
+        "linear" => Function::Linear {
+            offset: c.offset.unwrap_or(0.0),
+            slope: c.slope.unwrap_or(1.0),
+        },
+        "sine" => Function::Sine {
+            offset: c.offset.unwrap_or(0.0),
+            amplitude: c.amplitude.unwrap_or(1.0),
+            frequency: required(ck, "frequency", c.frequency)?,
+            phase: c.phase.unwrap_or(0.0),
+        },
+        _ => {
+            let (start, end) = (required(ck, "start", c.start), required(ck, "end", c.end));
+            let (start, end) = (start?, end?);
+            if start >= end {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!("start must be before end, got {start} and {end}"),
+                );
+                return None;
+            }
+            Function::SmoothStep {
+                start,
+                end,
+                from: c.from.unwrap_or(0.0),
+                to: c.to.unwrap_or(1.0),
+            }
+        }
+    };
+    ok.then_some(f)
 }
 
 /// Components named by a support entry.

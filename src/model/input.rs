@@ -522,15 +522,50 @@ pub struct GravityInput {
     pub curve: Option<String>,
 }
 
-/// A piecewise-linear curve `f(t)`.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+/// A curve `f(t)`: a piecewise-linear table (`points`) or a simple
+/// function (`function` and its parameters).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct CurveInput {
     /// Name by which loads refer to the curve.
     pub name: String,
     /// Points `[t, f]` with strictly increasing `t`. Constant beyond the
     /// first and last points.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub points: Vec<[f64; 2]>,
+    /// Instead of points: `linear` (`offset + slope·t`), `sine`
+    /// (`offset + amplitude·sin(2π·frequency·t + phase)`) or `smooth_step`
+    /// (from `from` at `start` to `to` at `end`, zero rate and acceleration
+    /// at both ends).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub function: Option<String>,
+    /// `linear`, `sine`: value at `t = 0` / mean value (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset: Option<f64>,
+    /// `linear`: slope (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slope: Option<f64>,
+    /// `sine`: amplitude (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitude: Option<f64>,
+    /// `sine`: frequency, cycles per unit of `t` (required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frequency: Option<f64>,
+    /// `sine`: phase in radians (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phase: Option<f64>,
+    /// `smooth_step`: start and end of the transition (required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<f64>,
+    /// `smooth_step`: end of the transition (required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub end: Option<f64>,
+    /// `smooth_step`: value before `start` (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from: Option<f64>,
+    /// `smooth_step`: value after `end` (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub to: Option<f64>,
 }
 
 // ---------- builder helpers for models written in Rust ----------

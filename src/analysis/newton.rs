@@ -122,6 +122,19 @@ pub enum NewtonFailure {
     },
 }
 
+impl NewtonFailure {
+    /// Iterations spent before the failure.
+    pub fn iterations_spent(&self) -> usize {
+        match self {
+            Self::MaxIterations { iterations, .. } => *iterations,
+            Self::Diverging { iteration, .. }
+            | Self::NonFinite { iteration }
+            | Self::NoArcRoot { iteration } => *iteration,
+            Self::Singular { .. } => 0,
+        }
+    }
+}
+
 /// A converged Newton solve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NewtonResult {
@@ -380,6 +393,89 @@ impl NewtonSolver {
         (kf, km)
     }
 
+    /// One Newton evaluation shared by load and arc-length control:
+    /// assembles residual and tangent at `state` and `time`, reports the
+    /// iteration and decides whether the iterations have converged
+    /// (`Ok(true)`, only if `may_converge`), must go on (`Ok(false)`) or
+    /// have failed.
+    #[allow(clippy::too_many_arguments)]
+    fn assess(
+        &mut self,
+        model: &Model,
+        settings: &StaticSettings,
+        state: &State,
+        time: f64,
+        increment: usize,
+        iteration: usize,
+        progress: &mut Progress,
+        may_converge: bool,
+        observer: &mut dyn Observer,
+    ) -> Result<bool, NewtonFailure> {
+        let length = model.length_scale;
+        self.assemble(model, state, time, true);
+        if self.stiffness_scale.is_none() {
+            self.stiffness_scale = Some(self.diagonal_scale());
+        }
+        let scale = self.stiffness_scale.expect("set above");
+        let tol = settings.residual_tolerance;
+        let floor = (RESIDUAL_FLOOR * scale.0 * length, RESIDUAL_FLOOR * scale.1);
+        let constraint_tol = (
+            settings.displacement_tolerance * length,
+            settings.rotation_tolerance,
+        );
+        let mut norms = self.norms(floor, tol, constraint_tol);
+        if let Some((dx, dth)) = progress.last_correction {
+            norms.displacement_correction = dx;
+            norms.rotation_correction = dth;
+        }
+        let residuals = &mut progress.residuals;
+        residuals.push(norms.relative_residual);
+        observer.iteration(&IterationInfo {
+            increment,
+            iteration,
+            time,
+            norms,
+        });
+        if !(norms.residual_force.is_finite() && norms.residual_moment.is_finite()) {
+            return Err(NewtonFailure::NonFinite { iteration });
+        }
+
+        // convergence: residual, and the next correction estimated as the
+        // last one scaled by the residual ratio, |Δq_k+1| ≈ |Δq_k| r_k/r_k-1
+        let residual_ok = norms.relative_residual <= tol && norms.residual_constraint <= 1.0;
+        let ratio = match residuals.len() {
+            n if n >= 2 && residuals[n - 2] > 0.0 => (residuals[n - 1] / residuals[n - 2]).min(1.0),
+            _ => 1.0,
+        };
+        let correction_ok = progress.last_correction.is_none_or(|(dx, dth)| {
+            dx * ratio <= settings.displacement_tolerance * length
+                && dth * ratio <= settings.rotation_tolerance
+        });
+        if may_converge && residual_ok && correction_ok {
+            return Ok(true);
+        }
+        if iteration == settings.max_iterations {
+            return Err(NewtonFailure::MaxIterations {
+                iterations: iteration,
+                relative_residual: norms.relative_residual,
+            });
+        }
+        // divergence: forces and moments (over the model size) far beyond
+        // those of the first iteration
+        let magnitude = norms.residual_force + norms.residual_moment / length;
+        let reference = *progress
+            .first_flux
+            .get_or_insert(norms.flux_force + norms.flux_moment / length);
+        let reference = reference.max(floor.0 + floor.1 / length);
+        if iteration > 0 && magnitude > DIVERGED_GROWTH * reference {
+            return Err(NewtonFailure::Diverging {
+                iteration,
+                relative_residual: norms.relative_residual,
+            });
+        }
+        Ok(false)
+    }
+
     /// Iterates to equilibrium at load parameter `time`, starting from
     /// `state` (which holds the prescribed values for `time`).
     pub fn solve(
@@ -392,75 +488,23 @@ impl NewtonSolver {
         observer: &mut dyn Observer,
     ) -> Result<NewtonResult, NewtonFailure> {
         let length = model.length_scale;
-        let mut residuals = Vec::new();
-        let mut last_correction = None::<(f64, f64)>;
-        let mut first_flux = None::<f64>;
+        let mut progress = Progress::default();
         for iteration in 0..=settings.max_iterations {
-            // assemble residual and tangent
-            self.assemble(model, state, time, true);
-            if self.stiffness_scale.is_none() {
-                self.stiffness_scale = Some(self.diagonal_scale());
-            }
-            let scale = self.stiffness_scale.expect("set above");
-            let tol = settings.residual_tolerance;
-            let floor = (RESIDUAL_FLOOR * scale.0 * length, RESIDUAL_FLOOR * scale.1);
-            let constraint_tol = (
-                settings.displacement_tolerance * length,
-                settings.rotation_tolerance,
-            );
-            let mut norms = self.norms(floor, tol, constraint_tol);
-            if let Some((dx, dth)) = last_correction {
-                norms.displacement_correction = dx;
-                norms.rotation_correction = dth;
-            }
-            residuals.push(norms.relative_residual);
-            observer.iteration(&IterationInfo {
+            let may_converge = self.tangent_checked;
+            if self.assess(
+                model,
+                settings,
+                state,
+                time,
                 increment,
                 iteration,
-                time,
-                norms,
-            });
-            if !(norms.residual_force.is_finite() && norms.residual_moment.is_finite()) {
-                return Err(NewtonFailure::NonFinite { iteration });
-            }
-
-            // convergence: residual, and the next correction estimated as the
-            // last one scaled by the residual ratio, |Δq_k+1| ≈ |Δq_k| r_k/r_k-1
-            let residual_ok = norms.relative_residual <= tol
-                && norms.residual_constraint <= 1.0
-                && self.tangent_checked;
-            let ratio = match residuals.len() {
-                n if n >= 2 && residuals[n - 2] > 0.0 => {
-                    (residuals[n - 1] / residuals[n - 2]).min(1.0)
-                }
-                _ => 1.0,
-            };
-            let correction_ok = last_correction.is_none_or(|(dx, dth)| {
-                dx * ratio <= settings.displacement_tolerance * length
-                    && dth * ratio <= settings.rotation_tolerance
-            });
-            if residual_ok && correction_ok {
+                &mut progress,
+                may_converge,
+                observer,
+            )? {
                 return Ok(NewtonResult {
                     iterations: iteration,
-                    residuals,
-                });
-            }
-            if iteration == settings.max_iterations {
-                return Err(NewtonFailure::MaxIterations {
-                    iterations: iteration,
-                    relative_residual: norms.relative_residual,
-                });
-            }
-            // divergence: forces and moments (over the model size) far
-            // beyond those of the first iteration
-            let magnitude = norms.residual_force + norms.residual_moment / length;
-            let reference =
-                *first_flux.get_or_insert(norms.flux_force + norms.flux_moment / length);
-            let reference = reference.max(floor.0 + floor.1 / length);
-            if iteration > 0 && magnitude > DIVERGED_GROWTH * reference {
-                return Err(NewtonFailure::Diverging {
-                    iteration,
-                    relative_residual: norms.relative_residual,
+                    residuals: progress.residuals,
                 });
             }
 
@@ -478,7 +522,7 @@ impl NewtonSolver {
 
             // update: x ← x + Δx, R ← R exp(ΔΘ~), extras additively
             self.update(model, state);
-            last_correction = Some((dx, dth));
+            progress.last_correction = Some((dx, dth));
         }
         unreachable!("the loop returns at max_iterations")
     }
@@ -569,75 +613,30 @@ impl NewtonSolver {
         };
         let mut dq = vec![0.0; n];
         let mut qt = vec![0.0; n];
-        let mut residuals = Vec::new();
-        let mut last_correction = None::<(f64, f64)>;
-        let mut first_flux = None::<f64>;
+        let mut progress = Progress::default();
         if direction.len() != n {
             direction.clear();
             direction.resize(n, 0.0);
         }
         for iteration in 0..=settings.max_iterations {
-            self.assemble(model, state, *t, true);
-            if self.stiffness_scale.is_none() {
-                self.stiffness_scale = Some(self.diagonal_scale());
-            }
-            let scale = self.stiffness_scale.expect("set above");
-            let tol = settings.residual_tolerance;
-            let floor = (RESIDUAL_FLOOR * scale.0 * length, RESIDUAL_FLOOR * scale.1);
-            let constraint_tol = (
-                settings.displacement_tolerance * length,
-                settings.rotation_tolerance,
-            );
-            let mut norms = self.norms(floor, tol, constraint_tol);
-            if let Some((dx, dth)) = last_correction {
-                norms.displacement_correction = dx;
-                norms.rotation_correction = dth;
-            }
-            residuals.push(norms.relative_residual);
-            observer.iteration(&IterationInfo {
+            // the predictor (iteration 0) is never a converged state
+            let may_converge = iteration > 0;
+            if self.assess(
+                model,
+                settings,
+                state,
+                *t,
                 increment,
                 iteration,
-                time: *t,
-                norms,
-            });
-            if !(norms.residual_force.is_finite() && norms.residual_moment.is_finite()) {
-                return Err(NewtonFailure::NonFinite { iteration });
-            }
-            if iteration > 0 {
-                let ratio = match residuals.len() {
-                    k if k >= 2 && residuals[k - 2] > 0.0 => {
-                        (residuals[k - 1] / residuals[k - 2]).min(1.0)
-                    }
-                    _ => 1.0,
-                };
-                let residual_ok =
-                    norms.relative_residual <= tol && norms.residual_constraint <= 1.0;
-                let correction_ok = last_correction.is_none_or(|(dx, dth)| {
-                    dx * ratio <= settings.displacement_tolerance * length
-                        && dth * ratio <= settings.rotation_tolerance
+                &mut progress,
+                may_converge,
+                observer,
+            )? {
+                direction.copy_from_slice(&dq);
+                return Ok(NewtonResult {
+                    iterations: iteration,
+                    residuals: progress.residuals,
                 });
-                if residual_ok && correction_ok {
-                    direction.copy_from_slice(&dq);
-                    return Ok(NewtonResult {
-                        iterations: iteration,
-                        residuals,
-                    });
-                }
-                if iteration == settings.max_iterations {
-                    return Err(NewtonFailure::MaxIterations {
-                        iterations: iteration,
-                        relative_residual: norms.relative_residual,
-                    });
-                }
-                let magnitude = norms.residual_force + norms.residual_moment / length;
-                let reference =
-                    *first_flux.get_or_insert(norms.flux_force + norms.flux_moment / length);
-                if magnitude > DIVERGED_GROWTH * reference.max(floor.0 + floor.1 / length) {
-                    return Err(NewtonFailure::Diverging {
-                        iteration,
-                        relative_residual: norms.relative_residual,
-                    });
-                }
             }
 
             // q_t: K q_t = −∂r/∂t, and q_r: K q_r = −r, one factorisation
@@ -704,7 +703,7 @@ impl NewtonSolver {
             }
             state.time = *t;
             self.update(model, state);
-            last_correction = Some((dx, dth));
+            progress.last_correction = Some((dx, dth));
         }
         unreachable!("the loop returns at max_iterations")
     }
@@ -784,6 +783,17 @@ impl NewtonSolver {
             }
         }
     }
+}
+
+/// What the iterations of one solve have seen so far.
+#[derive(Default)]
+struct Progress {
+    /// Relative residual at each evaluation.
+    residuals: Vec<f64>,
+    /// `(max|Δx|, max|ΔΘ|)` of the last correction.
+    last_correction: Option<(f64, f64)>,
+    /// Force flux of the first evaluation (divergence reference).
+    first_flux: Option<f64>,
 }
 
 /// `(max|Δx|, max|ΔΘ|)` of a correction.

@@ -258,13 +258,7 @@ impl<'m> StaticAnalysis<'m> {
                     increment += 1;
                 }
                 Err(reason) => {
-                    outcome.wasted_iterations += match &reason {
-                        NewtonFailure::MaxIterations { iterations, .. } => *iterations,
-                        NewtonFailure::Diverging { iteration, .. }
-                        | NewtonFailure::NonFinite { iteration } => *iteration,
-                        NewtonFailure::Singular { .. } => 0,
-                        NewtonFailure::NoArcRoot { iteration } => *iteration,
-                    };
+                    outcome.wasted_iterations += reason.iterations_spent();
                     state.clone_from(&backup);
                     let next = step * CUTBACK;
                     if next < s.min_increment {
@@ -379,13 +373,7 @@ impl<'m> StaticAnalysis<'m> {
                     increment += 1;
                 }
                 Err(reason) => {
-                    outcome.wasted_iterations += match &reason {
-                        NewtonFailure::MaxIterations { iterations, .. } => *iterations,
-                        NewtonFailure::Diverging { iteration, .. }
-                        | NewtonFailure::NonFinite { iteration }
-                        | NewtonFailure::NoArcRoot { iteration } => *iteration,
-                        NewtonFailure::Singular { .. } => 0,
-                    };
+                    outcome.wasted_iterations += reason.iterations_spent();
                     state.clone_from(&backup);
                     t = t_start;
                     direction = dir_backup;

@@ -542,16 +542,24 @@ impl NewtonSolver {
     /// `∂r/∂t` by a forward difference of the residual (loads, gravity and
     /// drivers move with `t`), by equation; the residual of the last
     /// assembly at `t` is kept.
-    fn load_derivative(&mut self, model: &Model, state: &State, t: f64, out: &mut [f64]) {
+    /// `r0` is work space (the residual at `t`, by dof).
+    fn load_derivative(
+        &mut self,
+        model: &Model,
+        state: &State,
+        t: f64,
+        r0: &mut Vec<f64>,
+        out: &mut [f64],
+    ) {
         let h = 1e-7 * t.abs().max(1.0);
-        let r0: Vec<f64> = self.assembler.residual.clone();
+        r0.clone_from(&self.assembler.residual);
         let ctx = model.context(t + h, false);
         self.assembler.assemble(model, &ctx, state);
         for (eq, o) in out.iter_mut().enumerate() {
             let d = self.dofs.dof(eq);
             *o = (self.assembler.residual[d] - r0[d]) / h;
         }
-        self.assembler.residual.copy_from_slice(&r0);
+        self.assembler.residual.copy_from_slice(r0);
     }
 
     /// Weighted length of the tangent predictor `Δt·q_t` at `state`, `t`:
@@ -561,7 +569,7 @@ impl NewtonSolver {
         self.assemble(model, state, t, true);
         let n = self.dofs.n_equations();
         let mut qt = vec![0.0; n];
-        self.load_derivative(model, state, t, &mut qt);
+        self.load_derivative(model, state, t, &mut Vec::new(), &mut qt);
         let w = self.arc_weights(model.length_scale);
         self.rhs.iter_mut().zip(&qt).for_each(|(r, q)| *r = -q);
         let ok = self.analyze().is_ok()
@@ -613,6 +621,8 @@ impl NewtonSolver {
         };
         let mut dq = vec![0.0; n];
         let mut qt = vec![0.0; n];
+        let mut qt_sol = vec![0.0; n];
+        let mut r0 = Vec::new();
         let mut progress = Progress::default();
         if direction.len() != n {
             direction.clear();
@@ -640,18 +650,16 @@ impl NewtonSolver {
             }
 
             // q_t: K q_t = −∂r/∂t, and q_r: K q_r = −r, one factorisation
-            self.load_derivative(model, state, *t, &mut qt);
+            self.load_derivative(model, state, *t, &mut r0, &mut qt);
             if self.solve_linear_system().is_err() {
                 return Err(self.diagnose(model, iteration));
             }
-            let qr = std::mem::take(&mut self.rhs);
-            self.rhs = qt.iter().map(|v| -v).collect();
+            qt_sol.iter_mut().zip(&qt).for_each(|(x, q)| *x = -q);
             let solved = self
                 .lu
                 .as_mut()
                 .expect("factored above")
-                .solve_in_place(&mut self.rhs);
-            let qt_sol = std::mem::replace(&mut self.rhs, qr);
+                .solve_in_place(&mut qt_sol);
             if solved.is_err() {
                 return Err(self.diagnose(model, iteration));
             }
@@ -671,19 +679,26 @@ impl NewtonSolver {
                 self.rhs.iter_mut().for_each(|v| *v = 0.0);
                 sign * arc / norm
             } else {
-                // ‖Δq + q_r + δt q_t‖ = arc
-                let a: Vec<f64> = dq.iter().zip(&self.rhs).map(|(d, r)| d + r).collect();
-                let (aa, ab, bb) = (wdot(&a, &a), wdot(&a, &qt_sol), wdot(&qt_sol, &qt_sol));
+                // ‖a + δt q_t‖ = arc with a = Δq + q_r
+                let (dd, dr, rr) = (
+                    wdot(&dq, &dq),
+                    wdot(&dq, &self.rhs),
+                    wdot(&self.rhs, &self.rhs),
+                );
+                let (dt_, rt, bb) = (
+                    wdot(&dq, &qt_sol),
+                    wdot(&self.rhs, &qt_sol),
+                    wdot(&qt_sol, &qt_sol),
+                );
+                let (aa, ab) = (dd + 2.0 * dr + rr, dt_ + rt);
                 let disc = ab * ab - bb * (aa - arc * arc);
                 if disc < 0.0 || bb == 0.0 {
                     return Err(NewtonFailure::NoArcRoot { iteration });
                 }
                 let roots = [(-ab + disc.sqrt()) / bb, (-ab - disc.sqrt()) / bb];
-                // the root whose increment stays closest to the current one
-                let score = |r: f64| -> f64 {
-                    let v: Vec<f64> = a.iter().zip(&qt_sol).map(|(x, y)| x + r * y).collect();
-                    wdot(&v, &dq)
-                };
+                // the root whose increment stays closest to the current one:
+                // largest (a + δt q_t)·Δq
+                let score = |r: f64| dd + dr + r * dt_;
                 if score(roots[0]) >= score(roots[1]) {
                     roots[0]
                 } else {

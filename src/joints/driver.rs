@@ -157,6 +157,7 @@ impl Element for Driver {
                 &mut sc.local,
                 &mut sc.grad,
                 &self.active,
+                true,
                 &[self.kind_of_equation()],
                 &phi,
                 lambda,

@@ -43,6 +43,7 @@ pub(crate) fn add_constraints<F>(
     local: &mut Local,
     grad: &mut Vec<f64>,
     active: &[usize],
+    affine: bool,
     kinds: &[Equation],
     f: &F,
     lambda: &[f64],
@@ -88,7 +89,7 @@ pub(crate) fn add_constraints<F>(
             }
         }
     }
-    local.add_weighted_hessian(m, active, f, &w[..m], t, n);
+    local.add_weighted_hessian(m, active, f, &w[..m], grad, affine, t, n);
 }
 
 /// A kinematic pair of the joint library.
@@ -346,6 +347,9 @@ impl Element for Joint {
                 &mut sc.local,
                 &mut sc.grad,
                 &self.active,
+                // every formula but the slider's curve is affine in the
+                // nodes' translations
+                self.joint_type != JointType::Slider,
                 self.kinds,
                 &self.phi(refs),
                 lambda,

@@ -159,14 +159,25 @@ impl Local {
         }
     }
 
-    /// Adds `Σᵢ wᵢ ∂gᵢᵣ/∂q꜀` to `tangent[c·ld + off + r]` for the active
-    /// unknowns `r, c` (column-major with leading dimension `ld`).
+    /// Adds `Σᵢ wᵢ ∂gᵢᵣ/∂q꜀` to `tangent[c·ld + r]` for the active
+    /// unknowns `r, c` (column-major with leading dimension `ld`), given
+    /// the gradients `grad` (`m × n`, from [`Local::gradient`]).
+    ///
+    /// Perturbations of different unknowns commute, except two rotations
+    /// of the same node: `R(I + ε₂ẽ꜀)(I + ε₁ẽᵣ)` and `R(I + ε₁ẽᵣ)(I + ε₂ẽ꜀)`
+    /// differ by `ε₁ε₂ R (e꜀ × eᵣ)~`, so `H꜀ᵣ = Hᵣ꜀ + g_Θ·(eᵣ × e꜀)`. Only
+    /// `r ≤ c` is evaluated and the other half follows. When the formula is
+    /// affine in the nodes' translations (`affine`), pairs of two
+    /// translations are zero and skipped.
+    #[allow(clippy::too_many_arguments)]
     pub fn add_weighted_hessian<F>(
         &mut self,
         m: usize,
         active: &[usize],
         f: &F,
         w: &[f64],
+        grad: &[f64],
+        affine: bool,
         tangent: &mut [f64],
         ld: usize,
     ) where
@@ -175,13 +186,33 @@ impl Local {
         if w.iter().all(|&w| w == 0.0) {
             return;
         }
+        let n = self.n();
+        let node_dofs = 6 * self.x.len();
+        let translation = |k: usize| k < node_dofs && k % 6 < 3;
+        let rotation = |k: usize| k < node_dofs && k % 6 >= 3;
         let mut out = [HyperDual::default(); MAX_OUT];
         let out = &mut out[..m];
-        for &c in active {
-            for &r in active {
+        for (ic, &c) in active.iter().enumerate() {
+            for &r in &active[..=ic] {
+                if affine && translation(r) && translation(c) {
+                    continue;
+                }
                 f(self.set(Some(r), Some(c)), out);
-                let s: f64 = (0..m).map(|i| w[i] * out[i].e12).sum();
-                tangent[c * ld + r] += s;
+                let h_rc: f64 = (0..m).map(|i| w[i] * out[i].e12).sum();
+                tangent[c * ld + r] += h_rc;
+                if r == c {
+                    continue;
+                }
+                let mut h_cr = h_rc;
+                if rotation(r) && rotation(c) && r / 6 == c / 6 {
+                    // eᵣ × e꜀ = ε_{abk} e_k
+                    let (a, b) = (r % 6 - 3, c % 6 - 3);
+                    let k = 3 - a - b;
+                    let sign = if (a + 1) % 3 == b { 1.0 } else { -1.0 };
+                    let gk = 6 * (r / 6) + 3 + k;
+                    h_cr += sign * (0..m).map(|i| w[i] * grad[i * n + gk]).sum::<f64>();
+                }
+                tangent[r * ld + c] += h_cr;
             }
         }
     }

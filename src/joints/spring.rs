@@ -186,7 +186,7 @@ impl Element for JointSpring {
             let h = &mut sc.hess;
             h.clear();
             h.resize(n * n, 0.0);
-            local.add_weighted_hessian(1, &self.active, &f, &[1.0], h, n);
+            local.add_weighted_hessian(1, &self.active, &f, &[1.0], g, true, h, n);
             let gamma = ctx.dynamics.map_or(0.0, |d| d.damping);
             for col in 0..n {
                 // ∂ċ/∂q_col at fixed q̇: Σ_r v_r H[r, col]

@@ -97,8 +97,8 @@ pub(crate) fn add_constraints<F>(
 pub struct Joint {
     id: Id,
     joint_type: JointType,
-    /// Node A, node B (absent if B is the ground); for a slider the sliding
-    /// node then the curve's nodes.
+    /// Node A then node B; the node alone (body B) for a joint to the
+    /// ground; for a slider the sliding node then the curve's nodes.
     nodes: Vec<usize>,
     pair: Pair,
     parameters: JointParameters,
@@ -114,19 +114,21 @@ pub struct Joint {
 }
 
 impl Joint {
-    /// A joint of type `joint_type` (not a slider) between node `a` and
-    /// node `b` (or the ground), placed by `pair`.
+    /// A joint of type `joint_type` (not a slider) between nodes `first`
+    /// (body A) and `second` (body B), or without `second` between the
+    /// ground (body A) and `first` (body B), placed by `pair` (built the
+    /// same way by [`Pair::from_reference`]).
     pub fn new(
         id: Id,
         joint_type: JointType,
-        a: usize,
-        b: Option<usize>,
+        first: usize,
+        second: Option<usize>,
         pair: Pair,
         parameters: JointParameters,
     ) -> Self {
         assert!(joint_type != JointType::Slider, "use Joint::slider");
-        let mut nodes = vec![a];
-        nodes.extend(b);
+        let mut nodes = vec![first];
+        nodes.extend(second);
         let active = (0..6 * nodes.len()).collect();
         let kinds = constraint_kinds(joint_type, parameters.lock_rotations);
         Self {

@@ -319,15 +319,6 @@ impl Pair {
         Self::from_reference(x, e, (x, r), None)
     }
 
-    /// Number of nodes (1 for a joint to the ground).
-    pub fn n_nodes(&self) -> usize {
-        if self.ground.is_some() {
-            1
-        } else {
-            2
-        }
-    }
-
     /// Local node of body B.
     pub fn node_b(&self) -> usize {
         if self.ground.is_some() {

@@ -22,6 +22,7 @@
 //! along the update above.
 
 pub mod beam;
+pub mod inertia;
 pub mod load;
 pub mod mass;
 pub mod spring;

@@ -401,6 +401,8 @@ impl ResultWriter {
             }
             remove_if_present(&dir.join(format!("{name}.tmp")))?;
         }
+        // the temporary collection of earlier versions
+        remove_if_present(&dir.join("unfold.tmp"))?;
         let entries = std::fs::read_dir(&vtk_dir).map_err(|e| file_error(&vtk_dir, e))?;
         for entry in entries {
             let path = entry.map_err(|e| file_error(&vtk_dir, e))?.path();

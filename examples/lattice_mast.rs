@@ -2,7 +2,8 @@
 //!
 //! The program builds the model with the `unfold` API, writes it as a model
 //! file (so that it can be inspected, edited and rerun with `unfold run`),
-//! then runs the static analysis and prints the tip motion.
+//! then runs the static analysis, writing the same result files as
+//! `unfold run` (docs/results.md), and prints the tip motion.
 //!
 //! ```text
 //! cargo run --release --example lattice_mast -- [bays] [output directory]
@@ -26,7 +27,9 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 
 use unfold::analysis::StaticAnalysis;
-use unfold::io::results::ResultWriter;
+use unfold::io::run::{
+    signal_name, stop_on_signals, Interrupted, Recorder, SignalEvent, Silent, StopRequest,
+};
 use unfold::model::input::{BeamLineInput, Id, LoadInput, ModelInput, SectionInput};
 use unfold::model::Model;
 
@@ -152,7 +155,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("model written to {}", file.display());
 
     let model = Model::from_input(&input)?;
-    let mut writer = ResultWriter::create(&out, &model)?;
     let mut analysis = StaticAnalysis::new(&model);
     println!(
         "{} nodes, {} elements, {} unknowns",
@@ -160,8 +162,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         model.elements.len(),
         analysis.n_equations()
     );
-    let outcome = analysis.run(&mut writer);
+    // the result files, log.txt and summary.json of `unfold run`; SIGINT
+    // or SIGTERM stop after the current increment
+    let stop = StopRequest::new();
+    stop_on_signals(&stop, |event| match event {
+        SignalEvent::Stopping(s) => eprintln!(
+            "{}: stopping after the current increment (again to stop at once)",
+            signal_name(s)
+        ),
+        SignalEvent::Ending(s) => eprintln!("{}: stopping at once", signal_name(s)),
+    })?;
+    let label = file.display().to_string();
+    let mut recorder = Recorder::create(&out, &label, &model, &analysis, Silent)?.with_stop(&stop);
+    let outcome = analysis.run(&mut recorder);
+    let report = recorder.finish(&outcome);
+    println!("{}", report.last_line);
+    if let Some(e) = report.output_errors.into_iter().next() {
+        return Err(e.into());
+    }
     if let Some(e) = outcome.error {
+        if let Some(i) = Interrupted::of(&e) {
+            eprintln!("{i} at t = {}; results up to it are kept", outcome.time);
+            std::process::exit(i.exit_code().into());
+        }
         return Err(e.into());
     }
     let tip: Vec<usize> = (0..3)

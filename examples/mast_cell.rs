@@ -9,8 +9,8 @@
 //!
 //! The program builds the model with the `unfold` API, writes it as a model
 //! file, runs it, and writes, besides the usual result files, the moments
-//! in the longerons along the fold (`longeron_moments.csv` and
-//! `longeron_moments.svg`). `examples/mast_cell.md` describes the model,
+//! in the longerons along the fold (`longeron_moments.csv`, and their plot
+//! `longeron_moments.svg` and `.png`). `examples/mast_cell.md` describes the model,
 //! its dimensions and the choice of the hinge axes.
 //!
 //! In short:
@@ -38,8 +38,10 @@ use std::time::Instant;
 
 use unfold::analysis::{IncrementInfo, NoObserver, Observer, StaticAnalysis, StaticOutcome};
 use unfold::elements::ElementKind;
-use unfold::io::plot::{line_chart_svg, Series};
-use unfold::io::results::{ResultWriter, Summary};
+use unfold::io::plot::{Axis, Chart, Series};
+use unfold::io::run::{
+    signal_name, stop_on_signals, Interrupted, Recorder, SignalEvent, Silent, StopRequest,
+};
 use unfold::joints::JointType;
 use unfold::model::input::{
     BeamLineInput, CurveInput, DriverInput, Id, InertiaInput, JointInput, ModelInput,
@@ -688,9 +690,9 @@ pub struct Record {
     pub diagonals: [MemberForces; 3],
 }
 
-/// Wraps the result writer and records the forces in the bars.
+/// Wraps the run's recorder and records the forces in the bars.
 struct FoldObserver {
-    writer: Option<ResultWriter>,
+    recorder: Option<Recorder>,
     design: Design,
     records: Vec<Record>,
     log: bool,
@@ -721,6 +723,24 @@ fn member(model: &Model, state: &State, time: f64, ids: &[Id]) -> MemberForces {
 }
 
 impl Observer for FoldObserver {
+    fn iteration(&mut self, info: &unfold::analysis::IterationInfo) {
+        if let Some(r) = self.recorder.as_mut() {
+            r.iteration(info);
+        }
+    }
+
+    fn cutback(&mut self, info: &unfold::analysis::CutbackInfo) {
+        if let Some(r) = self.recorder.as_mut() {
+            r.cutback(info);
+        }
+    }
+
+    fn note(&mut self, text: &str) {
+        if let Some(r) = self.recorder.as_mut() {
+            r.note(text);
+        }
+    }
+
     fn increment(
         &mut self,
         info: &IncrementInfo,
@@ -767,8 +787,8 @@ impl Observer for FoldObserver {
             );
         }
         self.records.push(record);
-        match self.writer.as_mut() {
-            Some(w) => w.increment(info, model, state, residual),
+        match self.recorder.as_mut() {
+            Some(r) => r.increment(info, model, state, residual),
             None => Ok(()),
         }
     }
@@ -814,26 +834,41 @@ pub struct Run {
 }
 
 /// Runs the model `input` built from `design`; with `out`, writes the
-/// result files there (VTK, CSV, `summary.json`, the longeron moments and
-/// their plot). With `log`, prints a line per increment.
+/// result files there (VTK, CSV, `log.txt`, `summary.json`, the longeron
+/// moments and their plot). With `log`, prints a line per increment.
 pub fn run(
     design: &Design,
     input: &ModelInput,
     out: Option<&Path>,
     log: bool,
 ) -> Result<Run, Box<dyn Error>> {
+    run_until(design, input, out, log, &StopRequest::new())
+}
+
+/// [`run`], stopping after the increment during which `stop` is
+/// requested.
+pub fn run_until(
+    design: &Design,
+    input: &ModelInput,
+    out: Option<&Path>,
+    log: bool,
+    stop: &StopRequest,
+) -> Result<Run, Box<dyn Error>> {
     let model = Model::from_input(input)?;
-    let writer = match out {
-        Some(dir) => Some(ResultWriter::create(dir, &model)?),
+    let mut analysis = StaticAnalysis::new(&model);
+    let recorder = match out {
+        Some(dir) => {
+            let file = dir.join("mast_cell.toml").display().to_string();
+            Some(Recorder::create(dir, &file, &model, &analysis, Silent)?.with_stop(stop))
+        }
         None => None,
     };
     let mut observer = FoldObserver {
-        writer,
+        recorder,
         design: design.clone(),
         records: Vec::new(),
         log,
     };
-    let mut analysis = StaticAnalysis::new(&model);
     let outcome = analysis.run(&mut observer);
     let records = observer.records;
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
@@ -859,41 +894,11 @@ pub fn run(
         cutbacks: outcome.cutbacks,
         wall_time: outcome.wall_time,
     };
-    if let (Some(w), Some(dir)) = (observer.writer.as_ref(), out) {
-        let message = outcome.error.as_ref().map(|e| e.to_string());
-        w.write_summary(&Summary {
-            model: dir.join("mast_cell.toml").display().to_string(),
-            title: model.title.clone(),
-            status: if message.is_none() {
-                "completed"
-            } else {
-                "failed"
-            }
-            .into(),
-            message,
-            nodes: figures.nodes,
-            elements: model
-                .elements
-                .iter()
-                .filter(|e| e.kind() != ElementKind::NodalLoad)
-                .count(),
-            beams: figures.beams,
-            joints: figures.joints,
-            drivers: figures.drivers,
-            dofs: figures.unknowns,
-            nonzeros: analysis.solver().nnz(),
-            increments: figures.increments,
-            iterations: outcome.iterations,
-            average_iterations: figures.iterations_per_increment,
-            wasted_iterations: outcome.wasted_iterations,
-            cutbacks: outcome.cutbacks,
-            redundant_constraints: outcome.redundant_constraints,
-            final_time: outcome.time,
-            end_time: model.settings.end_time,
-            wall_time_s: outcome.wall_time,
-            output_steps: w.output_steps(),
-            increment_log: w.log.clone(),
-        })?;
+    if let (Some(recorder), Some(dir)) = (observer.recorder, out) {
+        let report = recorder.finish(&outcome);
+        if let Some(e) = report.output_errors.into_iter().next() {
+            return Err(e.into());
+        }
         write_moments(dir, &records)?;
     }
     Ok(Run {
@@ -947,18 +952,18 @@ fn write_moments(dir: &Path, records: &[Record]) -> Result<(), Box<dyn Error>> {
     }
     std::fs::write(dir.join("longeron_moments.csv"), csv)?;
     let [bottom_m, bottom_t, max_m, max_t] = series;
-    line_chart_svg(
-        &dir.join("longeron_moments.svg"),
-        "Mast cell: longeron moments, (a) unlocking t ≤ 1, (b) folding t ≥ 1",
-        "t",
-        "moment (N·m)",
-        &[
-            Series::new("bending, next to the bottom hinge", bottom_m),
-            Series::new("torsion, next to the bottom hinge", bottom_t),
-            Series::new("bending, largest along the longeron", max_m),
-            Series::new("torsion, largest along the longeron", max_t),
-        ],
-    )?;
+    let chart = Chart::new(
+        "Mast cell: moments in the longerons",
+        Axis::dimensionless("load parameter t: (a) unlocking t ≤ 1, (b) folding t ≥ 1"),
+        Axis::new("moment", "N·m"),
+    )
+    .series(Series::new("bending, next to the bottom hinge", bottom_m))
+    .series(Series::new("torsion, next to the bottom hinge", bottom_t))
+    .series(Series::new("bending, largest along the longeron", max_m))
+    .series(Series::new("torsion, largest along the longeron", max_t))
+    .event(1.0, "(a) → (b)");
+    chart.write_svg(&dir.join("longeron_moments.svg"))?;
+    chart.write_png(&dir.join("longeron_moments.png"))?;
     Ok(())
 }
 
@@ -993,7 +998,16 @@ fn main() -> Result<(), Box<dyn Error>> {
     std::fs::write(&file, input.to_toml()?)?;
     println!("model written to {}", file.display());
 
-    let run = run(&design, &input, Some(&out), true)?;
+    // SIGINT, SIGTERM: stop after the current increment, results kept
+    let stop = StopRequest::new();
+    stop_on_signals(&stop, |event| match event {
+        SignalEvent::Stopping(s) => eprintln!(
+            "{}: stopping after the current increment (again to stop at once)",
+            signal_name(s)
+        ),
+        SignalEvent::Ending(s) => eprintln!("{}: stopping at once", signal_name(s)),
+    })?;
+    let run = run_until(&design, &input, Some(&out), true, &stop)?;
     let f = &run.figures;
     println!(
         "{} elements: {} beams, {} rigid bodies, {} revolute joints; {} drivers; {} nodes; {} unknowns ({} redundant constraint equations)",
@@ -1053,6 +1067,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     );
     println!("results in {}", out.display());
     if let Some(e) = run.outcome.error {
+        if let Some(i) = Interrupted::of(&e) {
+            eprintln!("{i} at t = {}; results up to it are kept", run.outcome.time);
+            std::process::exit(i.exit_code().into());
+        }
         return Err(e.into());
     }
     Ok(())

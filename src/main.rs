@@ -1,16 +1,18 @@
 //! `unfold`: command-line front end.
 //!
 //! ```text
-//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N]
+//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii]
 //! unfold check MODEL.toml
 //! ```
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
-//! written so far are kept) or results could not be written; 2 the command
-//! line or the model file is invalid, including a model whose tangent is
-//! singular from the start (a mechanism or an unrestrained structure).
+//! written so far are kept) or results could not be written (each error
+//! names its file; the output directory in use by another run); 2 the
+//! command line or the model file is invalid, including a model whose
+//! tangent is singular from the start (a mechanism or an unrestrained
+//! structure); 128 + the signal number (130 SIGINT, 143 SIGTERM, 129
+//! SIGHUP) the run was interrupted, with consistent results up to the last
+//! converged increment and `summary.json` saying `interrupted`.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -18,14 +20,11 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use unfold::analysis::statics::StaticError;
-use unfold::analysis::{
-    CutbackInfo, IncrementInfo, IterationInfo, NewtonFailure, Observer, StaticAnalysis,
-};
-use unfold::elements::ElementKind;
+use unfold::analysis::{IncrementInfo, NewtonFailure, StaticAnalysis};
 use unfold::io::model_file::read_model;
-use unfold::io::results::{ResultWriter, Summary};
+use unfold::io::run::{signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest};
+use unfold::io::vtk::Encoding;
 use unfold::model::Model;
-use unfold::state::State;
 
 #[derive(Parser)]
 #[command(
@@ -53,6 +52,9 @@ enum Command {
         /// Worker threads for assembly and factorisation (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// Write the VTK grids as text instead of compressed binary.
+        #[arg(long)]
+        vtk_ascii: bool,
     },
     /// Check a model file and print its size, without running it.
     Check {
@@ -61,7 +63,8 @@ enum Command {
     },
 }
 
-/// Exit code for an analysis that stopped early or unwritable results.
+/// Exit code for an analysis that stopped early or unwritable results
+/// (an interrupted run exits with 128 + the signal number instead).
 const EXIT_FAILED: u8 = 1;
 /// Exit code for invalid input.
 const EXIT_INPUT: u8 = 2;
@@ -75,6 +78,7 @@ fn main() -> ExitCode {
             out,
             quiet,
             threads,
+            vtk_ascii,
         } => {
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new()
@@ -91,25 +95,18 @@ fn main() -> ExitCode {
                     .map_or("model".into(), |s| s.to_string_lossy().into_owned());
                 Path::new("results").join(stem)
             });
-            run(&model, &out, quiet)
+            let encoding = if vtk_ascii {
+                Encoding::Ascii
+            } else {
+                Encoding::Binary
+            };
+            run(&model, &out, quiet, encoding)
         }
     }
 }
 
 fn describe(model: &Model) -> String {
-    let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
-    format!(
-        "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
-        model.n_nodes(),
-        count(ElementKind::Beam),
-        count(ElementKind::RigidBody),
-        count(ElementKind::PointMass),
-        count(ElementKind::Spring),
-        count(ElementKind::Joint),
-        count(ElementKind::JointSpring),
-        count(ElementKind::Driver),
-        count(ElementKind::NodalLoad),
-    )
+    unfold::io::run::describe(model)
 }
 
 fn check(path: &Path) -> ExitCode {
@@ -131,108 +128,64 @@ fn check(path: &Path) -> ExitCode {
     }
 }
 
-/// Turns analysis events into result files, log lines and a progress bar.
-struct RunObserver {
-    writer: ResultWriter,
-    log: BufWriter<File>,
+/// Shows a run in the terminal: log lines (unless quiet) above a progress
+/// bar, and the last line.
+struct Terminal {
     bar: ProgressBar,
     quiet: bool,
     end_time: f64,
 }
 
-impl RunObserver {
-    /// Writes a line to `log.txt` and, unless quiet, to the terminal.
+impl Console for Terminal {
     fn line(&mut self, text: &str) {
-        let _ = writeln!(self.log, "{text}");
-        if !self.quiet {
-            self.print(text);
+        if self.quiet {
+            return;
         }
-    }
-
-    /// Prints above the progress bar, or plainly when there is no bar
-    /// (output not a terminal).
-    fn print(&self, text: &str) {
+        // plainly when there is no bar (output not a terminal)
         if self.bar.is_hidden() {
             println!("{text}");
         } else {
             self.bar.println(text);
         }
     }
-}
 
-impl Observer for RunObserver {
-    fn iteration(&mut self, info: &IterationInfo) {
-        let n = &info.norms;
-        let _ = writeln!(
-            self.log,
-            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
-            info.increment,
-            info.iteration,
-            n.residual_force,
-            n.flux_force,
-            n.residual_moment,
-            n.flux_moment,
-            n.relative_residual,
-            n.residual_constraint,
-            n.displacement_correction,
-            n.rotation_correction
-        );
-    }
-
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        model: &Model,
-        state: &State,
-        reactions: &[f64],
-    ) -> std::io::Result<()> {
-        let residuals: Vec<String> = info.residuals.iter().map(|r| format!("{r:.1e}")).collect();
-        self.line(&format!(
-            "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  relative residuals: {}",
-            info.increment,
-            info.time,
-            info.step,
-            info.iterations,
-            residuals.join(" ")
-        ));
+    fn progress(&mut self, info: &IncrementInfo) {
         self.bar
             .set_position((1000.0 * info.time / self.end_time).round() as u64);
         self.bar.set_message(format!("t = {:.4}", info.time));
-        self.writer.increment(info, model, state, reactions)
     }
 
-    fn note(&mut self, text: &str) {
-        self.line(&format!("note: {text}"));
-    }
-
-    fn cutback(&mut self, info: &CutbackInfo) {
-        self.line(&format!(
-            "increment {:4}  from t = {:.6}: step {:.3e} failed ({}); retrying with {:.3e}",
-            info.increment, info.time, info.failed_step, info.reason, info.next_step
-        ));
+    fn finish(&mut self, text: &str) {
+        self.bar.finish_and_clear();
+        println!("{text}");
     }
 }
 
-fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
+fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
+    // from now on SIGINT, SIGTERM and SIGHUP stop the run after the
+    // current increment, with consistent result files
+    let stop = StopRequest::new();
+    let handled = stop_on_signals(&stop, |event| match event {
+        SignalEvent::Stopping(s) => eprintln!(
+            "\n{}: stopping after the current increment (again to stop at once)",
+            signal_name(s)
+        ),
+        SignalEvent::Ending(s) => eprintln!(
+            "\n{}: stopping at once; summary.json is left saying \"running\"",
+            signal_name(s)
+        ),
+    });
+    if let Err(e) = handled {
+        eprintln!(
+            "warning: signals cannot be handled ({e}): an interrupted run will leave no summary"
+        );
+    }
+
     let (_, model) = match read_model(path) {
         Ok(m) => m,
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
-        }
-    };
-    let writer = match ResultWriter::create(out, &model) {
-        Ok(w) => w,
-        Err(e) => {
-            eprintln!("error: {}: cannot create result files: {e}", out.display());
-            return ExitCode::from(EXIT_FAILED);
-        }
-    };
-    let log = match File::create(out.join("log.txt")) {
-        Ok(f) => BufWriter::new(f),
-        Err(e) => {
-            eprintln!("error: {}: {e}", out.join("log.txt").display());
-            return ExitCode::from(EXIT_FAILED);
         }
     };
     let mut analysis = StaticAnalysis::new(&model);
@@ -242,97 +195,39 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
             .expect("valid template")
             .progress_chars("=> "),
     );
-    let mut observer = RunObserver {
-        writer,
-        log,
+    let terminal = Terminal {
         bar,
         quiet,
         end_time: model.settings.end_time,
     };
-    observer.line(&format!(
-        "{}: {}; {} unknowns; {} analysis to t = {}",
-        path.display(),
-        describe(&model),
-        analysis.n_equations(),
-        if model.settings.kinematic {
-            "kinematic"
-        } else {
-            "static"
-        },
-        model.settings.end_time
-    ));
-    let outcome = analysis.run(&mut observer);
-    observer.bar.finish_and_clear();
-
-    let ok = outcome.error.is_none();
-    let message = outcome.error.as_ref().map(|e| e.to_string());
-    let summary = Summary {
-        model: path.display().to_string(),
-        title: model.title.clone(),
-        status: if ok { "completed" } else { "failed" }.into(),
-        message: message.clone(),
-        nodes: model.n_nodes(),
-        elements: model
-            .elements
-            .iter()
-            .filter(|e| e.kind() != ElementKind::NodalLoad)
-            .count(),
-        beams: model
-            .elements
-            .iter()
-            .filter(|e| e.kind() == ElementKind::Beam)
-            .count(),
-        joints: model
-            .elements
-            .iter()
-            .filter(|e| e.kind() == ElementKind::Joint)
-            .count(),
-        drivers: model
-            .elements
-            .iter()
-            .filter(|e| e.kind() == ElementKind::Driver)
-            .count(),
-        redundant_constraints: outcome.redundant_constraints,
-        dofs: analysis.n_equations(),
-        nonzeros: analysis.solver().nnz(),
-        increments: outcome.increments,
-        iterations: outcome.iterations,
-        average_iterations: if outcome.increments > 0 {
-            (outcome.iterations - observer.writer.log.first().map_or(0, |r| r.iterations)) as f64
-                / outcome.increments as f64
-        } else {
-            0.0
-        },
-        wasted_iterations: outcome.wasted_iterations,
-        cutbacks: outcome.cutbacks,
-        final_time: outcome.time,
-        end_time: model.settings.end_time,
-        wall_time_s: outcome.wall_time,
-        output_steps: observer.writer.output_steps(),
-        increment_log: observer.writer.log.clone(),
+    let label = path.display().to_string();
+    let mut recorder = match Recorder::create(out, &label, &model, &analysis, terminal) {
+        Ok(r) => r.with_stop(&stop).with_vtk_encoding(encoding),
+        Err(e) => {
+            eprintln!("error: cannot write results: {e}");
+            return ExitCode::from(EXIT_FAILED);
+        }
     };
-    let summary_written = observer.writer.write_summary(&summary);
-    let tail = format!(
-        "{}: {} increments, {} iterations ({:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
-        summary.status,
-        summary.increments,
-        summary.iterations,
-        summary.average_iterations,
-        summary.cutbacks,
-        summary.final_time,
-        summary.wall_time_s,
-        out.display()
-    );
-    let _ = writeln!(observer.log, "{tail}");
-    let _ = observer.log.flush();
-    println!("{tail}");
-    if let Some(m) = message {
-        eprintln!("error: {}: {m}", path.display());
+    let outcome = analysis.run(&mut recorder);
+    let report = recorder.finish(&outcome);
+
+    for e in &report.output_errors {
+        eprintln!("error: cannot write results: {e}");
+    }
+    if let Some(i) = report.interrupted {
+        eprintln!(
+            "{}: {i} at t = {}; results up to it are kept in {}",
+            path.display(),
+            outcome.time,
+            out.display()
+        );
+        return ExitCode::from(i.exit_code());
+    }
+    if let Some(e) = &outcome.error {
+        eprintln!("error: {}: {e}", path.display());
         // a model that is singular from the start is invalid input
-        if let Some(
-            StaticError::Initial(NewtonFailure::Singular { .. })
-            | StaticError::Indeterminate { .. },
-        ) = outcome.error
+        if let StaticError::Initial(NewtonFailure::Singular { .. })
+        | StaticError::Indeterminate { .. } = e
         {
             return ExitCode::from(EXIT_INPUT);
         }
@@ -343,8 +238,7 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
         );
         return ExitCode::from(EXIT_FAILED);
     }
-    if let Err(e) = summary_written {
-        eprintln!("error: {}: cannot write summary.json: {e}", out.display());
+    if !report.output_errors.is_empty() {
         return ExitCode::from(EXIT_FAILED);
     }
     ExitCode::SUCCESS

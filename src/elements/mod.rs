@@ -164,6 +164,18 @@ pub enum ExtraKind {
     Coordinate,
 }
 
+/// A point an element attaches to one of its nodes or to the ground (see
+/// [`Element::attachments`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attachment {
+    /// The node carrying it; `None` for the ground.
+    pub node: Option<usize>,
+    /// Where it is, global frame.
+    pub point: Vec3,
+    /// The axes it carries (columns), global frame.
+    pub axes: crate::so3::Mat3,
+}
+
 /// Where an element writes its contributions.
 pub struct ElementOutput<'a> {
     /// Local residual `f_int − f_ext`, length `n = 6·nodes + extra`.
@@ -233,6 +245,11 @@ pub trait Element: Send + Sync {
     fn strain_energy(&self, _ctx: &EvalContext, _state: &State) -> f64 {
         0.0
     }
+
+    /// Points of the element carried by its nodes (joint points), for
+    /// drawing: each is drawn joined to its node, so that a rigid link is
+    /// seen from its node to its joints. Appended to `out`.
+    fn attachments(&self, _state: &State, _out: &mut Vec<Attachment>) {}
 
     /// How the element is drawn in VTK files.
     fn cell_shape(&self) -> CellShape {

@@ -4,11 +4,15 @@
 //!   errors that name the file, the entity and the problem;
 //! - [`results`]: writes per-step CSV histories, `summary.json`, and VTK
 //!   files through an [`crate::analysis::Observer`];
+//! - [`run`]: the record of a whole run (results, `log.txt`, summary,
+//!   stopping on a signal), shared by the command-line tool and the
+//!   programs that use the library;
 //! - [`vtk`]: the VTK unstructured-grid (`.vtu`) and collection (`.pvd`)
 //!   writers;
-//! - [`plot`]: line charts as SVG files (result histories).
+//! - [`plot`]: line charts of result histories, as SVG and PNG files.
 
 pub mod model_file;
 pub mod plot;
 pub mod results;
+pub mod run;
 pub mod vtk;

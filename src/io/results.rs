@@ -5,31 +5,70 @@
 //! - `springs.csv`: force and deformation of every spring;
 //! - `reactions.csv`: support reactions (forces and moments, global frame);
 //! - `joints.csv`: relative coordinates of every joint and the load it
-//!   applies to its first body, in the joint axes;
-//! - `drivers.csv`: driven coordinate, its target and the actuator load;
+//!   applies to its first body, in the joint axes and in the global axes;
+//! - `drivers.csv`: driven coordinate, its target, the actuator load and
+//!   the load on the driven body (global axes);
 //! - `joint_springs.csv`: coordinate, rate and force of joint springs and
 //!   dampers;
 //! - `steps.csv`: one line per output step (increment, load parameter,
 //!   iterations, final relative residual);
 //! - `vtk/step_NNNNN.vtu` and `unfold.pvd`: the configurations for ParaView;
-//! - `summary.json`: size of the model, counts, wall time and status,
-//!   written at the end (also after a failure).
+//! - `summary.json`: size of the model, counts, wall time and status.
 //!
-//! Each step is appended and flushed as soon as it converges, so a run that
-//! stops early keeps everything written before.
+//! Rows of a step are in increasing node or element id.
+//!
+//! **One step is all or nothing.** A step is formatted in memory, then its
+//! grid is written (to a temporary file renamed into place), then its rows
+//! are appended to every CSV file, and last the collection `unfold.pvd`
+//! that lists the grids is replaced. If any of these writes fails (a full
+//! disk), the CSV files are cut back to their length before the step and
+//! the grid is removed, so every file holds the same steps; the error
+//! names the file.
+//!
+//! **The directory belongs to one run.** A lock file (`.unfold.lock`) is
+//! held for the life of the writer: a second run on the same directory is
+//! refused. Files that unfold writes ([`OWNED_FILES`], `vtk/step_*.vtu`)
+//! and that this run will not rewrite are removed when it starts, so that
+//! no result of an earlier model is left beside the new ones; other files
+//! are left alone.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{self, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
 use super::vtk;
-use crate::analysis::{IncrementInfo, Observer};
+use crate::analysis::{IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
 use crate::elements::ElementKind;
 use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
+
+/// Result files in the output directory that unfold writes (besides the
+/// grids `vtk/step_NNNNN.vtu`). A run removes those of them it will not
+/// rewrite, and their temporary files (`NAME.tmp`).
+pub const OWNED_FILES: [&str; 11] = [
+    "log.txt",
+    "steps.csv",
+    "nodes.csv",
+    "beams.csv",
+    "springs.csv",
+    "reactions.csv",
+    "joints.csv",
+    "drivers.csv",
+    "joint_springs.csv",
+    "unfold.pvd",
+    "summary.json",
+];
+
+/// The lock file of an output directory.
+pub const LOCK_FILE: &str = ".unfold.lock";
+
+/// `e`, with the file's name in front of its message.
+pub fn file_error(path: &Path, e: io::Error) -> io::Error {
+    io::Error::new(e.kind(), format!("{}: {e}", path.display()))
+}
 
 /// Per-increment record kept for `summary.json`.
 #[derive(Clone, Debug, Serialize)]
@@ -46,6 +85,35 @@ pub struct IncrementRecord {
     pub residuals: Vec<f64>,
 }
 
+/// Where a run stands, as written in `summary.json`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RunStatus {
+    /// Written when the run starts. Left in place, it means that the
+    /// process ended without writing its final summary (killed, or its
+    /// summary could not be written).
+    Running,
+    /// The analysis reached `end_time`.
+    Completed,
+    /// The analysis stopped early: no convergence, inconsistent
+    /// constraints, or a result file could not be written.
+    Failed,
+    /// Stopped on request (a signal) after a converged increment.
+    Interrupted,
+}
+
+impl RunStatus {
+    /// The name written in `summary.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Running => "running",
+            Self::Completed => "completed",
+            Self::Failed => "failed",
+            Self::Interrupted => "interrupted",
+        }
+    }
+}
+
 /// Final report of a run, written as `summary.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -53,9 +121,9 @@ pub struct Summary {
     pub model: String,
     /// Model title.
     pub title: String,
-    /// `"completed"` or `"failed"`.
-    pub status: String,
-    /// Error message when failed.
+    /// Where the run stands.
+    pub status: RunStatus,
+    /// Error message when failed, the reason when interrupted.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub message: Option<String>,
     /// Number of nodes.
@@ -96,106 +164,308 @@ pub struct Summary {
     pub increment_log: Vec<IncrementRecord>,
 }
 
+impl Summary {
+    /// The summary of a run of `model` (read from `model_file`) that has
+    /// not started: status `running`, counts of the model, no increment.
+    pub fn start(model_file: &str, model: &Model, analysis: &StaticAnalysis) -> Self {
+        let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
+        Self {
+            model: model_file.to_string(),
+            title: model.title.clone(),
+            status: RunStatus::Running,
+            message: None,
+            nodes: model.n_nodes(),
+            elements: model.elements.len() - count(ElementKind::NodalLoad),
+            beams: count(ElementKind::Beam),
+            joints: count(ElementKind::Joint),
+            drivers: count(ElementKind::Driver),
+            redundant_constraints: 0,
+            dofs: analysis.n_equations(),
+            nonzeros: analysis.solver().nnz(),
+            increments: 0,
+            iterations: 0,
+            average_iterations: 0.0,
+            wasted_iterations: 0,
+            cutbacks: 0,
+            final_time: 0.0,
+            end_time: model.settings.end_time,
+            wall_time_s: 0.0,
+            output_steps: 0,
+            increment_log: Vec::new(),
+        }
+    }
+
+    /// Fills in what the analysis did (`outcome`), the increments recorded
+    /// by `writer`, and the final status.
+    pub fn finish(
+        &mut self,
+        outcome: &StaticOutcome,
+        writer: &ResultWriter,
+        status: RunStatus,
+        message: Option<String>,
+    ) {
+        self.status = status;
+        self.message = message;
+        self.redundant_constraints = outcome.redundant_constraints;
+        self.increments = outcome.increments;
+        self.iterations = outcome.iterations;
+        // the initial equilibrium is not an increment
+        self.average_iterations = if outcome.increments > 0 {
+            (outcome.iterations - writer.log.first().map_or(0, |r| r.iterations)) as f64
+                / outcome.increments as f64
+        } else {
+            0.0
+        };
+        self.wasted_iterations = outcome.wasted_iterations;
+        self.cutbacks = outcome.cutbacks;
+        self.final_time = outcome.time;
+        self.wall_time_s = outcome.wall_time;
+        self.output_steps = writer.output_steps();
+        self.increment_log = writer.log.clone();
+    }
+}
+
+/// A lock held on an output directory for the life of a run (an advisory
+/// lock on `.unfold.lock`, released by the system when the process ends,
+/// however it ends).
+#[derive(Debug)]
+pub struct DirectoryLock {
+    _file: File,
+}
+
+impl DirectoryLock {
+    /// Locks `dir`, or fails with [`io::ErrorKind::ResourceBusy`] if
+    /// another run holds it.
+    pub fn acquire(dir: &Path) -> io::Result<Self> {
+        let path = dir.join(LOCK_FILE);
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(|e| file_error(&path, e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let owner = std::fs::read_to_string(&path).unwrap_or_default();
+                let owner = owner.trim();
+                let by = if owner.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (process {owner})")
+                };
+                return Err(io::Error::new(
+                    io::ErrorKind::ResourceBusy,
+                    format!(
+                        "{}: another run is writing its results there{by}; wait for it to end or choose another output directory",
+                        dir.display()
+                    ),
+                ));
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(file_error(&path, e)),
+        }
+        // the owner, for the message above (best effort)
+        let _ = file
+            .set_len(0)
+            .and_then(|()| write!(file, "{}", std::process::id()));
+        Ok(Self { _file: file })
+    }
+}
+
+/// A CSV file written one step at a time: the rows of a step are gathered
+/// in `pending`, appended by [`Self::append`], and kept by
+/// [`Self::settle`] or cut off by [`Self::rollback`].
+struct CsvFile {
+    path: PathBuf,
+    file: File,
+    /// Length of the file after the last settled step.
+    settled: u64,
+    /// Rows of the step being written.
+    pending: String,
+}
+
+impl CsvFile {
+    fn create(path: PathBuf, header: &str) -> io::Result<Self> {
+        let mut file = File::create(&path).map_err(|e| file_error(&path, e))?;
+        let line = format!("{header}\n");
+        file.write_all(line.as_bytes())
+            .map_err(|e| file_error(&path, e))?;
+        Ok(Self {
+            path,
+            file,
+            settled: line.len() as u64,
+            pending: String::new(),
+        })
+    }
+
+    fn append(&mut self) -> io::Result<()> {
+        self.file
+            .write_all(self.pending.as_bytes())
+            .map_err(|e| file_error(&self.path, e))
+    }
+
+    fn settle(&mut self) {
+        self.settled += self.pending.len() as u64;
+        self.pending.clear();
+    }
+
+    /// Cuts the file back to its last settled step (best effort: it only
+    /// shortens the file, which needs no space).
+    fn rollback(&mut self) {
+        self.pending.clear();
+        let _ = self.file.set_len(self.settled);
+        let _ = self.file.seek(SeekFrom::Start(self.settled));
+    }
+}
+
+/// The CSV file of the results of one kind of element.
+struct ElementTable {
+    kind: ElementKind,
+    file: CsvFile,
+    /// Elements (indices in `model.elements`) in increasing id.
+    elements: Vec<usize>,
+    /// Number of result values.
+    width: usize,
+}
+
+/// File name and id column of the result table of each kind of element.
+const TABLES: [(ElementKind, &str, &str); 5] = [
+    (ElementKind::Beam, "beams.csv", "element"),
+    (ElementKind::Spring, "springs.csv", "element"),
+    (ElementKind::Joint, "joints.csv", "joint"),
+    (ElementKind::Driver, "drivers.csv", "driver"),
+    (ElementKind::JointSpring, "joint_springs.csv", "element"),
+];
+
 /// Writes result files as the analysis converges.
 pub struct ResultWriter {
     dir: PathBuf,
-    nodes: BufWriter<File>,
-    beams: Option<BufWriter<File>>,
-    springs: Option<BufWriter<File>>,
-    joints: Option<BufWriter<File>>,
-    drivers: Option<BufWriter<File>>,
-    joint_springs: Option<BufWriter<File>>,
-    reactions: Option<BufWriter<File>>,
-    steps: BufWriter<File>,
-    pvd: Vec<(f64, String)>,
-    /// Supported nodes (index), for reactions.
+    _lock: DirectoryLock,
+    encoding: vtk::Encoding,
+    nodes: CsvFile,
+    /// Node indices in increasing id.
+    node_order: Vec<usize>,
+    steps: CsvFile,
+    reactions: Option<CsvFile>,
+    /// Supported nodes (indices) in increasing id, for reactions.
     supported: Vec<usize>,
+    tables: Vec<ElementTable>,
+    pvd: Vec<(f64, String)>,
     /// Every converged increment, for the summary.
     pub log: Vec<IncrementRecord>,
 }
 
-fn csv(path: &Path, header: &str) -> std::io::Result<BufWriter<File>> {
-    let mut w = BufWriter::new(File::create(path)?);
-    writeln!(w, "{header}")?;
-    Ok(w)
+/// Removes `path` if it exists.
+fn remove_if_present(path: &Path) -> io::Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != io::ErrorKind::NotFound => Err(file_error(path, e)),
+        _ => Ok(()),
+    }
+}
+
+/// Whether `name` is a grid of a step, or the temporary file of one.
+fn is_step_grid(name: &str) -> bool {
+    name.starts_with("step_") && (name.ends_with(".vtu") || name.ends_with(".tmp"))
 }
 
 impl ResultWriter {
-    /// Creates `dir` (and `dir/vtk`) and the CSV files with their headers.
-    /// Grids left in `dir/vtk` by an earlier run are removed, so that the
-    /// directory holds one run only.
-    pub fn create(dir: &Path, model: &Model) -> std::io::Result<Self> {
+    /// Locks `dir` (creating it and `dir/vtk`), removes the result files
+    /// of an earlier run that this one will not rewrite (see the module
+    /// documentation), and creates the CSV files with their headers.
+    pub fn create(dir: &Path, model: &Model) -> io::Result<Self> {
         let vtk_dir = dir.join("vtk");
-        std::fs::create_dir_all(&vtk_dir)?;
-        for entry in std::fs::read_dir(&vtk_dir)? {
-            let path = entry?.path();
+        std::fs::create_dir_all(&vtk_dir).map_err(|e| file_error(&vtk_dir, e))?;
+        let lock = DirectoryLock::acquire(dir)?;
+
+        // what this run writes
+        let has = |k: ElementKind| model.elements.iter().any(|e| e.kind() == k);
+        let supported = {
+            let mut s: Vec<usize> = (0..model.n_nodes())
+                .filter(|&i| model.fixed[i].iter().any(|&f| f))
+                .collect();
+            s.sort_by_key(|&i| model.node_ids[i]);
+            s
+        };
+        let writes = |name: &str| match name {
+            "reactions.csv" => !supported.is_empty(),
+            // written again by whoever writes the summary
+            "summary.json" => false,
+            _ => TABLES.iter().find(|t| t.1 == name).is_none_or(|t| has(t.0)),
+        };
+
+        // leftovers of an earlier run
+        for name in OWNED_FILES {
+            if !writes(name) {
+                remove_if_present(&dir.join(name))?;
+            }
+            remove_if_present(&dir.join(format!("{name}.tmp")))?;
+        }
+        // the temporary collection of earlier versions
+        remove_if_present(&dir.join("unfold.tmp"))?;
+        let entries = std::fs::read_dir(&vtk_dir).map_err(|e| file_error(&vtk_dir, e))?;
+        for entry in entries {
+            let path = entry.map_err(|e| file_error(&vtk_dir, e))?.path();
             let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-            if name.starts_with("step_") && name.ends_with(".vtu") {
-                std::fs::remove_file(&path)?;
+            if is_step_grid(name) {
+                remove_if_present(&path)?;
             }
         }
-        let _ = std::fs::remove_file(dir.join("summary.json"));
-        let has = |k: ElementKind| model.elements.iter().any(|e| e.kind() == k);
-        let supported: Vec<usize> = (0..model.n_nodes())
-            .filter(|&i| model.fixed[i].iter().any(|&f| f))
-            .collect();
+
+        let mut node_order: Vec<usize> = (0..model.n_nodes()).collect();
+        node_order.sort_by_key(|&i| model.node_ids[i]);
+        let mut tables = Vec::new();
+        for (kind, name, id_column) in TABLES {
+            let mut elements: Vec<usize> = (0..model.elements.len())
+                .filter(|&k| model.elements[k].kind() == kind)
+                .collect();
+            let Some(&first) = elements.first() else {
+                continue;
+            };
+            elements.sort_by_key(|&k| model.elements[k].id());
+            let names = model.elements[first].result_names();
+            tables.push(ElementTable {
+                kind,
+                file: CsvFile::create(
+                    dir.join(name),
+                    &format!("step,time,{id_column},{}", names.join(",")),
+                )?,
+                elements,
+                width: names.len(),
+            });
+        }
         Ok(Self {
             dir: dir.to_path_buf(),
-            nodes: csv(
-                &dir.join("nodes.csv"),
+            _lock: lock,
+            encoding: vtk::Encoding::default(),
+            nodes: CsvFile::create(
+                dir.join("nodes.csv"),
                 "step,time,node,x,y,z,ux,uy,uz,qw,qx,qy,qz",
             )?,
-            beams: has(ElementKind::Beam)
-                .then(|| csv(&dir.join("beams.csv"), "step,time,element,N,V2,V3,T,M2,M3"))
-                .transpose()?,
-            springs: has(ElementKind::Spring)
-                .then(|| {
-                    csv(
-                        &dir.join("springs.csv"),
-                        "step,time,element,F1,F2,F3,D1,D2,D3",
-                    )
-                })
-                .transpose()?,
-            joints: has(ElementKind::Joint)
-                .then(|| {
-                    csv(
-                        &dir.join("joints.csv"),
-                        "step,time,joint,c1,c2,c3,F1,F2,F3,M1,M2,M3",
-                    )
-                })
-                .transpose()?,
-            drivers: has(ElementKind::Driver)
-                .then(|| {
-                    csv(
-                        &dir.join("drivers.csv"),
-                        "step,time,driver,coordinate,target,load",
-                    )
-                })
-                .transpose()?,
-            joint_springs: has(ElementKind::JointSpring)
-                .then(|| {
-                    csv(
-                        &dir.join("joint_springs.csv"),
-                        "step,time,element,coordinate,rate,spring,damper",
-                    )
-                })
-                .transpose()?,
+            node_order,
+            steps: CsvFile::create(
+                dir.join("steps.csv"),
+                "step,increment,time,step_size,iterations,relative_residual",
+            )?,
             reactions: (!supported.is_empty())
                 .then(|| {
-                    csv(
-                        &dir.join("reactions.csv"),
+                    CsvFile::create(
+                        dir.join("reactions.csv"),
                         "step,time,node,Fx,Fy,Fz,Mx,My,Mz",
                     )
                 })
                 .transpose()?,
-            steps: csv(
-                &dir.join("steps.csv"),
-                "step,increment,time,step_size,iterations,relative_residual",
-            )?,
-            pvd: Vec::new(),
             supported,
+            tables,
+            pvd: Vec::new(),
             log: Vec::new(),
         })
+    }
+
+    /// Writes the grids in `encoding` (binary by default).
+    pub fn with_vtk_encoding(mut self, encoding: vtk::Encoding) -> Self {
+        self.encoding = encoding;
+        self
     }
 
     /// The output directory.
@@ -208,58 +478,65 @@ impl ResultWriter {
         self.pvd.len()
     }
 
-    /// Writes `summary.json`.
-    pub fn write_summary(&self, summary: &Summary) -> std::io::Result<()> {
-        let text = serde_json::to_string_pretty(summary).map_err(std::io::Error::other)?;
-        std::fs::write(self.dir.join("summary.json"), text + "\n")
+    /// Writes `summary.json` (through a temporary file, so that it is
+    /// never seen half written).
+    pub fn write_summary(&self, summary: &Summary) -> io::Result<()> {
+        let text = serde_json::to_string_pretty(summary).map_err(io::Error::other)?;
+        vtk::write_atomically(&self.dir.join("summary.json"), (text + "\n").as_bytes())
     }
 
-    fn write_step(
+    /// Every CSV file.
+    fn csv_files(&mut self) -> impl Iterator<Item = &mut CsvFile> {
+        [&mut self.nodes, &mut self.steps]
+            .into_iter()
+            .chain(self.reactions.as_mut())
+            .chain(self.tables.iter_mut().map(|t| &mut t.file))
+    }
+
+    /// Formats the rows of output step `step` into the files' pending
+    /// text.
+    fn format_step(
         &mut self,
+        step: usize,
         info: &IncrementInfo,
         model: &Model,
         state: &State,
         residual: &[f64],
-    ) -> std::io::Result<()> {
-        let step = self.pvd.len();
+    ) {
+        use std::fmt::Write as _;
         let t = info.time;
-        for i in 0..model.n_nodes() {
+        for &i in &self.node_order {
             let x = state.x[i];
             let u = x - model.reference_x[i];
             let q = state.q[i].quaternion();
-            writeln!(
-                self.nodes,
+            let _ = writeln!(
+                self.nodes.pending,
                 "{step},{t:.12e},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.15e},{:.15e},{:.15e},{:.15e}",
                 model.node_ids[i], x.x, x.y, x.z, u.x, u.y, u.z, q.w, q.i, q.j, q.k
-            )?;
+            );
         }
         let ctx = model.context(t, false);
-        let mut values = [0.0; 9];
-        for e in &model.elements {
-            let file = match e.kind() {
-                ElementKind::Beam => self.beams.as_mut(),
-                ElementKind::Spring => self.springs.as_mut(),
-                ElementKind::Joint => self.joints.as_mut(),
-                ElementKind::Driver => self.drivers.as_mut(),
-                ElementKind::JointSpring => self.joint_springs.as_mut(),
-                _ => None,
-            };
-            if let Some(w) = file {
-                let n = e.result_names().len();
-                e.results(&ctx, state, &mut values[..n]);
-                write!(w, "{step},{t:.12e},{}", e.id())?;
-                for v in &values[..n] {
+        let mut values = Vec::new();
+        for table in &mut self.tables {
+            values.resize(table.width, 0.0);
+            for &k in &table.elements {
+                let e = &model.elements[k];
+                debug_assert_eq!(e.kind(), table.kind);
+                e.results(&ctx, state, &mut values);
+                let w = &mut table.file.pending;
+                let _ = write!(w, "{step},{t:.12e},{}", e.id());
+                for v in &values {
                     // absent quantities (a joint with fewer coordinates) are empty
                     if v.is_nan() {
-                        write!(w, ",")?;
+                        w.push(',');
                     } else {
-                        write!(w, ",{v:.9e}")?;
+                        let _ = write!(w, ",{v:.9e}");
                     }
                 }
-                writeln!(w)?;
+                w.push('\n');
             }
         }
-        if let Some(w) = self.reactions.as_mut() {
+        if let Some(file) = self.reactions.as_mut() {
             for &i in &self.supported {
                 let f = Vec3::new(residual[6 * i], residual[6 * i + 1], residual[6 * i + 2]);
                 // the rotational residual is conjugate to material rotations
@@ -269,40 +546,60 @@ impl ResultWriter {
                     residual[6 * i + 5],
                 );
                 let m = so3::matrix(&state.q[i]) * m_mat;
-                writeln!(
-                    w,
+                let _ = writeln!(
+                    file.pending,
                     "{step},{t:.12e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
                     model.node_ids[i], f.x, f.y, f.z, m.x, m.y, m.z
-                )?;
+                );
             }
         }
-        writeln!(
-            self.steps,
+        let _ = writeln!(
+            self.steps.pending,
             "{step},{},{t:.12e},{:.6e},{},{:.3e}",
             info.increment,
             info.step,
             info.iterations,
             info.residuals.last().copied().unwrap_or(0.0)
-        )?;
-        for w in [
-            Some(&mut self.nodes),
-            Some(&mut self.steps),
-            self.beams.as_mut(),
-            self.springs.as_mut(),
-            self.joints.as_mut(),
-            self.drivers.as_mut(),
-            self.joint_springs.as_mut(),
-            self.reactions.as_mut(),
-        ]
-        .into_iter()
-        .flatten()
-        {
-            w.flush()?;
-        }
+        );
+    }
+
+    /// Writes one output step to every file, or to none (see the module
+    /// documentation).
+    fn write_step(
+        &mut self,
+        info: &IncrementInfo,
+        model: &Model,
+        state: &State,
+        residual: &[f64],
+    ) -> io::Result<()> {
+        let step = self.pvd.len();
+        self.format_step(step, info, model, state, residual);
         let name = format!("step_{step:05}.vtu");
-        vtk::write_vtu(&self.dir.join("vtk").join(&name), model, &ctx, state)?;
-        self.pvd.push((t, format!("vtk/{name}")));
-        vtk::write_pvd(&self.dir.join("unfold.pvd"), &self.pvd)
+        let grid = self.dir.join("vtk").join(&name);
+        let ctx = model.context(info.time, false);
+        if let Err(e) = vtk::write_vtu(&grid, model, &ctx, state, self.encoding) {
+            self.csv_files().for_each(CsvFile::rollback);
+            return Err(e);
+        }
+        let mut result = self.csv_files().try_for_each(|f| f.append());
+        if result.is_ok() {
+            self.pvd.push((info.time, format!("vtk/{name}")));
+            result = vtk::write_pvd(&self.dir.join("unfold.pvd"), &self.pvd);
+            if result.is_err() {
+                self.pvd.pop();
+            }
+        }
+        match result {
+            Ok(()) => {
+                self.csv_files().for_each(CsvFile::settle);
+                Ok(())
+            }
+            Err(e) => {
+                self.csv_files().for_each(CsvFile::rollback);
+                let _ = std::fs::remove_file(&grid);
+                Err(e)
+            }
+        }
     }
 }
 
@@ -313,7 +610,7 @@ impl Observer for ResultWriter {
         model: &Model,
         state: &State,
         reactions: &[f64],
-    ) -> std::io::Result<()> {
+    ) -> io::Result<()> {
         self.log.push(IncrementRecord {
             increment: info.increment,
             time: info.time,

@@ -1,50 +1,225 @@
-//! VTK XML writers for ParaView: one unstructured grid (`.vtu`, ASCII) per
-//! output step, gathered by a collection file (`.pvd`) whose time values are
-//! the load parameter.
+//! VTK XML writers for ParaView: one unstructured grid (`.vtu`) per output
+//! step, gathered by a collection file (`.pvd`) whose time values are the
+//! load parameter.
 //!
-//! Grid contents:
-//! - points: the nodes, with point data `node_id`, `displacement`
-//!   (from the reference) and `rotation` (rotation vector of `R R₀ᵀ`,
-//!   global frame);
+//! Encoding ([`Encoding`]): binary by default, as VTK writes it itself:
+//! every array in one `<AppendedData encoding="raw">` block, compressed
+//! with zlib (`compressor="vtkZLibDataCompressor"`, `header_type="UInt64"`).
+//! Each array there is a header of little-endian `u64`,
+//! `[blocks, block size, size of the last block (0 if full), compressed
+//! size of each block]`, then its blocks, each a zlib stream of up to
+//! [`BLOCK_SIZE`] bytes of little-endian values; the `offset` attribute of
+//! the `DataArray` counts from the byte after the `_` that opens the
+//! block. [`Encoding::Ascii`] writes every number as text instead.
+//!
+//! Grid contents (docs/results.md, "VTK files"):
+//! - points: the nodes, then the joint points (each joint's point on body
+//!   A, unless A is the ground, and on body B), with point data `node_id`
+//!   (−1 at joint points), `joint_id` (−1 at nodes), `displacement` (from
+//!   the reference), `rotation` (rotation vector of `R R₀ᵀ`, global frame;
+//!   at a joint point that of its node) and `axis_1`, `axis_2`, `axis_3`
+//!   (unit vectors: a node's material axes, a joint point's joint axes);
 //! - cells: beams and two-node springs as lines, rigid bodies, point masses
-//!   and springs to ground as vertices, with cell data `kind` (1 beam,
-//!   2 rigid body, 3 point mass, 4 spring, 6 constraint), `element_id`, the beam section
-//!   forces `N`, `V2`, `V3`, `T`, `M2`, `M3` (zero on other cells) and the
-//!   spring force and deformation `spring_F`, `spring_D` (zero on other
-//!   cells).
+//!   and springs to ground as vertices; for each joint, a line from each
+//!   of its nodes to its joint point on that node (a rigid link) and a
+//!   vertex at its point on body B (the joint marker). Cell data `kind`
+//!   (1 beam, 2 rigid body, 3 point mass, 4 spring, 7 joint, 10 rigid
+//!   link), `element_id`, the beam section forces `N`, `V2`, `V3`, `T`,
+//!   `M2`, `M3` (zero on other cells) and the spring force and deformation
+//!   `spring_F`, `spring_D` (zero on other cells).
 
 use std::fmt::Write as _;
-use std::io::Write as _;
-use std::path::Path;
+use std::io::{self, Write as _};
+use std::path::{Path, PathBuf};
 
-use crate::elements::{CellShape, ElementKind, EvalContext};
+use flate2::write::ZlibEncoder;
+use flate2::Compression;
+
+use super::results::file_error;
+use crate::elements::{Attachment, CellShape, ElementKind, EvalContext};
 use crate::model::Model;
-use crate::so3;
+use crate::so3::{self, Vec3};
 use crate::state::State;
 
 /// VTK cell type codes.
 const VTK_VERTEX: u8 = 1;
 const VTK_LINE: u8 = 3;
 
-fn data_array(
-    out: &mut String,
-    ty: &str,
-    name: &str,
-    components: usize,
-    values: impl Iterator<Item = String>,
-) {
-    let _ = write!(
-        out,
-        "        <DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{components}\" format=\"ascii\">\n         "
-    );
-    for (i, v) in values.enumerate() {
-        out.push(' ');
-        out.push_str(&v);
-        if i % 12 == 11 {
-            out.push_str("\n         ");
+/// Cell `kind` of a rigid link from a node to a joint point.
+pub const KIND_LINK: i32 = 10;
+
+/// Uncompressed size of a compressed block, bytes (VTK's default).
+pub const BLOCK_SIZE: usize = 1 << 15;
+
+/// How the arrays of a grid are written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Encoding {
+    /// Numbers as text (larger and slower; readable in an editor).
+    Ascii,
+    /// Raw appended data, zlib-compressed (see the module documentation).
+    #[default]
+    Binary,
+}
+
+/// A number type of a data array.
+trait Value: Copy {
+    /// VTK type name.
+    const TYPE: &'static str;
+    fn push_le(self, out: &mut Vec<u8>);
+    fn push_text(self, out: &mut String);
+}
+
+impl Value for f64 {
+    const TYPE: &'static str = "Float64";
+    fn push_le(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+    fn push_text(self, out: &mut String) {
+        // shortest text that reads back to the same number
+        let _ = write!(out, "{self:e}");
+    }
+}
+
+impl Value for i64 {
+    const TYPE: &'static str = "Int64";
+    fn push_le(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+    fn push_text(self, out: &mut String) {
+        let _ = write!(out, "{self}");
+    }
+}
+
+impl Value for i32 {
+    const TYPE: &'static str = "Int32";
+    fn push_le(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+    fn push_text(self, out: &mut String) {
+        let _ = write!(out, "{self}");
+    }
+}
+
+impl Value for u8 {
+    const TYPE: &'static str = "UInt8";
+    fn push_le(self, out: &mut Vec<u8>) {
+        out.push(self);
+    }
+    fn push_text(self, out: &mut String) {
+        let _ = write!(out, "{self}");
+    }
+}
+
+/// A VTK XML file being built: the XML text and, for binary encoding, the
+/// appended data.
+struct Document {
+    encoding: Encoding,
+    xml: String,
+    appended: Vec<u8>,
+    raw: Vec<u8>,
+}
+
+impl Document {
+    fn new(encoding: Encoding) -> Self {
+        Self {
+            encoding,
+            xml: String::new(),
+            appended: Vec::new(),
+            raw: Vec::new(),
         }
     }
-    out.push_str("\n        </DataArray>\n");
+
+    /// Adds a `DataArray` of `values` with `components` per tuple.
+    fn array<T: Value>(&mut self, name: &str, components: usize, values: &[T]) {
+        let _ = write!(
+            self.xml,
+            "        <DataArray type=\"{}\" Name=\"{name}\" NumberOfComponents=\"{components}\"",
+            T::TYPE
+        );
+        match self.encoding {
+            Encoding::Ascii => {
+                self.xml.push_str(" format=\"ascii\">\n         ");
+                for (i, v) in values.iter().enumerate() {
+                    self.xml.push(' ');
+                    v.push_text(&mut self.xml);
+                    if i % 12 == 11 {
+                        self.xml.push_str("\n         ");
+                    }
+                }
+                self.xml.push_str("\n        </DataArray>\n");
+            }
+            Encoding::Binary => {
+                let _ = writeln!(
+                    self.xml,
+                    " format=\"appended\" offset=\"{}\"/>",
+                    self.appended.len()
+                );
+                self.raw.clear();
+                for v in values {
+                    v.push_le(&mut self.raw);
+                }
+                compress_blocks(&self.raw, &mut self.appended);
+            }
+        }
+    }
+
+    /// The whole file.
+    fn finish(mut self) -> Vec<u8> {
+        if self.encoding == Encoding::Binary {
+            self.xml.push_str("  <AppendedData encoding=\"raw\">\n   _");
+        }
+        let mut bytes = self.xml.into_bytes();
+        if self.encoding == Encoding::Binary {
+            bytes.extend_from_slice(&self.appended);
+            bytes.extend_from_slice(b"\n  </AppendedData>\n");
+        }
+        bytes.extend_from_slice(b"</VTKFile>\n");
+        bytes
+    }
+}
+
+/// Appends `raw` to `out` as VTK compressed blocks: the `u64` header
+/// `[blocks, BLOCK_SIZE, last block size (0 if full), compressed sizes…]`
+/// then the zlib stream of each block. Level 1 (fast): on a grid of 20,000
+/// beams it writes in about the time of the ASCII text, 10 % larger than
+/// level 6 at half its time.
+fn compress_blocks(raw: &[u8], out: &mut Vec<u8>) {
+    let blocks: Vec<Vec<u8>> = raw
+        .chunks(BLOCK_SIZE)
+        .map(|chunk| {
+            let mut z = ZlibEncoder::new(Vec::with_capacity(chunk.len() / 2), Compression::fast());
+            // writing to a Vec cannot fail
+            let _ = z.write_all(chunk);
+            z.finish().unwrap_or_default()
+        })
+        .collect();
+    let last = raw.len() % BLOCK_SIZE;
+    let header = [blocks.len(), BLOCK_SIZE, last]
+        .into_iter()
+        .chain(blocks.iter().map(Vec::len));
+    for h in header {
+        out.extend_from_slice(&(h as u64).to_le_bytes());
+    }
+    for b in &blocks {
+        out.extend_from_slice(b);
+    }
+}
+
+/// The joint points of every element at `state`, with the element's
+/// index.
+fn attachments(model: &Model, state: &State) -> Vec<(usize, Attachment)> {
+    let mut all = Vec::new();
+    let mut one = Vec::new();
+    for (k, e) in model.elements.iter().enumerate() {
+        one.clear();
+        e.attachments(state, &mut one);
+        all.extend(one.iter().map(|a| (k, *a)));
+    }
+    all
+}
+
+fn push3(out: &mut Vec<f64>, v: &Vec3) {
+    out.extend_from_slice(&[v.x, v.y, v.z]);
 }
 
 /// Writes the grid of `state` to `path`.
@@ -53,33 +228,96 @@ pub fn write_vtu(
     model: &Model,
     ctx: &EvalContext,
     state: &State,
-) -> std::io::Result<()> {
-    // cells
-    let mut connectivity = Vec::new();
-    let mut offsets = Vec::new();
-    let mut types = Vec::new();
-    let mut kinds = Vec::new();
-    let mut ids = Vec::new();
-    let mut beam = Vec::new(); // 6 per cell
-    let mut spring = Vec::new(); // 6 per cell
-    let mut results = [0.0; 6];
-    for e in &model.elements {
-        let shape = e.cell_shape();
-        let nodes = e.nodes();
-        match shape {
-            CellShape::Line => {
-                connectivity.extend_from_slice(&nodes[..2]);
-                types.push(VTK_LINE);
-            }
-            CellShape::Vertex => {
-                connectivity.push(nodes[0]);
-                types.push(VTK_VERTEX);
-            }
-            CellShape::None => continue,
+    encoding: Encoding,
+) -> io::Result<()> {
+    let n_nodes = model.n_nodes();
+    let joints = attachments(model, state);
+    let joints_at_reference = if joints.is_empty() {
+        Vec::new()
+    } else {
+        attachments(model, &model.initial_state())
+    };
+
+    // points: nodes then joint points
+    let n_points = n_nodes + joints.len();
+    let mut position = Vec::with_capacity(3 * n_points);
+    let mut displacement = Vec::with_capacity(3 * n_points);
+    let mut rotation = Vec::with_capacity(3 * n_points);
+    let mut axes: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(3 * n_points));
+    let mut node_id: Vec<i64> = model.node_ids.iter().map(|&i| i as i64).collect();
+    let mut joint_id = vec![-1i64; n_nodes];
+    let node_rotation = |i: usize| so3::log(&(state.q[i] * model.reference_q[i].inverse()));
+    for i in 0..n_nodes {
+        push3(&mut position, &state.x[i]);
+        push3(&mut displacement, &(state.x[i] - model.reference_x[i]));
+        push3(&mut rotation, &node_rotation(i));
+        let r = so3::matrix(&state.q[i]);
+        for (c, a) in axes.iter_mut().enumerate() {
+            push3(a, &r.column(c).into_owned());
         }
-        offsets.push(connectivity.len());
-        kinds.push(e.kind().code());
-        ids.push(e.id());
+    }
+    for (j, (k, a)) in joints.iter().enumerate() {
+        push3(&mut position, &a.point);
+        let reference = joints_at_reference.get(j).map_or(a.point, |r| r.1.point);
+        push3(&mut displacement, &(a.point - reference));
+        push3(&mut rotation, &a.node.map_or(Vec3::zeros(), node_rotation));
+        for (c, ax) in axes.iter_mut().enumerate() {
+            push3(ax, &a.axes.column(c).into_owned());
+        }
+        node_id.push(-1);
+        joint_id.push(model.elements[*k].id() as i64);
+    }
+
+    // cells
+    let mut connectivity: Vec<i64> = Vec::new();
+    let mut offsets: Vec<i64> = Vec::new();
+    let mut types: Vec<u8> = Vec::new();
+    let mut kinds: Vec<i32> = Vec::new();
+    let mut ids: Vec<i64> = Vec::new();
+    let mut beam: Vec<[f64; 6]> = Vec::new();
+    let mut spring: Vec<[f64; 6]> = Vec::new();
+    let mut cell = |points: &[usize], kind: i32, id: i64, b: [f64; 6], s: [f64; 6]| {
+        connectivity.extend(points.iter().map(|&p| p as i64));
+        offsets.push(connectivity.len() as i64);
+        types.push(if points.len() == 2 {
+            VTK_LINE
+        } else {
+            VTK_VERTEX
+        });
+        kinds.push(kind);
+        ids.push(id);
+        beam.push(b);
+        spring.push(s);
+    };
+    let mut results = [0.0; 6];
+    let mut next_joint_point = n_nodes;
+    for (k, e) in model.elements.iter().enumerate() {
+        let id = e.id() as i64;
+        let nodes = e.nodes();
+        // joints: links from the nodes to the joint points, a marker at B's
+        let first = next_joint_point;
+        while next_joint_point < n_points && joints[next_joint_point - n_nodes].0 == k {
+            let a = &joints[next_joint_point - n_nodes].1;
+            if let Some(node) = a.node {
+                cell(&[node, next_joint_point], KIND_LINK, id, [0.0; 6], [0.0; 6]);
+            }
+            next_joint_point += 1;
+        }
+        if next_joint_point > first {
+            cell(
+                &[next_joint_point - 1],
+                e.kind().code(),
+                id,
+                [0.0; 6],
+                [0.0; 6],
+            );
+            continue;
+        }
+        let points = match e.cell_shape() {
+            CellShape::Line => &nodes[..2],
+            CellShape::Vertex => &nodes[..1],
+            CellShape::None => continue,
+        };
         results.fill(0.0);
         if matches!(e.kind(), ElementKind::Beam | ElementKind::Spring) {
             e.results(ctx, state, &mut results);
@@ -89,137 +327,67 @@ pub fn write_vtu(
             ElementKind::Spring => ([0.0; 6], results),
             _ => ([0.0; 6], [0.0; 6]),
         };
-        beam.extend_from_slice(&b);
-        spring.extend_from_slice(&s);
+        cell(points, e.kind().code(), id, b, s);
     }
-
-    let n_points = model.n_nodes();
     let n_cells = types.len();
-    let mut out = String::with_capacity(64 * n_points + 128 * n_cells + 1024);
-    out.push_str("<?xml version=\"1.0\"?>\n");
-    out.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
-    out.push_str("  <UnstructuredGrid>\n");
+
+    let mut doc = Document::new(encoding);
+    doc.xml.push_str("<?xml version=\"1.0\"?>\n");
+    doc.xml.push_str(
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"",
+    );
+    if encoding == Encoding::Binary {
+        doc.xml.push_str(" compressor=\"vtkZLibDataCompressor\"");
+    }
+    doc.xml.push_str(">\n  <UnstructuredGrid>\n");
     let _ = writeln!(
-        out,
+        doc.xml,
         "    <Piece NumberOfPoints=\"{n_points}\" NumberOfCells=\"{n_cells}\">"
     );
 
     // point data
-    out.push_str("      <PointData Scalars=\"node_id\" Vectors=\"displacement\">\n");
-    data_array(
-        &mut out,
-        "Int64",
-        "node_id",
-        1,
-        model.node_ids.iter().map(|i| i.to_string()),
-    );
-    data_array(
-        &mut out,
-        "Float64",
-        "displacement",
-        3,
-        (0..n_points).flat_map(|i| {
-            let u = state.x[i] - model.reference_x[i];
-            [u.x, u.y, u.z].map(|v| format!("{v:.9e}"))
-        }),
-    );
-    data_array(
-        &mut out,
-        "Float64",
-        "rotation",
-        3,
-        (0..n_points).flat_map(|i| {
-            let psi = so3::log(&(state.q[i] * model.reference_q[i].inverse()));
-            [psi.x, psi.y, psi.z].map(|v| format!("{v:.9e}"))
-        }),
-    );
-    out.push_str("      </PointData>\n");
+    doc.xml
+        .push_str("      <PointData Scalars=\"node_id\" Vectors=\"displacement\">\n");
+    doc.array("node_id", 1, &node_id);
+    doc.array("joint_id", 1, &joint_id);
+    doc.array("displacement", 3, &displacement);
+    doc.array("rotation", 3, &rotation);
+    for (c, a) in axes.iter().enumerate() {
+        doc.array(&format!("axis_{}", c + 1), 3, a);
+    }
+    doc.xml.push_str("      </PointData>\n");
 
     // cell data
-    out.push_str("      <CellData Scalars=\"kind\">\n");
-    data_array(
-        &mut out,
-        "Int32",
-        "kind",
-        1,
-        kinds.iter().map(|k| k.to_string()),
-    );
-    data_array(
-        &mut out,
-        "Int64",
-        "element_id",
-        1,
-        ids.iter().map(|k| k.to_string()),
-    );
+    doc.xml.push_str("      <CellData Scalars=\"kind\">\n");
+    doc.array("kind", 1, &kinds);
+    doc.array("element_id", 1, &ids);
+    let mut column = Vec::with_capacity(3 * n_cells);
     for (c, name) in ["N", "V2", "V3", "T", "M2", "M3"].iter().enumerate() {
-        data_array(
-            &mut out,
-            "Float64",
-            name,
-            1,
-            (0..n_cells).map(|k| format!("{:.9e}", beam[6 * k + c])),
-        );
+        column.clear();
+        column.extend(beam.iter().map(|b| b[c]));
+        doc.array(name, 1, &column);
     }
-    data_array(
-        &mut out,
-        "Float64",
-        "spring_F",
-        3,
-        (0..n_cells)
-            .flat_map(|k| (0..3).map(move |c| (k, c)))
-            .map(|(k, c)| format!("{:.9e}", spring[6 * k + c])),
-    );
-    data_array(
-        &mut out,
-        "Float64",
-        "spring_D",
-        3,
-        (0..n_cells)
-            .flat_map(|k| (3..6).map(move |c| (k, c)))
-            .map(|(k, c)| format!("{:.9e}", spring[6 * k + c])),
-    );
-    out.push_str("      </CellData>\n");
+    for (name, range) in [("spring_F", 0..3), ("spring_D", 3..6)] {
+        column.clear();
+        column.extend(spring.iter().flat_map(|s| s[range.clone()].iter().copied()));
+        doc.array(name, 3, &column);
+    }
+    doc.xml.push_str("      </CellData>\n");
 
     // geometry
-    out.push_str("      <Points>\n");
-    data_array(
-        &mut out,
-        "Float64",
-        "position",
-        3,
-        state
-            .x
-            .iter()
-            .flat_map(|x| [x.x, x.y, x.z].map(|v| format!("{v:.12e}"))),
-    );
-    out.push_str("      </Points>\n      <Cells>\n");
-    data_array(
-        &mut out,
-        "Int64",
-        "connectivity",
-        1,
-        connectivity.iter().map(|v| v.to_string()),
-    );
-    data_array(
-        &mut out,
-        "Int64",
-        "offsets",
-        1,
-        offsets.iter().map(|v| v.to_string()),
-    );
-    data_array(
-        &mut out,
-        "UInt8",
-        "types",
-        1,
-        types.iter().map(|v| v.to_string()),
-    );
-    out.push_str("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
-    write_atomically(path, out.as_bytes())
+    doc.xml.push_str("      <Points>\n");
+    doc.array("position", 3, &position);
+    doc.xml.push_str("      </Points>\n      <Cells>\n");
+    doc.array("connectivity", 1, &connectivity);
+    doc.array("offsets", 1, &offsets);
+    doc.array("types", 1, &types);
+    doc.xml
+        .push_str("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n");
+    write_atomically(path, &doc.finish())
 }
 
 /// Writes the collection file listing `(time, file name)` pairs.
-pub fn write_pvd(path: &Path, entries: &[(f64, String)]) -> std::io::Result<()> {
+pub fn write_pvd(path: &Path, entries: &[(f64, String)]) -> io::Result<()> {
     let mut out = String::from(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
     );
@@ -233,13 +401,23 @@ pub fn write_pvd(path: &Path, entries: &[(f64, String)]) -> std::io::Result<()> 
     write_atomically(path, out.as_bytes())
 }
 
+/// The temporary file of `path`: `NAME.tmp` beside it.
+fn temporary(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(".tmp");
+    path.with_file_name(name)
+}
+
 /// Writes to a temporary file then renames it, so a reader (or a crash)
-/// never sees a half-written file.
-fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension("tmp");
-    {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-    }
-    std::fs::rename(&tmp, path)
+/// never sees a half-written file. On failure the temporary file is
+/// removed and the error names `path`.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let tmp = temporary(path);
+    let result = std::fs::File::create(&tmp)
+        .and_then(|mut f| f.write_all(bytes))
+        .and_then(|()| std::fs::rename(&tmp, path));
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        file_error(path, e)
+    })
 }

@@ -20,6 +20,7 @@ use super::types::Equation;
 use crate::curves::CurveIndex;
 use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext, ExtraKind};
 use crate::model::input::Id;
+use crate::so3::{self, Vec3};
 use crate::state::State;
 
 /// A driven coordinate.
@@ -36,8 +37,20 @@ pub struct Driver {
     internal: usize,
 }
 
-/// Names of driver results.
-pub const DRIVER_RESULTS: [&str; 3] = ["coordinate", "target", "load"];
+/// Names of driver results: the coordinate, its target and the load along
+/// it, then the load on the driven body (body B, or the node of a node
+/// driver) as a force and a moment about its joint point, global axes.
+pub const DRIVER_RESULTS: [&str; 9] = [
+    "coordinate",
+    "target",
+    "load",
+    "Fx",
+    "Fy",
+    "Fz",
+    "Mx",
+    "My",
+    "Mz",
+];
 
 impl Driver {
     /// Drives `source` to `value·curves[curve](t)` (relative to the
@@ -91,6 +104,34 @@ impl Driver {
         } else {
             0.0
         }
+    }
+
+    /// Load the driver applies to the driven body (body B of the pair, or
+    /// the node of a node driver): force, and moment about B's joint
+    /// point, global frame. It is `−r_B`, the element's residual at B's
+    /// node, equal to `−Bᵀ(pΦ − kλ)` there.
+    pub fn load_on_driven_body(&self, ctx: &EvalContext, state: &State) -> (Vec3, Vec3) {
+        let mut r = vec![0.0; self.n_local()];
+        let c = EvalContext {
+            need_tangent: false,
+            ..*ctx
+        };
+        self.evaluate(
+            &c,
+            state,
+            &mut ElementOutput {
+                residual: &mut r,
+                tangent: &mut Vec::new(),
+            },
+        );
+        let nb = self.source.pair.node_b();
+        let node = self.source.nodes[nb];
+        let rb = so3::matrix(&state.q[node]);
+        let f = -Vec3::new(r[6 * nb], r[6 * nb + 1], r[6 * nb + 2]);
+        // the rotational residual is conjugate to material rotations
+        let m_node = rb * -Vec3::new(r[6 * nb + 3], r[6 * nb + 4], r[6 * nb + 5]);
+        let arm = rb * self.source.pair.b;
+        (f, m_node - arm.cross(&f))
     }
 
     /// Target value of the coordinate at `ctx.time` (while active).
@@ -180,19 +221,25 @@ impl Element for Driver {
     fn result_names(&self) -> &'static [&'static str] {
         &DRIVER_RESULTS
     }
+    /// Fills the first `out.len()` values of [`DRIVER_RESULTS`].
     fn results(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
-        let c = self.source.value(state, self.reference(state));
-        out[0] = c;
-        if !self.is_active(ctx.time) {
-            out[1] = f64::NAN;
-            out[2] = 0.0;
-            return;
+        let mut all = [0.0; DRIVER_RESULTS.len()];
+        all[0] = self.source.value(state, self.reference(state));
+        if self.is_active(ctx.time) {
+            let target = self.target(ctx, state);
+            let (k, p) = scale_of(&ctx.scaling, self.kind_of_equation());
+            all[1] = target;
+            // generalised load applied along the coordinate: −(pΦ − kλ)
+            all[2] = k * state.extra[self.extra] - p * (all[0] - target);
+            let (f, m) = self.load_on_driven_body(ctx, state);
+            all[3..6].copy_from_slice(f.as_slice());
+            all[6..9].copy_from_slice(m.as_slice());
+        } else {
+            // released: no target, no load
+            all[1] = f64::NAN;
         }
-        let target = self.target(ctx, state);
-        let (k, p) = scale_of(&ctx.scaling, self.kind_of_equation());
-        out[1] = target;
-        // generalised load applied along the coordinate: −(pΦ − kλ)
-        out[2] = k * state.extra[self.extra] - p * (c - target);
+        let n = out.len().min(all.len());
+        out[..n].copy_from_slice(&all[..n]);
     }
     fn cell_shape(&self) -> CellShape {
         CellShape::None

@@ -19,7 +19,8 @@ use super::types::{
     JointType,
 };
 use crate::elements::{
-    CellShape, ConstraintScaling, Element, ElementKind, ElementOutput, EvalContext, ExtraKind,
+    Attachment, CellShape, ConstraintScaling, Element, ElementKind, ElementOutput, EvalContext,
+    ExtraKind,
 };
 use crate::model::input::Id;
 use crate::so3::{self, Vec3};
@@ -295,8 +296,11 @@ impl Joint {
 
 /// Names of joint results: three coordinates (NaN when absent), then the
 /// load the joint applies to its first node, in the joint axes of body A
-/// (see [`Joint::reaction`] and [`Joint::axes`]).
-pub const JOINT_RESULTS: [&str; 9] = ["c1", "c2", "c3", "F1", "F2", "F3", "M1", "M2", "M3"];
+/// (see [`Joint::reaction`] and [`Joint::axes`]), then the same load in
+/// the global axes.
+pub const JOINT_RESULTS: [&str; 15] = [
+    "c1", "c2", "c3", "F1", "F2", "F3", "M1", "M2", "M3", "Fx", "Fy", "Fz", "Mx", "My", "Mz",
+];
 
 impl Element for Joint {
     fn kind(&self) -> ElementKind {
@@ -373,15 +377,43 @@ impl Element for Joint {
     fn result_names(&self) -> &'static [&'static str] {
         &JOINT_RESULTS
     }
+    /// Fills the first `out.len()` values of [`JOINT_RESULTS`].
     fn results(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
-        let mut c = [f64::NAN; 3];
-        self.coordinates(state, &mut c);
-        out[..3].copy_from_slice(&c);
+        let mut all = [f64::NAN; JOINT_RESULTS.len()];
+        self.coordinates(state, &mut all[..3]);
         let (f, m) = self.reaction(ctx, state);
         let e = self.axes(state);
         let (fl, ml) = (e.transpose() * f, e.transpose() * m);
-        out[3..6].copy_from_slice(fl.as_slice());
-        out[6..9].copy_from_slice(ml.as_slice());
+        all[3..6].copy_from_slice(fl.as_slice());
+        all[6..9].copy_from_slice(ml.as_slice());
+        all[9..12].copy_from_slice(f.as_slice());
+        all[12..15].copy_from_slice(m.as_slice());
+        let n = out.len().min(all.len());
+        out[..n].copy_from_slice(&all[..n]);
+    }
+    /// The joint point and axes of body A (unless it is the ground) and
+    /// of body B; a slider's joint point on its sliding node.
+    fn attachments(&self, state: &State, out: &mut Vec<Attachment>) {
+        let on = |node: usize, offset: &Vec3, axes: &so3::Mat3| {
+            let r = so3::matrix(&state.q[node]);
+            Attachment {
+                node: Some(node),
+                point: state.x[node] + r * offset,
+                axes: r * axes,
+            }
+        };
+        if self.joint_type == JointType::Slider {
+            out.push(on(self.nodes[0], &self.pair.a, &self.pair.ea));
+            return;
+        }
+        if self.pair.ground.is_none() {
+            out.push(on(self.nodes[0], &self.pair.a, &self.pair.ea));
+        }
+        out.push(on(
+            self.nodes[self.pair.node_b()],
+            &self.pair.b,
+            &self.pair.eb,
+        ));
     }
     fn cell_shape(&self) -> CellShape {
         if self.nodes.len() >= 2 {

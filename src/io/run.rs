@@ -1,0 +1,485 @@
+//! A run's record: the result files ([`super::results`]), `log.txt` and
+//! `summary.json`, written by one [`Recorder`] for the command-line tool
+//! and for programs that build their model with the library.
+//!
+//! ```no_run
+//! # use unfold::analysis::StaticAnalysis;
+//! # use unfold::io::run::{Recorder, Silent};
+//! # fn run(model: &unfold::model::Model) -> std::io::Result<()> {
+//! let mut analysis = StaticAnalysis::new(model);
+//! let mut recorder = Recorder::create("results/x".as_ref(), "x.toml", model, &analysis, Silent)?;
+//! let outcome = analysis.run(&mut recorder);
+//! let report = recorder.finish(&outcome);
+//! # Ok(()) }
+//! ```
+//!
+//! Stopping: a [`StopRequest`] shared with the recorder (set by
+//! [`stop_on_signals`] on SIGINT, SIGTERM or SIGHUP) makes it write the
+//! increment that has just converged as an output step, then stop the
+//! analysis with an [`Interrupted`] error; the summary then says
+//! `interrupted`. A step is never split between files: the request is
+//! looked at between increments, and a second signal, which ends the
+//! process at once, waits for the step being written.
+//!
+//! The library never prints: what a person should see goes to a
+//! [`Console`], which the caller provides.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicI32, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use super::results::{file_error, ResultWriter, RunStatus, Summary};
+use super::vtk::Encoding;
+use crate::analysis::statics::StaticError;
+use crate::analysis::{
+    CutbackInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome,
+};
+use crate::elements::ElementKind;
+use crate::model::Model;
+use crate::state::State;
+
+/// What a person watching the run sees. Every method has an empty
+/// default.
+pub trait Console {
+    /// A line of the log worth showing: an increment, a cut-back, a note.
+    fn line(&mut self, _text: &str) {}
+    /// After each converged increment.
+    fn progress(&mut self, _info: &IncrementInfo) {}
+    /// The last line of the run (status, counts, where the results are).
+    fn finish(&mut self, _text: &str) {}
+}
+
+/// A console that shows nothing.
+pub struct Silent;
+
+impl Console for Silent {}
+
+/// A request to stop a run between increments, shared between the thread
+/// that asks (a signal handler) and the [`Recorder`]. It also guards the
+/// writing of a step: [`StopRequest::output`] is held while a step is
+/// written.
+#[derive(Clone, Debug, Default)]
+pub struct StopRequest {
+    inner: Arc<StopInner>,
+}
+
+#[derive(Debug, Default)]
+struct StopInner {
+    /// 0: none; −1: asked without a signal; otherwise the signal number.
+    signal: AtomicI32,
+    output: Mutex<()>,
+}
+
+impl StopRequest {
+    /// No stop requested.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Asks the run to stop, because of `signal` (its number) if any.
+    /// Only the first request counts.
+    pub fn request(&self, signal: Option<i32>) {
+        let _ = self.inner.signal.compare_exchange(
+            0,
+            signal.unwrap_or(-1),
+            Ordering::SeqCst,
+            Ordering::SeqCst,
+        );
+    }
+
+    /// Whether a stop was requested, and by which signal.
+    pub fn requested(&self) -> Option<Interrupted> {
+        match self.inner.signal.load(Ordering::SeqCst) {
+            0 => None,
+            -1 => Some(Interrupted { signal: None }),
+            s => Some(Interrupted { signal: Some(s) }),
+        }
+    }
+
+    /// Held while a step is being written.
+    pub fn output(&self) -> MutexGuard<'_, ()> {
+        self.inner
+            .output
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+}
+
+/// The error with which a recorder stops an analysis on request.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Interrupted {
+    /// The signal that asked for it.
+    pub signal: Option<i32>,
+}
+
+impl Interrupted {
+    /// The exit status of a process stopped this way: `128 + signal`
+    /// (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP), as shells
+    /// report a process killed by the signal; 1 without a signal.
+    pub fn exit_code(&self) -> u8 {
+        self.signal
+            .and_then(|s| u8::try_from(128 + s).ok())
+            .unwrap_or(1)
+    }
+
+    /// The interruption behind a stopped analysis, if that is why it
+    /// stopped.
+    pub fn of(error: &StaticError) -> Option<Self> {
+        match error {
+            StaticError::Output(e) => e.get_ref()?.downcast_ref::<Self>().copied(),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.signal {
+            Some(s) => write!(f, "interrupted by {}", signal_name(s)),
+            None => write!(f, "interrupted"),
+        }
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+/// The usual name of a signal number.
+pub fn signal_name(signal: i32) -> String {
+    match signal {
+        1 => "SIGHUP".into(),
+        2 => "SIGINT".into(),
+        15 => "SIGTERM".into(),
+        s => format!("signal {s}"),
+    }
+}
+
+/// What a signal handler installed by [`stop_on_signals`] reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SignalEvent {
+    /// A first signal: the run will stop after the current increment.
+    Stopping(i32),
+    /// A second signal: the process ends now, with status `128 + signal`,
+    /// once the step being written (if any) is complete.
+    Ending(i32),
+}
+
+/// Handles SIGINT, SIGTERM and SIGHUP from now on (Unix): the first sets
+/// `stop`, a second ends the process at once (status `128 + signal`)
+/// after the step being written. `report` is called on each, from the
+/// handling thread. It also makes a write past the file-size limit
+/// (`ulimit -f`) fail with an error instead of killing the process
+/// (SIGXFSZ).
+#[cfg(unix)]
+pub fn stop_on_signals(
+    stop: &StopRequest,
+    report: impl Fn(SignalEvent) + Send + 'static,
+) -> io::Result<()> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM, SIGXFSZ};
+    signal_hook::flag::register(SIGXFSZ, Arc::new(std::sync::atomic::AtomicBool::new(false)))?;
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])?;
+    let stop = stop.clone();
+    std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            for signal in signals.forever() {
+                if stop.requested().is_none() {
+                    stop.request(Some(signal));
+                    report(SignalEvent::Stopping(signal));
+                } else {
+                    report(SignalEvent::Ending(signal));
+                    let _writing = stop.output();
+                    std::process::exit(128 + signal);
+                }
+            }
+        })?;
+    Ok(())
+}
+
+/// Without Unix signals, nothing is installed.
+#[cfg(not(unix))]
+pub fn stop_on_signals(
+    _stop: &StopRequest,
+    _report: impl Fn(SignalEvent) + Send + 'static,
+) -> io::Result<()> {
+    Ok(())
+}
+
+/// The size of a model in one line: nodes and elements of each kind.
+pub fn describe(model: &Model) -> String {
+    let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
+    format!(
+        "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
+        model.n_nodes(),
+        count(ElementKind::Beam),
+        count(ElementKind::RigidBody),
+        count(ElementKind::PointMass),
+        count(ElementKind::Spring),
+        count(ElementKind::Joint),
+        count(ElementKind::JointSpring),
+        count(ElementKind::Driver),
+        count(ElementKind::NodalLoad),
+    )
+}
+
+/// `log.txt`: a line per increment, iteration, cut-back and note. A write
+/// error is kept and reported at the next increment; nothing more is
+/// written to the file after it.
+struct LogFile {
+    path: PathBuf,
+    file: BufWriter<File>,
+    error: Option<io::Error>,
+    /// The error was reported to the analysis already.
+    reported: bool,
+}
+
+impl LogFile {
+    fn create(path: PathBuf) -> io::Result<Self> {
+        let file = File::create(&path).map_err(|e| file_error(&path, e))?;
+        Ok(Self {
+            path,
+            file: BufWriter::new(file),
+            error: None,
+            reported: false,
+        })
+    }
+
+    fn line(&mut self, text: &str) {
+        if self.error.is_none() {
+            if let Err(e) = writeln!(self.file, "{text}") {
+                self.error = Some(file_error(&self.path, e));
+            }
+        }
+    }
+
+    /// Flushes; the first error, once.
+    fn flush(&mut self) -> io::Result<()> {
+        if self.error.is_none() {
+            if let Err(e) = self.file.flush() {
+                self.error = Some(file_error(&self.path, e));
+            }
+        }
+        match &self.error {
+            Some(e) if !self.reported => {
+                self.reported = true;
+                Err(io::Error::new(e.kind(), e.to_string()))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// How a run ended, for the caller to report.
+#[derive(Debug)]
+pub struct RunReport {
+    /// The final status, as written in `summary.json`.
+    pub status: RunStatus,
+    /// The summary as written (or as it would have been).
+    pub summary: Summary,
+    /// The interruption, if the run was stopped on request.
+    pub interrupted: Option<Interrupted>,
+    /// Result files that could not be written at the end (`summary.json`,
+    /// `log.txt`); each error names its file.
+    pub output_errors: Vec<io::Error>,
+    /// The last line of the run, as written to `log.txt`.
+    pub last_line: String,
+}
+
+/// Records a run: result files, `log.txt`, `summary.json`; stops it on
+/// request. See the module documentation.
+pub struct Recorder {
+    writer: ResultWriter,
+    log: LogFile,
+    console: Box<dyn Console>,
+    stop: StopRequest,
+    summary: Summary,
+    end_time: f64,
+}
+
+impl Recorder {
+    /// Locks and prepares `dir` for a run of `model` (read from
+    /// `model_file`, as named in the summary): result files with their
+    /// headers, `log.txt` with a first line describing the model, and a
+    /// `summary.json` saying `running`; the run is shown on `console`.
+    /// Every error names its file.
+    pub fn create(
+        dir: &Path,
+        model_file: &str,
+        model: &Model,
+        analysis: &StaticAnalysis,
+        console: impl Console + 'static,
+    ) -> io::Result<Self> {
+        let writer = ResultWriter::create(dir, model)?;
+        let log = LogFile::create(dir.join("log.txt"))?;
+        let summary = Summary::start(model_file, model, analysis);
+        let mut recorder = Self {
+            writer,
+            log,
+            console: Box::new(console),
+            stop: StopRequest::new(),
+            summary,
+            end_time: model.settings.end_time,
+        };
+        recorder.line(&format!(
+            "{model_file}: {}; {} unknowns; {} analysis to t = {}",
+            describe(model),
+            analysis.n_equations(),
+            if model.settings.kinematic {
+                "kinematic"
+            } else {
+                "static"
+            },
+            model.settings.end_time
+        ));
+        recorder.log.flush()?;
+        recorder.writer.write_summary(&recorder.summary)?;
+        Ok(recorder)
+    }
+
+    /// Stops the run when `stop` is requested.
+    pub fn with_stop(mut self, stop: &StopRequest) -> Self {
+        self.stop = stop.clone();
+        self
+    }
+
+    /// Writes the grids in `encoding` (binary by default).
+    pub fn with_vtk_encoding(mut self, encoding: Encoding) -> Self {
+        self.writer = self.writer.with_vtk_encoding(encoding);
+        self
+    }
+
+    /// The result files.
+    pub fn writer(&self) -> &ResultWriter {
+        &self.writer
+    }
+
+    /// The output directory.
+    pub fn dir(&self) -> &Path {
+        self.writer.dir()
+    }
+
+    /// Writes a line to `log.txt` and shows it.
+    pub fn line(&mut self, text: &str) {
+        self.log.line(text);
+        self.console.line(text);
+    }
+
+    /// Ends the record of a run whose analysis returned `outcome`: the
+    /// status (completed, failed or interrupted), the last line of
+    /// `log.txt`, and `summary.json`. Write errors are returned in the
+    /// report, not lost.
+    pub fn finish(mut self, outcome: &StaticOutcome) -> RunReport {
+        let interrupted = outcome.error.as_ref().and_then(Interrupted::of);
+        let (status, message) = match (&outcome.error, interrupted) {
+            (None, _) => (RunStatus::Completed, None),
+            (Some(_), Some(i)) => (
+                RunStatus::Interrupted,
+                Some(format!("{i} at t = {}", outcome.time)),
+            ),
+            (Some(e), None) => (RunStatus::Failed, Some(e.to_string())),
+        };
+        self.summary.finish(outcome, &self.writer, status, message);
+        let s = &self.summary;
+        let last_line = format!(
+            "{}: {} increments, {} iterations ({:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
+            s.status.name(),
+            s.increments,
+            s.iterations,
+            s.average_iterations,
+            s.cutbacks,
+            s.final_time,
+            s.wall_time_s,
+            self.writer.dir().display()
+        );
+        self.log.line(&last_line);
+        self.console.finish(&last_line);
+        let mut output_errors = Vec::new();
+        if let Err(e) = self.log.flush() {
+            output_errors.push(e);
+        }
+        {
+            let _writing = self.stop.output();
+            if let Err(e) = self.writer.write_summary(&self.summary) {
+                output_errors.push(e);
+            }
+        }
+        RunReport {
+            status,
+            summary: self.summary,
+            interrupted,
+            output_errors,
+            last_line,
+        }
+    }
+}
+
+impl Observer for Recorder {
+    fn iteration(&mut self, info: &IterationInfo) {
+        let n = &info.norms;
+        self.log.line(&format!(
+            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+            info.increment,
+            info.iteration,
+            n.residual_force,
+            n.flux_force,
+            n.residual_moment,
+            n.flux_moment,
+            n.relative_residual,
+            n.residual_constraint,
+            n.displacement_correction,
+            n.rotation_correction
+        ));
+    }
+
+    fn increment(
+        &mut self,
+        info: &IncrementInfo,
+        model: &Model,
+        state: &State,
+        residual: &[f64],
+    ) -> io::Result<()> {
+        let residuals: Vec<String> = info.residuals.iter().map(|r| format!("{r:.1e}")).collect();
+        self.line(&format!(
+            "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  relative residuals: {}",
+            info.increment,
+            info.time,
+            info.step,
+            info.iterations,
+            residuals.join(" ")
+        ));
+        self.console.progress(info);
+
+        // a stop request before the end: this increment is the last
+        // output step
+        let stop = self.stop.requested().filter(|_| info.time < self.end_time);
+        {
+            let _writing = self.stop.output();
+            if stop.is_some() && !info.output {
+                let last = IncrementInfo {
+                    output: true,
+                    ..info.clone()
+                };
+                self.writer.increment(&last, model, state, residual)?;
+            } else {
+                self.writer.increment(info, model, state, residual)?;
+            }
+        }
+        self.log.flush()?;
+        match stop {
+            Some(i) => Err(io::Error::new(io::ErrorKind::Interrupted, i)),
+            None => Ok(()),
+        }
+    }
+
+    fn note(&mut self, text: &str) {
+        self.line(&format!("note: {text}"));
+    }
+
+    fn cutback(&mut self, info: &CutbackInfo) {
+        self.line(&format!(
+            "increment {:4}  from t = {:.6}: step {:.3e} failed ({}); retrying with {:.3e}",
+            info.increment, info.time, info.failed_step, info.reason, info.next_step
+        ));
+    }
+}

@@ -1,0 +1,362 @@
+//! A run that is interrupted, that cannot write a file, or that meets
+//! another run on its output directory stops cleanly: every result file
+//! holds the same steps, every grid listed in `unfold.pvd` exists and
+//! every grid is listed, no temporary file is left, `summary.json` says
+//! what happened, the error names the file, and the exit code says how
+//! the run ended (docs/results.md).
+
+#![cfg(unix)]
+
+use std::collections::BTreeSet;
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A fresh scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("unfold-run-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The roll-up cantilever with `elements` elements, in increments of
+/// `increment`: a run of `1/increment` increments.
+fn rollup(elements: usize, increment: f64) -> String {
+    std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/cantilever_rollup.toml"),
+    )
+    .unwrap()
+    .replace("elements = 10\n", &format!("elements = {elements}\n"))
+    .replace("first_node = 2\n", "first_node = 100\n")
+    .replace(
+        "initial_increment = 0.1",
+        &format!("initial_increment = {increment}\nmax_increment = {increment}"),
+    )
+}
+
+/// A run of `unfold` in the background, killed if the test fails.
+struct Run {
+    child: Child,
+}
+
+impl Drop for Run {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Run {
+    fn start(model: &Path, out: &Path) -> Self {
+        Self {
+            child: Command::new(env!("CARGO_BIN_EXE_unfold"))
+                .args([
+                    "run",
+                    model.to_str().unwrap(),
+                    "--out",
+                    out.to_str().unwrap(),
+                ])
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap(),
+        }
+    }
+
+    fn signal(&self, signal: i32) {
+        // SAFETY: kill(2) on our own child's pid
+        let r = unsafe { libc::kill(self.child.id() as libc::pid_t, signal) };
+        assert_eq!(r, 0, "kill failed");
+    }
+
+    /// Waits for the end (at most a minute); exit code and stderr.
+    fn finish(mut self) -> (i32, String) {
+        let start = Instant::now();
+        loop {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                let mut err = String::new();
+                use std::io::Read;
+                self.child
+                    .stderr
+                    .take()
+                    .unwrap()
+                    .read_to_string(&mut err)
+                    .unwrap();
+                return (status.code().unwrap_or(-1), err);
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(60),
+                "the run did not stop"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+}
+
+/// Waits until `steps.csv` in `out` lists at least `n` steps.
+fn wait_for_steps(out: &Path, n: usize) {
+    let start = Instant::now();
+    loop {
+        let steps = std::fs::read_to_string(out.join("steps.csv"))
+            .map(|t| t.lines().count().saturating_sub(1))
+            .unwrap_or(0);
+        if steps >= n {
+            return;
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "no step written");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// The steps of a CSV file (its `step` column); panics on a row cut short.
+fn steps_in(path: &Path) -> BTreeSet<usize> {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(
+        text.ends_with('\n'),
+        "{}: last row cut short",
+        path.display()
+    );
+    let mut lines = text.lines();
+    let width = lines.next().unwrap().split(',').count();
+    lines
+        .map(|l| {
+            assert_eq!(l.split(',').count(), width, "{}: row {l}", path.display());
+            l.split(',').next().unwrap().parse().unwrap()
+        })
+        .collect()
+}
+
+/// Checks that the result files in `out` agree: the same steps in every
+/// CSV file, one grid per step listed in the collection and present, no
+/// temporary file. Returns the number of steps and the last time.
+fn assert_consistent(out: &Path) -> (usize, f64) {
+    let steps = steps_in(&out.join("steps.csv"));
+    let n = steps.len();
+    assert_eq!(steps, (0..n).collect(), "steps.csv numbering");
+    for entry in std::fs::read_dir(out).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(!name.ends_with(".tmp"), "temporary file {name} left");
+        if name.ends_with(".csv") {
+            assert_eq!(steps_in(&path), steps, "{name} has other steps");
+        }
+    }
+    let pvd = std::fs::read_to_string(out.join("unfold.pvd")).unwrap();
+    let listed: BTreeSet<String> = pvd
+        .split("file=\"")
+        .skip(1)
+        .map(|s| s[..s.find('"').unwrap()].to_string())
+        .collect();
+    let grids: BTreeSet<String> = std::fs::read_dir(out.join("vtk"))
+        .unwrap()
+        .map(|e| format!("vtk/{}", e.unwrap().file_name().to_string_lossy()))
+        .collect();
+    assert_eq!(listed, grids, "grids and collection differ");
+    assert_eq!(grids.len(), n);
+    let last_row = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let last_time = last_row.lines().last().unwrap().split(',').nth(2).unwrap();
+    (n, last_time.parse().unwrap())
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+/// Interrupts a long run with `signal` once it has written a few steps.
+fn interrupt(name: &str, signal: i32) -> (PathBuf, i32, String) {
+    let dir = scratch(name);
+    let model = dir.join("long.toml");
+    // 5000 increments: minutes if not interrupted
+    std::fs::write(&model, rollup(200, 2e-4)).unwrap();
+    let out = dir.join("out");
+    let run = Run::start(&model, &out);
+    wait_for_steps(&out, 3);
+    run.signal(signal);
+    let (code, err) = run.finish();
+    (out, code, err)
+}
+
+#[test]
+fn sigint_stops_after_a_step_with_consistent_files() {
+    let (out, code, err) = interrupt("sigint", libc::SIGINT);
+    assert_eq!(code, 130, "{err}");
+    assert!(err.contains("interrupted by SIGINT"), "{err}");
+    let (steps, last) = assert_consistent(&out);
+    assert!(steps >= 3);
+    let s = summary(&out);
+    assert_eq!(s["status"], "interrupted");
+    assert_eq!(s["final_time"].as_f64().unwrap(), last);
+    assert_eq!(s["output_steps"].as_u64().unwrap() as usize, steps);
+    assert!(s["message"].as_str().unwrap().contains("SIGINT"));
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    assert!(
+        log.lines().last().unwrap().starts_with("interrupted:"),
+        "{log}"
+    );
+}
+
+#[test]
+fn sigterm_stops_after_a_step_with_consistent_files() {
+    let (out, code, err) = interrupt("sigterm", libc::SIGTERM);
+    assert_eq!(code, 143, "{err}");
+    assert!(err.contains("interrupted by SIGTERM"), "{err}");
+    assert_consistent(&out);
+    assert_eq!(summary(&out)["status"], "interrupted");
+}
+
+/// A second signal ends the process at once, between steps: the files
+/// still agree, and the summary is left saying `running`.
+#[test]
+fn a_second_signal_ends_the_run_at_once() {
+    let dir = scratch("twice");
+    let model = dir.join("long.toml");
+    // a beam of 20,000 elements in two increments: the first increment
+    // takes seconds; the first signal waits for its end, the second does
+    // not
+    std::fs::write(&model, rollup(20_000, 0.5)).unwrap();
+    let out = dir.join("out");
+    let run = Run::start(&model, &out);
+    wait_for_steps(&out, 1);
+    run.signal(libc::SIGINT);
+    std::thread::sleep(Duration::from_millis(200));
+    run.signal(libc::SIGINT);
+    let (code, err) = run.finish();
+    assert_eq!(code, 130, "{err}");
+    assert!(err.contains("stopping at once"), "{err}");
+    assert_eq!(assert_consistent(&out).0, 1);
+    assert_eq!(summary(&out)["status"], "running");
+}
+
+/// Another run holding the directory: refused at once, naming the
+/// directory and the other process; the other run goes on undisturbed.
+#[test]
+fn a_second_run_on_the_same_directory_is_refused() {
+    let dir = scratch("busy");
+    let model = dir.join("long.toml");
+    std::fs::write(&model, rollup(200, 2e-4)).unwrap();
+    let out = dir.join("out");
+    let first = Run::start(&model, &out);
+    wait_for_steps(&out, 2);
+    let second = Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args([
+            "run",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(second.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(out.to_str().unwrap())
+            && err.contains("another run")
+            && err.contains(&first.child.id().to_string()),
+        "{err}"
+    );
+    first.signal(libc::SIGINT);
+    let (code, err) = first.finish();
+    assert_eq!(code, 130, "{err}");
+    assert_consistent(&out);
+}
+
+/// `/dev/full` behaves as a full disk: every write fails with ENOSPC.
+#[cfg(target_os = "linux")]
+fn on_full_disk(file: &str) -> (PathBuf, i32, String) {
+    let dir = scratch(&format!("full-{file}"));
+    let model = dir.join("model.toml");
+    std::fs::write(&model, rollup(10, 0.1)).unwrap();
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::os::unix::fs::symlink("/dev/full", out.join(file)).unwrap();
+    let result = Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args([
+            "run",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    (
+        out,
+        result.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&result.stderr).into_owned(),
+    )
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_is_reported_with_the_file_name() {
+    for file in ["log.txt", "nodes.csv", "steps.csv"] {
+        let (out, code, err) = on_full_disk(file);
+        assert_eq!(code, 1, "{file}: {err}");
+        assert!(
+            err.contains(&format!(
+                "{}: No space left on device",
+                out.join(file).display()
+            )),
+            "{file}: {err}"
+        );
+        for entry in std::fs::read_dir(&out).unwrap() {
+            let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+            assert!(!name.ends_with(".tmp"), "{file}: {name} left");
+        }
+        // nothing was run: no summary claims a run
+        assert!(!out.join("summary.json").exists(), "{file}");
+    }
+}
+
+/// A file that fills up during the run (the file-size limit, `ulimit -f`,
+/// stands for a disk that fills): the step being written is removed from
+/// every file, the run stops with exit code 1, the summary says failed
+/// and names the file.
+#[test]
+fn a_write_failing_mid_run_leaves_every_file_with_the_same_steps() {
+    let dir = scratch("fsize");
+    let model = dir.join("model.toml");
+    // 401 nodes, about 80 kB of nodes.csv per step: the limit falls in the
+    // fourth step, long before log.txt or a grid reaches it
+    std::fs::write(&model, rollup(400, 0.05)).unwrap();
+    let out = dir.join("out");
+    let limit = 300_000;
+    let mut command = Command::new(env!("CARGO_BIN_EXE_unfold"));
+    command.args([
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // SAFETY: setrlimit is async-signal-safe
+    unsafe {
+        command.pre_exec(move || {
+            let l = libc::rlimit {
+                rlim_cur: limit,
+                rlim_max: limit,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &l) == 0 {
+                Ok(())
+            } else {
+                Err(std::io::Error::last_os_error())
+            }
+        });
+    }
+    let result = command.output().unwrap();
+    let err = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(1), "{err}");
+    let nodes = out.join("nodes.csv");
+    assert!(
+        err.contains(&format!("{}: File too large", nodes.display())),
+        "{err}"
+    );
+    let (steps, last) = assert_consistent(&out);
+    assert!(steps >= 2, "{steps} steps");
+    assert!(std::fs::metadata(&nodes).unwrap().len() <= limit);
+    let s = summary(&out);
+    assert_eq!(s["status"], "failed");
+    assert!(s["message"].as_str().unwrap().contains("nodes.csv"));
+    assert_eq!(s["output_steps"].as_u64().unwrap() as usize, steps);
+    assert!(s["final_time"].as_f64().unwrap() >= last);
+}

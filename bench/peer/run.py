@@ -206,8 +206,18 @@ def fmt_side(r):
     if r is None:
         return "—"
     if not r["ok"]:
-        return "no step down to the last tried met the tolerance"
+        last = r["tried"][-1]["h"] if r["tried"] else float("nan")
+        return f"no step down to {last:.2e} s met the tolerance"
     return f"h {r['h']:.3e}  err {r['error']:.1e}  {r['wall']:.3f} s"
+
+
+def failures_where_exudyn_succeeds(case):
+    """Steps at which Exudyn converged and unfold did not."""
+    e, u = case["exudyn"], case["unfold"]
+    if not u:
+        return []
+    exu_ok = {t["h"] for t in e["tried"] if t["ok"]}
+    return [t["h"] for t in u["tried"] if not t["ok"] and t["h"] in exu_ok]
 
 
 def main():
@@ -234,12 +244,20 @@ def main():
     )
     log(f"  generalized-alpha, rho_inf = {RHO_INFINITY}; outputs every {OUTPUT_PERIOD} s")
 
-    unfold_ok, why = (False, "not requested (--no-unfold)") if args.no_unfold else unfold_side.availability()
-    if unfold_ok:
-        log(f"  unfold: {unfold_side.binary()} ({unfold_side.version()})")
+    log(f"  load average at the start: {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    if args.no_unfold:
+        unfold_ok, why = False, "not run (--no-unfold)"
+        log("  unfold: not run (--no-unfold)")
     else:
-        log("  unfold: dynamic analysis not available")
-        log(f"    ({why})")
+        try:
+            unfold_ok, why = unfold_side.availability()
+        except unfold_side.ModelError as e:
+            raise SystemExit(f"error: {e}")
+        if unfold_ok:
+            log(f"  unfold: {unfold_side.binary()} ({unfold_side.version()})")
+        else:
+            log("  unfold: dynamic analysis not available")
+            log(f"    ({why})")
 
     results = {
         "python": platform.python_version(),
@@ -249,6 +267,8 @@ def main():
         "threads": args.threads,
         "rho_infinity": RHO_INFINITY,
         "unfold_available": unfold_ok,
+        "unfold_unavailable_because": why,
+        "load_average_start": os.getloadavg(),
         "cases": [],
     }
     rows = []
@@ -335,14 +355,32 @@ def main():
     for label, case in rows:
         e, u = case["exudyn"], case["unfold"]
         if not unfold_ok:
-            u_text, ratio = "unfold: dynamic analysis not available", "—"
+            u_text, ratio = "unfold: dynamic analysis not available" if not args.no_unfold else "not run", "—"
         else:
             u_text = fmt_side(u)
             ratio = f"{e['wall'] / u['wall']:.1f}" if (e["ok"] and u and u["ok"]) else "—"
-            if u and not u["ok"] and e["ok"]:
-                ratio = "unfold fails where Exudyn succeeds"
         log(f"  {label:<14} {fmt_side(e):<44} {u_text:<44} {ratio}")
+        if unfold_ok:
+            bad = failures_where_exudyn_succeeds(case)
+            if bad:
+                log(f"  {'':<14} unfold fails where Exudyn succeeds, at h = {', '.join(f'{h:.3e}' for h in bad)} s")
 
+    pend = [(case["size"], case) for label, case in rows if case["problem"] == "pendulum"]
+    if pend:
+        log("")
+        log("Pendulum: wall time per step and element at the equal-accuracy step (constant = cost linear in n)")
+        for side in ("exudyn", "unfold"):
+            cells = []
+            for n, case in pend:
+                r = case[side]
+                if r and r["ok"]:
+                    cells.append(f"{n}: {1e6 * r['wall'] / (r['steps'] * n):.1f} µs")
+                else:
+                    cells.append(f"{n}: —")
+            log(f"  {side:<8} " + "   ".join(cells))
+
+    log(f"\n  load average at the end: {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    results["load_average_end"] = os.getloadavg()
     OUT_DIR.mkdir(exist_ok=True)
     out = OUT_DIR / "results.json"
     out.write_text(json.dumps(results, indent=1))

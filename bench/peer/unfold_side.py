@@ -1,0 +1,231 @@
+"""The benchmark problems in unfold: model-file generators and the runner.
+
+unfold's dynamic analysis does not exist yet. The `[analysis]` keys of a
+dynamic run (`type = "dynamic"`, `end_time`, `time_step`, `rho_infinity`,
+`output_every`) and the initial velocities of a node (`velocity`,
+`angular_velocity` in `[[nodes]]`, global frame) are the expected form and
+are written in one place each (`_analysis`, `_node`) so that they can be
+adapted when the analysis lands. Everything else follows docs/model-format.md.
+
+The binary is `$UNFOLD`, else `target/release/unfold` of this repository.
+When it is missing, or when `unfold check` rejects the dynamic model, the
+harness reports "unfold: dynamic analysis not available" and no figure.
+"""
+
+import csv
+import json
+import os
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from problems import GRAVITY, OUTPUT_PERIOD, RHO_INFINITY, HeavyTop, Pendulum, steps_for
+
+REPO = Path(__file__).resolve().parents[2]
+
+TIP_NODE = 2  # pendulum: node at x = L
+TOP_NODE = 1  # heavy top: node at the centre of mass
+
+
+@dataclass
+class Run:
+    ok: bool
+    times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    wall_solve: float = 0.0  # s, the analysis as timed by unfold (summary.json)
+    wall_total: float = 0.0  # s, the whole `unfold run` process
+    steps: int = 0
+    newton_iterations: int = 0
+    jacobians: int = 0
+    message: str = ""
+
+
+def _vec(v):
+    return "[" + ", ".join(repr(float(x) + 0.0) for x in v) + "]"  # no -0.0
+
+
+def _analysis(end_time, h, dynamic=True):
+    if not dynamic:  # the same model as a static analysis, to check the rest of it
+        return f'[analysis]\ntype = "static"\nend_time = {end_time!r}\n'
+    every = max(1, round(OUTPUT_PERIOD / h))
+    return (
+        "[analysis]\n"
+        'type = "dynamic"\n'
+        f"end_time = {end_time!r}\n"
+        f"time_step = {h!r}\n"
+        f"rho_infinity = {RHO_INFINITY!r}\n"
+        f"output_every = {every}   # results every {OUTPUT_PERIOD} s\n"
+    )
+
+
+def _node(nid, x, velocity=None, angular_velocity=None, dynamic=True):
+    s = f"[[nodes]]\nid = {nid}\nx = {_vec(x)}\n"
+    if velocity is not None and dynamic:
+        s += f"velocity = {_vec(velocity)}\n"
+    if angular_velocity is not None and dynamic:
+        s += f"angular_velocity = {_vec(angular_velocity)}\n"
+    return s
+
+
+# Gravity is constant in time: the default curve of `[gravity]` is the ramp f(t) = t.
+_CONSTANT_CURVE = '[[curves]]\nname = "constant"\nfunction = "linear"\noffset = 1.0\nslope = 0.0\n'
+
+
+def pendulum_toml(n, h, p=Pendulum, dynamic=True):
+    """Model file of the flexible pendulum with n elements and step h
+    (dynamic=False: the same model as a static analysis)."""
+    return "\n".join(
+        [
+            f'title = "Flexible beam pendulum falling from the horizontal, {n} elements"\n',
+            _analysis(p.end_time, h, dynamic),
+            "[[sections]]\n"
+            'name = "beam"\n'
+            f"EA = {p.EA!r}\nGA2 = {p.GA!r}\nGA3 = {p.GA!r}\nGJ = {p.GJ!r}\n"
+            f"EI2 = {p.EI!r}\nEI3 = {p.EI!r}\n"
+            f"mass_per_length = {p.rho_A!r}\n"
+            f"inertia_per_length = {_vec([p.rho_J, p.rho_I, p.rho_I])}\n",
+            _node(1, [0.0, 0.0, 0.0]),
+            _node(TIP_NODE, [p.length, 0.0, 0.0]),
+            "[[beam_lines]]\n"
+            f"nodes = [1, {TIP_NODE}]\n"
+            f"elements = {n}\n"
+            'section = "beam"\n'
+            "orientation = [0.0, 0.0, 1.0]\n"
+            "first_node = 3\n"
+            "first_element = 2\n",
+            "[[joints]]              # the pin: revolute to the ground about global y\n"
+            "id = 1\n"
+            'type = "revolute"\n'
+            "nodes = [1]\n"
+            "axis = [0.0, 1.0, 0.0]\n",
+            _CONSTANT_CURVE,
+            f'[gravity]\nacceleration = [0.0, 0.0, {-GRAVITY!r}]\ncurve = "constant"\n',
+        ]
+    )
+
+
+def top_toml(h, t=HeavyTop, dynamic=True):
+    """Model file of the heavy top with step h: the node at the centre of mass,
+    a spherical joint to the ground at the origin (dynamic=False: the same
+    model as a static analysis, without initial velocities)."""
+    return "\n".join(
+        [
+            'title = "Heavy top (Arnold & Brüls 2007) on a spherical joint"\n',
+            _analysis(t.end_time, h, dynamic),
+            _node(TOP_NODE, t.center_of_mass, velocity=t.com_velocity0(), angular_velocity=t.omega0, dynamic=dynamic),
+            "[[rigid_bodies]]\n"
+            "id = 1\n"
+            f"node = {TOP_NODE}\n"
+            f"mass = {t.mass!r}\n"
+            f"inertia = {_vec(t.inertia_com)}\n",
+            "[[joints]]\n"
+            "id = 2\n"
+            'type = "spherical"\n'
+            f"nodes = [{TOP_NODE}]\n"
+            "position = [0.0, 0.0, 0.0]\n",
+            _CONSTANT_CURVE,
+            f'[gravity]\nacceleration = [0.0, 0.0, {-GRAVITY!r}]\ncurve = "constant"\n',
+        ]
+    )
+
+
+def binary():
+    b = os.environ.get("UNFOLD")
+    return Path(b) if b else REPO / "target" / "release" / "unfold"
+
+
+def _check(b, text, d, name):
+    model = Path(d) / f"{name}.toml"
+    model.write_text(text)
+    r = subprocess.run([str(b), "check", str(model)], capture_output=True, text=True)
+    if r.returncode == 0:
+        return ""
+    lines = [l.strip() for l in (r.stderr or r.stdout).strip().splitlines()]
+    if not lines:
+        return f"exit code {r.returncode}"
+    detail = [l for l in lines[1:] if l.startswith("unknown field") or l.startswith("unknown variant")]
+    return " ".join([lines[0]] + detail[:1])[:300]
+
+
+class ModelError(Exception):
+    """unfold rejects a generated model even as a static analysis: the
+    generator, not the missing analysis, is at fault."""
+
+
+def availability():
+    """(True, "") when the binary exists and accepts the dynamic models, else
+    (False, reason). Raises ModelError when even the static form of a
+    generated model is rejected."""
+    b = binary()
+    if not b.is_file() or not os.access(b, os.X_OK):
+        return False, f"no unfold binary at {b} (set UNFOLD or run `cargo build --release`)"
+    with tempfile.TemporaryDirectory() as d:
+        for name, make in (("pendulum", lambda dyn: pendulum_toml(2, 1e-2, dynamic=dyn)), ("top", lambda dyn: top_toml(1e-2, dynamic=dyn))):
+            error = _check(b, make(False), d, name + "_static")
+            if error:
+                raise ModelError(f"unfold rejects the {name} model as a static analysis: {error}")
+            error = _check(b, make(True), d, name)
+            if error:
+                return False, f"`unfold check` rejects the dynamic {name} model: {error}"
+    return True, ""
+
+
+def _read_node(out, node, end_time):
+    """Positions of `node` at the output times, from nodes.csv."""
+    times, pos = [], []
+    with open(out / "nodes.csv", newline="") as f:
+        for row in csv.DictReader(f):
+            if int(row["node"]) == node:
+                times.append(float(row["time"]))
+                pos.append([float(row["x"]), float(row["y"]), float(row["z"])])
+    times, pos = np.array(times), np.array(pos).reshape(-1, 3)
+    expected = np.arange(steps_for(end_time, OUTPUT_PERIOD) + 1) * OUTPUT_PERIOD
+    if times.size != expected.size or np.abs(times - expected).max() > 1e-9:
+        raise ValueError(f"nodes.csv: node {node} is not written at every {OUTPUT_PERIOD} s ({times.size} rows)")
+    return times, pos
+
+
+def _run(text, node, end_time, h, threads):
+    with tempfile.TemporaryDirectory() as d:
+        model, out = Path(d) / "model.toml", Path(d) / "out"
+        model.write_text(text)
+        cmd = [str(binary()), "run", str(model), "--out", str(out), "--quiet", "--threads", str(threads)]
+        t0 = time.perf_counter()
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        run = Run(ok=r.returncode == 0, wall_solve=wall, wall_total=wall, steps=steps_for(end_time, h))
+        if not run.ok:
+            lines = (r.stderr or r.stdout).strip().splitlines()
+            run.message = lines[-1] if lines else f"exit {r.returncode}"
+            return run
+        try:
+            summary = json.loads((out / "summary.json").read_text())
+            run.wall_solve = float(summary["wall_time_s"])
+            run.steps = int(summary["increments"])
+            run.newton_iterations = int(summary["iterations"])
+            if int(summary.get("cutbacks", 0)) > 0:
+                # as Exudyn's adaptive step is off, a run is at the step h or fails
+                run.ok = False
+                run.message = f"{summary['cutbacks']} cut-back(s) of the step"
+                return run
+            run.times, run.positions = _read_node(out, node, end_time)
+        except (OSError, ValueError, KeyError) as e:
+            run.ok, run.message = False, str(e)
+        return run
+
+
+def run_pendulum(n, h, threads=1):
+    return _run(pendulum_toml(n, h), TIP_NODE, Pendulum.end_time, h, threads)
+
+
+def run_top(h, threads=1):
+    return _run(top_toml(h), TOP_NODE, HeavyTop.end_time, h, threads)
+
+
+def version():
+    r = subprocess.run([str(binary()), "--version"], capture_output=True, text=True)
+    return r.stdout.strip() if r.returncode == 0 else "unknown"

@@ -17,6 +17,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use unfold::analysis::preflight;
 use unfold::analysis::statics::StaticError;
 use unfold::analysis::{
     CutbackInfo, IncrementInfo, IterationInfo, NewtonFailure, Observer, StaticAnalysis,
@@ -26,6 +27,23 @@ use unfold::io::model_file::read_model;
 use unfold::io::results::{ResultWriter, Summary};
 use unfold::model::Model;
 use unfold::state::State;
+
+// `println!` and `eprintln!` that ignore a failed write instead of
+// panicking: the std macros panic when the stream is closed or broken
+// (`unfold check m.toml | head -0`, a closed stderr, a full disk). These
+// shadow the std macros in the whole file.
+macro_rules! println {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+macro_rules! eprintln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
 
 #[derive(Parser)]
 #[command(
@@ -112,20 +130,46 @@ fn describe(model: &Model) -> String {
     )
 }
 
+/// Prints the model's warnings to stderr.
+fn print_warnings(path: &Path, model: &Model) {
+    for w in &model.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+}
+
+/// Validates a model file and runs every check that needs no analysis
+/// (analysis::preflight): exit code 2, with the message a run would give,
+/// when one fails.
 fn check(path: &Path) -> ExitCode {
-    match read_model(path) {
-        Ok((_, model)) => {
-            let analysis = StaticAnalysis::new(&model);
+    let model = match read_model(path) {
+        Ok((_, model)) => model,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
+    print_warnings(path, &model);
+    match preflight::check(&model) {
+        Ok(report) => {
             println!(
                 "{}: valid model: {}; {} unknowns",
                 path.display(),
                 describe(&model),
-                analysis.n_equations()
+                report.unknowns
             );
+            for line in model.load_history() {
+                println!("load history: {line}");
+            }
+            if report.redundant_constraints > 0 {
+                println!(
+                    "note: {} redundant constraint equation(s) will be removed (over-constrained loops)",
+                    report.redundant_constraints
+                );
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}: {e}", path.display());
             ExitCode::from(EXIT_INPUT)
         }
     }
@@ -221,6 +265,7 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
             return ExitCode::from(EXIT_INPUT);
         }
     };
+    print_warnings(path, &model);
     let writer = match ResultWriter::create(out, &model) {
         Ok(w) => w,
         Err(e) => {
@@ -261,6 +306,12 @@ fn run(path: &Path, out: &Path, quiet: bool) -> ExitCode {
         },
         model.settings.end_time
     ));
+    for w in &model.warnings {
+        let _ = writeln!(observer.log, "warning: {w}");
+    }
+    for line in model.load_history() {
+        observer.line(&format!("load history: {line}"));
+    }
     let outcome = analysis.run(&mut observer);
     observer.bar.finish_and_clear();
 

@@ -861,3 +861,66 @@ fn one_message_per_problem() {
     assert!(err.contains("node 4: x must be finite"), "{err}");
     assert_eq!(err.lines().count(), 2, "{err}");
 }
+
+/// Analysis settings that could only hang or accept anything: more than
+/// 10⁶ increments, steps lost in the round-off of t, 10⁶ iterations,
+/// tolerances of 1 or more, constraint scaling beyond 1e150.
+#[test]
+fn analysis_settings_are_limited() {
+    let analysis = |body: &str| format!("{CANTILEVER}\n[analysis]\n{body}\n");
+    assert_rejected(
+        "too_many_increments",
+        &analysis("end_time = 1.0e9\ninitial_increment = 0.1\nmax_increment = 0.1\nmin_increment = 0.01"),
+        &["analysis: end_time / max_increment = 1.000e10: the analysis would need more than 1e6 increments"],
+    );
+    assert_rejected(
+        "tiny_min_increment",
+        &analysis("min_increment = 1e-300"),
+        &[
+            "analysis: min_increment must be at least end_time·1e-12",
+            "got 1e-300",
+        ],
+    );
+    assert_rejected(
+        "many_iterations",
+        &analysis("max_iterations = 1000000"),
+        &["analysis: max_iterations must be from 1 to 1000, got 1000000"],
+    );
+    assert_rejected(
+        "loose_tolerance",
+        &analysis("residual_tolerance = 2.0\nconstraint_scale = 1e200"),
+        &[
+            "analysis: residual_tolerance must be below 1",
+            "analysis: constraint_scale must be at most 1e150",
+        ],
+    );
+}
+
+/// Values each in range whose products are not: the element is named, and
+/// the elements of a beam line sharing the problem are counted in one
+/// message.
+#[test]
+fn out_of_range_element_forces_are_named() {
+    assert_rejected(
+        "heavy_mass",
+        &format!(
+            "{CANTILEVER}\n[[point_masses]]\nid = 10\nnode = 3\nmass = 1e308\n\n[gravity]\nacceleration = [0.0, 0.0, -9.81]\n"
+        ),
+        &["point mass 10: its forces or stiffness in the reference configuration at t = 0.5 are not finite or exceed 1e150"],
+    );
+    let text = CANTILEVER
+        .replace("EA = 1.0e7", "EA = 1.0e160")
+        .replace(
+            "[[beams]]\nid = 1\nnodes = [1, 2]\nsection = \"s\"\n\n[[beams]]\nid = 2\nnodes = [2, 3]\nsection = \"s\"\n",
+            "[[beam_lines]]\nnodes = [1, 3]\nelements = 4\nsection = \"s\"\nfirst_node = 10\n",
+        )
+        .replace("[[nodes]]\nid = 2\nx = [0.5, 0.0, 0.0]\n", "");
+    let dir = scratch("stiff_line");
+    let (code, _, err) = run_model(&dir, "stiff.toml", &text);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("beam 1 (and 3 other beam elements): its forces or stiffness in the reference configuration at t = 0 are not finite or exceed 1e150"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}

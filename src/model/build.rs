@@ -1244,6 +1244,19 @@ fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
             "a kinematic analysis follows its drivers: arc-length control does not apply",
         );
     }
+    // k and p multiply the constraint gradients in the tangent
+    for (name, v) in [
+        ("constraint_scale", a.constraint_scale),
+        ("constraint_penalty", a.constraint_penalty),
+    ] {
+        if v.is_some_and(|v| v > LARGEST_ELEMENT_VALUE) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                "analysis",
+                format!("{name} must be at most {LARGEST_ELEMENT_VALUE:e}"),
+            );
+        }
+    }
     if let Some(k) = a.constraint_scale {
         ck.positive("analysis", "constraint_scale", k);
     }
@@ -1276,6 +1289,23 @@ fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         s.displacement_tolerance,
     );
     ck.positive("analysis", "rotation_tolerance", s.rotation_tolerance);
+    // relative tolerances of 1 or more accept any iterate
+    for (name, v) in [
+        ("residual_tolerance", s.residual_tolerance),
+        ("displacement_tolerance", s.displacement_tolerance),
+        ("rotation_tolerance", s.rotation_tolerance),
+    ] {
+        if v >= 1.0 {
+            ck.push(
+                ModelErrorKind::Invalid,
+                "analysis",
+                format!(
+                    "{name} must be below 1 (a relative tolerance, or radians), got {}",
+                    num(v)
+                ),
+            );
+        }
+    }
     if s.max_iterations == 0 || s.max_iterations > MAX_ITERATIONS {
         ck.push(
             ModelErrorKind::Invalid,

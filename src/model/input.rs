@@ -708,7 +708,8 @@ impl ModelInput {
         self
     }
 
-    /// Adds a dead nodal force and moment following the default ramp.
+    /// Adds a dead nodal force and moment following the default curve (the
+    /// ramp in statics, the constant in a kinematic analysis).
     pub fn add_load(&mut self, node: Id, force: [f64; 3], moment: [f64; 3]) -> &mut Self {
         self.loads.push(LoadInput {
             node,

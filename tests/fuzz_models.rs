@@ -1,8 +1,10 @@
 //! Fuzzing of model files: the example models (`examples/*.toml`, and
-//! `tests/data/every_table.toml`, which uses every table) mutated
-//! at random — numbers replaced by 0, −1, huge, tiny and non-finite values
-//! or by strings, ids swapped and duplicated, fields deleted and
-//! duplicated, arrays shortened, lines deleted — and put through
+//! `tests/data/every_table.toml`, which uses every table) mutated at
+//! random — numbers replaced by 0, −1, huge, tiny and non-finite values,
+//! values by strings or by values of another type, ids swapped and
+//! duplicated, fields and array entries deleted, entries (nodes,
+//! elements, points) duplicated, arrays shortened, lines deleted — and
+//! put through
 //!
 //! - the code path of `unfold check` (parse, validate and build the model,
 //!   then `analysis::preflight`), in-process: it must return a model or an

@@ -1,6 +1,14 @@
 //! Load curves: scalar functions `f(t)` of the load parameter (pseudo-time
 //! in statics) that scale loads, gravity, prescribed motions and drivers:
-//! piecewise-linear tables or simple functions.
+//! piecewise-linear tables or simple functions, and the built-in `ramp`
+//! (`f = t`) and `constant` (`f = 1`).
+//!
+//! Besides evaluation, a curve gives two bounds the model builder checks
+//! before a run (docs/model-format.md, "Curves"): the largest `|f|` over
+//! the analysis ([`Curve::magnitude`]), so that `value·f(t)` is known to
+//! stay finite, and the largest change of `f` over one increment
+//! ([`Curve::largest_change`]), so that a driver asking for more than half
+//! a turn per increment is noticed.
 
 /// A simple function of `t`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,6 +47,48 @@ pub enum Function {
 }
 
 impl Function {
+    /// Largest `|f(t)|` for `t` in `[0, t_end]`: exact for a linear
+    /// function and a smooth step (monotone), `|offset| + |amplitude|` for a
+    /// sine.
+    pub fn magnitude(&self, t_end: f64) -> f64 {
+        match *self {
+            Self::Linear { .. } => self.value(0.0).abs().max(self.value(t_end).abs()),
+            Self::Sine {
+                offset, amplitude, ..
+            } => offset.abs() + amplitude.abs(),
+            Self::SmoothStep { from, to, .. } => from.abs().max(to.abs()),
+        }
+    }
+
+    /// Largest `|f(t + h) − f(t)|` for `0 ≤ t ≤ t + h ≤ t_end` (an upper
+    /// bound for a sine).
+    pub fn largest_change(&self, h: f64, t_end: f64) -> f64 {
+        let h = h.min(t_end).max(0.0);
+        match *self {
+            Self::Linear { slope, .. } => slope.abs() * h,
+            // |sin(a + 2πfh) − sin(a)| = 2|sin(πfh)|·|cos(a + πfh)| ≤ 2|sin(πfh)|
+            Self::Sine {
+                amplitude,
+                frequency,
+                ..
+            } => {
+                let half = std::f64::consts::PI * (frequency * h).abs();
+                let s = if half < std::f64::consts::FRAC_PI_2 {
+                    half.sin()
+                } else {
+                    1.0
+                };
+                2.0 * amplitude.abs() * s
+            }
+            // the steepest window is centred on the middle of the
+            // transition (the rate s'(τ) = 30τ²(1 − τ)² peaks at τ = ½)
+            Self::SmoothStep { start, end, .. } => {
+                let mid = 0.5 * (start + end);
+                (self.value(mid + 0.5 * h) - self.value(mid - 0.5 * h)).abs()
+            }
+        }
+    }
+
     /// Evaluates the function.
     pub fn value(&self, t: f64) -> f64 {
         match *self {
@@ -65,7 +115,7 @@ impl Function {
 /// A curve `f(t)`: a piecewise-linear table through points `(tᵢ, fᵢ)` with
 /// strictly increasing `tᵢ`, held constant before the first and after the
 /// last point, or a [`Function`]. The built-in [`Curve::ramp`] is
-/// `f(t) = t` for every `t`.
+/// `f(t) = t` for every `t`, the built-in [`Curve::constant`] `f(t) = 1`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Curve {
     name: String,
@@ -77,6 +127,9 @@ impl Curve {
     /// Name of the built-in ramp.
     pub const RAMP: &'static str = "ramp";
 
+    /// Name of the built-in constant.
+    pub const CONSTANT: &'static str = "constant";
+
     /// The built-in ramp `f(t) = t` (no clamping).
     pub fn ramp() -> Self {
         Self {
@@ -84,6 +137,18 @@ impl Curve {
             points: Vec::new(),
             function: None,
         }
+    }
+
+    /// The built-in constant `f(t) = 1`: a load applied in full from
+    /// `t = 0`.
+    pub fn constant() -> Self {
+        Self::function(
+            Self::CONSTANT,
+            Function::Linear {
+                offset: 1.0,
+                slope: 0.0,
+            },
+        )
     }
 
     /// A piecewise-linear curve. The caller guarantees at least one point
@@ -111,6 +176,83 @@ impl Curve {
     /// The curve's name.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// A short description for messages: `f = t` for the ramp, `f = 1`
+    /// for the constant, the kind of curve otherwise.
+    pub fn describe(&self) -> &'static str {
+        match (&self.function, self.points.is_empty()) {
+            (None, true) => "f = t",
+            (Some(_), _) if self.name == Self::CONSTANT => "f = 1",
+            (Some(Function::Linear { .. }), _) => "linear",
+            (Some(Function::Sine { .. }), _) => "sine",
+            (Some(Function::SmoothStep { .. }), _) => "smooth step",
+            (None, false) => "table",
+        }
+    }
+
+    /// Largest `|f(t)|` for `t` in `[0, t_end]` (an upper bound for a
+    /// sine).
+    pub fn magnitude(&self, t_end: f64) -> f64 {
+        match &self.function {
+            Some(f) => f.magnitude(t_end),
+            None if self.points.is_empty() => t_end.abs(),
+            None => self.points.iter().fold(0.0, |m, p| m.max(p.1.abs())),
+        }
+    }
+
+    /// Largest `|f(t + h) − f(t)|` for `0 ≤ t ≤ t + h ≤ t_end`: what one
+    /// increment `h` asks of a quantity following the curve (an upper bound
+    /// for a sine).
+    pub fn largest_change(&self, h: f64, t_end: f64) -> f64 {
+        let h = h.min(t_end).max(0.0);
+        match &self.function {
+            Some(f) => f.largest_change(h, t_end),
+            None if self.points.is_empty() => h,
+            None => {
+                // piecewise linear: the largest change over a window of
+                // width h is found with a window end on a breakpoint or on
+                // an end of [0, t_end]
+                let mut starts: Vec<f64> = vec![0.0, t_end - h];
+                for p in &self.points {
+                    starts.push(p.0);
+                    starts.push(p.0 - h);
+                }
+                starts
+                    .into_iter()
+                    .map(|t| t.clamp(0.0, t_end - h))
+                    .map(|t| (self.value(t + h) - self.value(t)).abs())
+                    .fold(0.0, f64::max)
+            }
+        }
+    }
+
+    /// Whether `f` takes one value over `[0, t_end]`.
+    pub fn is_constant_on(&self, t_end: f64) -> bool {
+        match self.function {
+            Some(Function::Linear { slope, .. }) => slope == 0.0,
+            Some(Function::Sine {
+                amplitude,
+                frequency,
+                ..
+            }) => amplitude == 0.0 || frequency == 0.0,
+            Some(Function::SmoothStep {
+                start,
+                end,
+                from,
+                to,
+            }) => from == to || end <= 0.0 || start >= t_end,
+            None if self.points.is_empty() => t_end == 0.0,
+            None => {
+                let f0 = self.value(0.0);
+                self.value(t_end) == f0
+                    && self
+                        .points
+                        .iter()
+                        .filter(|p| p.0 > 0.0 && p.0 < t_end)
+                        .all(|p| p.1 == f0)
+            }
+        }
     }
 
     /// Evaluates `f(t)`.
@@ -171,6 +313,72 @@ mod tests {
             slope: -2.0,
         };
         assert_eq!(Curve::function("l", l).value(2.0), -3.0);
+    }
+
+    #[test]
+    fn constant_is_one() {
+        let c = Curve::constant();
+        assert_eq!(c.name(), "constant");
+        assert_eq!(c.value(0.0), 1.0);
+        assert_eq!(c.value(7.5), 1.0);
+        assert!(c.is_constant_on(3.0));
+        assert!(!Curve::ramp().is_constant_on(3.0));
+        assert_eq!(c.largest_change(0.5, 3.0), 0.0);
+    }
+
+    /// The bounds against a brute-force scan of the curve (a fine sampling
+    /// of every window; the bounds must hold and, except for the sine,
+    /// which is bounded, be reached within the sampling error).
+    #[test]
+    fn magnitude_and_largest_change_bound_the_curve() {
+        let curves = [
+            Curve::ramp(),
+            Curve::constant(),
+            Curve::function(
+                "l",
+                Function::Linear {
+                    offset: -1.0,
+                    slope: 3.0,
+                },
+            ),
+            Curve::function(
+                "s",
+                Function::SmoothStep {
+                    start: 0.5,
+                    end: 1.5,
+                    from: 2.0,
+                    to: -1.0,
+                },
+            ),
+            Curve::function(
+                "w",
+                Function::Sine {
+                    offset: 0.5,
+                    amplitude: 2.0,
+                    frequency: 0.7,
+                    phase: 0.3,
+                },
+            ),
+            Curve::piecewise_linear("p", vec![(0.2, 0.0), (0.3, 4.0), (1.0, 4.5), (1.6, -2.0)]),
+        ];
+        let (t_end, h) = (2.0, 0.25);
+        let n = 8000;
+        for c in &curves {
+            let t = |k: usize| t_end * k as f64 / n as f64;
+            let magnitude = (0..=n).map(|k| c.value(t(k)).abs()).fold(0.0, f64::max);
+            let m = (h / t_end * n as f64) as usize;
+            let change = (0..=n - m)
+                .map(|k| (c.value(t(k + m)) - c.value(t(k))).abs())
+                .fold(0.0, f64::max);
+            let (mb, cb) = (c.magnitude(t_end), c.largest_change(h, t_end));
+            assert!(mb >= magnitude - 1e-12, "{}: {mb} < {magnitude}", c.name());
+            assert!(cb >= change - 1e-12, "{}: {cb} < {change}", c.name());
+            if c.name() != "w" {
+                // exact bounds, up to the sampling step t_end/n
+                assert!(mb - magnitude < 1e-2, "{}: {mb} vs {magnitude}", c.name());
+                assert!(cb - change < 1e-2, "{}: {cb} vs {change}", c.name());
+            }
+        }
     }
 
     #[test]

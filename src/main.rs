@@ -19,12 +19,30 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use unfold::analysis::preflight;
 use unfold::analysis::statics::StaticError;
 use unfold::analysis::{IncrementInfo, NewtonFailure, StaticAnalysis};
 use unfold::io::model_file::read_model;
 use unfold::io::run::{signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest};
 use unfold::io::vtk::Encoding;
 use unfold::model::Model;
+
+// `println!` and `eprintln!` that ignore a failed write instead of
+// panicking: the std macros panic when the stream is closed or broken
+// (`unfold check m.toml | head -0`, a closed stderr, a full disk). These
+// shadow the std macros in the whole file.
+macro_rules! println {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+macro_rules! eprintln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
 
 #[derive(Parser)]
 #[command(
@@ -109,20 +127,46 @@ fn describe(model: &Model) -> String {
     unfold::io::run::describe(model)
 }
 
+/// Prints the model's warnings to stderr.
+fn print_warnings(path: &Path, model: &Model) {
+    for w in &model.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+}
+
+/// Validates a model file and runs every check that needs no analysis
+/// (analysis::preflight): exit code 2, with the message a run would give,
+/// when one fails.
 fn check(path: &Path) -> ExitCode {
-    match read_model(path) {
-        Ok((_, model)) => {
-            let analysis = StaticAnalysis::new(&model);
+    let model = match read_model(path) {
+        Ok((_, model)) => model,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
+    print_warnings(path, &model);
+    match preflight::check(&model) {
+        Ok(report) => {
             println!(
                 "{}: valid model: {}; {} unknowns",
                 path.display(),
                 describe(&model),
-                analysis.n_equations()
+                report.unknowns
             );
+            for line in model.load_history() {
+                println!("load history: {line}");
+            }
+            if report.redundant_constraints > 0 {
+                println!(
+                    "note: {} redundant constraint equation(s) will be removed (over-constrained loops)",
+                    report.redundant_constraints
+                );
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}: {e}", path.display());
             ExitCode::from(EXIT_INPUT)
         }
     }
@@ -188,6 +232,7 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
             return ExitCode::from(EXIT_INPUT);
         }
     };
+    print_warnings(path, &model);
     let mut analysis = StaticAnalysis::new(&model);
     let bar = ProgressBar::new(1000);
     bar.set_style(

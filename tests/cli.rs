@@ -505,3 +505,422 @@ fn bad_function_curves() {
         ],
     );
 }
+
+/// A point mass m = 2 kg at L = 1 m from a hinge about z, in gravity
+/// g = 9.81 m/s² along −y, turned by a driver through `value` (in `unit`
+/// when given): `extra` is appended (analysis settings).
+fn pendulum(value: &str, unit: Option<&str>, extra: &str) -> String {
+    let unit = unit.map_or(String::new(), |u| format!("unit = \"{u}\"\n"));
+    format!(
+        "[[nodes]]\nid = 2\nx = [1.0, 0.0, 0.0]\n\n[[joints]]\nid = 1\ntype = \"revolute\"\nnodes = [2]\naxis = [0.0, 0.0, 1.0]\nposition = [0.0, 0.0, 0.0]\n\n[[point_masses]]\nid = 2\nnode = 2\nmass = 2.0\n\n[gravity]\nacceleration = [0.0, -9.81, 0.0]\n\n[[drivers]]\nid = 3\njoint = 1\nvalue = {value}\n{unit}\n{extra}"
+    )
+}
+
+/// Rows of drivers.csv as (time, coordinate, load).
+fn driver_rows(dir: &Path) -> Vec<(f64, f64, f64)> {
+    std::fs::read_to_string(dir.join("out/drivers.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let c: Vec<f64> = l
+                .split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect();
+            (c[1], c[3], c[5])
+        })
+        .collect()
+}
+
+/// In a kinematic analysis the gravity (and every load) acts in full by
+/// default: the driver torque of the pendulum at 45° is the static moment
+/// m g L sin 45° = 13.873 N·m (it was half of it, 6.94 N·m, when gravity
+/// followed the default ramp). Tolerance 1e-6 relative: the constraint
+/// and residual tolerances are 1e-6 and 1e-8. `check` and `run` say which
+/// curve each load follows; a kinematic analysis that ramps gravity, and a
+/// static one whose gravity follows the default ramp while drivers move
+/// the model, are warned about.
+#[test]
+fn load_history_is_explicit_and_visible() {
+    let dir = scratch("pendulum");
+    let text = pendulum(
+        "1.5707963267948966",
+        None,
+        "[analysis]\ntype = \"kinematic\"\n",
+    );
+    let (code, out, err) = run_model(&dir, "pendulum.toml", &text);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    assert!(
+        out.contains("load history: curve \"constant\" (f = 1) is followed by gravity (default)"),
+        "{out}"
+    );
+    assert!(
+        out.contains("load history: curve \"ramp\" (f = t) is followed by driver 3 (default)"),
+        "{out}"
+    );
+    let rows = driver_rows(&dir);
+    let (_, angle, load) = rows[5];
+    assert!(
+        (angle - std::f64::consts::FRAC_PI_4).abs() < 1e-9,
+        "{rows:?}"
+    );
+    let expected = 2.0 * 9.81 * 1.0 * std::f64::consts::FRAC_PI_4.sin();
+    assert!(
+        (load - expected).abs() < 1e-6 * expected,
+        "{load} vs {expected}"
+    );
+    let (code, out, _) = unfold(&["check", dir.join("pendulum.toml").to_str().unwrap()]);
+    assert_eq!(code, 0);
+    assert!(out.contains("is followed by gravity (default)"), "{out}");
+
+    // an explicit ramp on gravity in a kinematic analysis: kept, warned
+    let ramped = text.replace(
+        "acceleration = [0.0, -9.81, 0.0]\n",
+        "acceleration = [0.0, -9.81, 0.0]\ncurve = \"ramp\"\n",
+    );
+    let (code, _, err) = run_model(&dir, "ramped.toml", &ramped);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("warning: ")
+            && err.contains("ramped.toml: gravity: follows curve \"ramp\" in a kinematic analysis"),
+        "{err}"
+    );
+    let (_, _, load) = driver_rows(&dir)[5];
+    assert!((load - expected / 2.0).abs() < 1e-6 * expected, "{load}");
+
+    // statics: gravity follows the ramp by default, with a warning when
+    // drivers move the model; `curve = "constant"` is the built-in f = 1
+    let statics = pendulum("1.5707963267948966", None, "");
+    let (code, out, err) = run_model(&dir, "static.toml", &statics);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("static.toml: gravity: follows the default ramp"),
+        "{err}"
+    );
+    assert!(
+        out.contains("is followed by driver 3 (default), gravity (default)"),
+        "{out}"
+    );
+    let constant = statics.replace(
+        "acceleration = [0.0, -9.81, 0.0]\n",
+        "acceleration = [0.0, -9.81, 0.0]\ncurve = \"constant\"\n",
+    );
+    let (code, _, err) = run_model(&dir, "constant.toml", &constant);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let (_, _, load) = driver_rows(&dir)[5];
+    assert!((load - expected).abs() < 1e-6 * expected, "{load}");
+}
+
+/// A driver value meant in degrees: read in radians, 90 rad over ten
+/// increments asks for 9 rad per increment (more than half a turn): a
+/// warning names the driver and suggests `unit = "deg"`; with it, the
+/// hinge turns by π/2 in ten increments without a cut-back.
+#[test]
+fn angles_in_degrees() {
+    let dir = scratch("degrees");
+    let kinematic = "[analysis]\ntype = \"kinematic\"\n";
+    let (code, out, err) = run_model(&dir, "rad.toml", &pendulum("90", None, kinematic));
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("rad.toml: driver 3: asks for 9.0000 rad (515.7°) in one increment")
+            && err.contains("unit = \"deg\""),
+        "{err}"
+    );
+    assert!(!out.contains(" 0 cut-backs"), "{out}");
+    let (code, out, err) = run_model(&dir, "deg.toml", &pendulum("90", Some("deg"), kinematic));
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    assert!(
+        out.contains("10 increments") && out.contains(" 0 cut-backs"),
+        "{out}"
+    );
+    let (_, angle, _) = *driver_rows(&dir).last().unwrap();
+    assert!(
+        (angle - std::f64::consts::FRAC_PI_2).abs() < 1e-9,
+        "{angle}"
+    );
+
+    // a unit on a length, and an unknown unit
+    let slide = pendulum("0.1", Some("deg"), kinematic).replace("\"revolute\"", "\"prismatic\"");
+    assert_rejected(
+        "unit_on_slide",
+        &slide,
+        &[
+            "driver 3",
+            "unit = \"deg\" applies to angles, but coordinate slide is a length",
+        ],
+    );
+    assert_rejected(
+        "unknown_unit",
+        &pendulum("90", Some("grad"), kinematic),
+        &["unknown variant `grad`", "expected `rad` or `deg`"],
+    );
+}
+
+/// `check` runs every check that needs no analysis, with the message and
+/// the exit code (2) of `run`: an undriven four-bar in a kinematic
+/// analysis is not determinate; a mechanism in statics has a singular
+/// tangent, named by node and component.
+#[test]
+fn check_finds_what_run_rejects() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/four_bar.toml"),
+    )
+    .unwrap();
+    let free = &text[..text.find("[[drivers]]").unwrap()];
+    let pinned = CANTILEVER.replace("fixed = [\"all\"]", "fixed = [\"translations\"]");
+    for (name, model, message) in [
+        (
+            "free_four_bar",
+            free.to_string(),
+            "do not make the mechanism determinate: 1 motion(s) are left free",
+        ),
+        ("pinned", pinned, "singular tangent: no stiffness for node "),
+    ] {
+        let dir = scratch(name);
+        let file = format!("{name}.toml");
+        let (run_code, _, run_err) = run_model(&dir, &file, &model);
+        let (code, out, err) = unfold(&["check", dir.join(&file).to_str().unwrap()]);
+        assert_eq!(code, 2, "{name}: {out}{err}");
+        assert_eq!(run_code, 2, "{name}: {run_err}");
+        assert!(!out.contains("valid model"), "{name}: {out}");
+        assert!(err.contains(message), "{name}: {err}");
+        // the same message as the run
+        let first = err.lines().next().unwrap();
+        assert!(
+            run_err.contains(first),
+            "{name}: check «{first}», run «{run_err}»"
+        );
+    }
+    // with its driver, the four-bar checks, with its redundant equations
+    let dir = scratch("four_bar_checks");
+    std::fs::write(dir.join("four_bar.toml"), &text).unwrap();
+    let (code, out, err) = unfold(&["check", dir.join("four_bar.toml").to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("valid model") && out.contains("3 redundant"),
+        "{out}"
+    );
+}
+
+/// Sizes are checked before anything is allocated: a beam line of
+/// i64::MAX elements (a capacity-overflow panic before), 2³² + 1 (an
+/// abort allocating 103 GB) or 10⁹ elements (15 GB in `check`) is an
+/// error within a second, reported with the other problems of the file
+/// (here a NaN coordinate, never reached before); node ids near i64::MAX
+/// that would generate ids beyond it are errors too.
+#[test]
+fn sizes_and_ids_are_limited_before_allocating() {
+    let line = |n: &str| {
+        CANTILEVER.replace(
+            "[[beams]]\nid = 1\nnodes = [1, 2]\nsection = \"s\"\n",
+            &format!("[[beam_lines]]\nnodes = [1, 2]\nelements = {n}\nsection = \"s\"\n"),
+        ) + "\n[[nodes]]\nid = 7\nx = [nan, 0.0, 0.0]\n"
+    };
+    for n in ["9223372036854775807", "4294967297", "1000000000"] {
+        let start = std::time::Instant::now();
+        assert_rejected(
+            &format!("elements_{n}"),
+            &line(n),
+            &[
+                &format!("beam_lines[1] (nodes 1 to 2): {n} elements: more than the limit of 100000 per line"),
+                "node 7: x must be finite",
+            ],
+        );
+        // a bound far above the milliseconds it takes, far below the
+        // minutes and gigabytes of the allocation it replaces
+        assert!(start.elapsed().as_secs() < 20);
+    }
+    let ids = CANTILEVER
+        .replace("id = 3\nx", "id = 9223372036854775806\nx")
+        .replace("nodes = [2, 3]", "nodes = [2, 9223372036854775806]")
+        .replace(
+            "[[beams]]\nid = 1\nnodes = [1, 2]\nsection = \"s\"\n",
+            "[[beam_lines]]\nnodes = [1, 2]\nelements = 3\nsection = \"s\"\n",
+        )
+        .replace("node = 3", "node = 9223372036854775806");
+    assert_rejected(
+        "huge_ids",
+        &ids,
+        &[
+            "beam_lines[1] (nodes 1 to 2)",
+            "interior nodes would get ids above 9223372036854775807",
+        ],
+    );
+}
+
+/// Writing to a full or closed stream never panics: messages that cannot
+/// be written are dropped and the exit code stays that of the outcome.
+#[test]
+fn unwritable_output_streams_do_not_panic() {
+    let dir = scratch("dev_full");
+    std::fs::write(dir.join("ok.toml"), CANTILEVER).unwrap();
+    std::fs::write(
+        dir.join("bad.toml"),
+        CANTILEVER.replace("EA = 1.0e7", "EA = -1.0"),
+    )
+    .unwrap();
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    for (file, expected) in [("ok.toml", 0), ("bad.toml", 2)] {
+        for args in [vec!["check", file], vec!["run", file, "--out", "out"]] {
+            let out = Command::new(env!("CARGO_BIN_EXE_unfold"))
+                .args(&args)
+                .current_dir(&dir)
+                .stdout(full())
+                .stderr(full())
+                .output()
+                .unwrap();
+            assert_eq!(out.status.code(), Some(expected), "{args:?}");
+        }
+    }
+}
+
+/// Curves and loads that can only give non-finite values are rejected at
+/// input, naming the entity; a reference to an invalid curve is not
+/// reported again as undefined.
+#[test]
+fn non_finite_curves_and_products_are_rejected() {
+    let with_curve = |curve: &str, load: &str| {
+        CANTILEVER.replace(
+            "force = [0.0, 0.0, -1.0]",
+            &format!("force = {load}\ncurve = \"c\""),
+        ) + &format!("\n[[curves]]\nname = \"c\"\n{curve}\n")
+    };
+    let dir = scratch("sine");
+    let text = with_curve("function = \"sine\"\nfrequency = 1e308", "[0.0, 0.0, -1.0]");
+    let (code, _, err) = run_model(&dir, "sine.toml", &text);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("curve \"c\": its values over the analysis (t from 0 to 1) exceed the range of floating-point numbers"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "one problem, one message: {err}");
+    assert_rejected(
+        "amplitude_product",
+        &with_curve(
+            "function = \"sine\"\nfrequency = 1.0\namplitude = 1e300",
+            "[0.0, 0.0, -1e300]",
+        ),
+        &["loads[1] (node 3): force (1e300) times curve \"c\" (up to 1e300) exceeds the range"],
+    );
+    assert_rejected(
+        "table_overflow",
+        &with_curve(
+            "points = [[0.0, -1.7e308], [1.0, 1.7e308]]",
+            "[0.0, 0.0, -1.0]",
+        ),
+        &["curve \"c\"", "too far apart to interpolate"],
+    );
+    assert_rejected(
+        "reserved_constant",
+        &(CANTILEVER.to_string() + "\n[[curves]]\nname = \"constant\"\npoints = [[0.0, 2.0]]\n"),
+        &[
+            "curve \"constant\"",
+            "reserved for the built-in curve f(t) = 1",
+        ],
+    );
+}
+
+/// One message per problem: a bad orientation on a ten-element beam line
+/// is reported once, at the line (not once per generated beam, with
+/// doubled brackets); an invalid joint or node is not reported again by
+/// what refers to it.
+#[test]
+fn one_message_per_problem() {
+    let text = CANTILEVER.replace(
+        "[[beams]]\nid = 1\nnodes = [1, 2]\nsection = \"s\"\n",
+        "[[beam_lines]]\nnodes = [1, 2]\nelements = 10\nsection = \"s\"\norientation = [1.0, 0.0, 0.0]\nfirst_node = 100\n",
+    );
+    let dir = scratch("one_message");
+    let (code, _, err) = run_model(&dir, "line.toml", &text);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("beam_lines[1] (nodes 1 to 2): orientation vector [1.0, 0.0, 0.0] is zero or parallel to the line"),
+        "{err}"
+    );
+    assert!(!err.contains("))"), "{err}");
+
+    let text = hinged(
+        "[[joints]]\nid = 30\ntype = \"revolute\"\nnodes = [3, 4]\n\n[[joint_springs]]\nid = 31\njoint = 30\nstiffness = 1.0\n\n[[drivers]]\nid = 32\njoint = 30\nvalue = 1.0\n",
+    )
+    .replace("x = [1.0, 0.0, 0.0]\n\n[[rigid", "x = [1.0, nan, 0.0]\n\n[[rigid");
+    let (code, _, err) = run_model(&dir, "joint.toml", &text);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("joint 30: a revolute joint needs `axis`"),
+        "{err}"
+    );
+    assert!(err.contains("node 4: x must be finite"), "{err}");
+    assert_eq!(err.lines().count(), 2, "{err}");
+}
+
+/// Analysis settings that could only hang or accept anything: more than
+/// 10⁶ increments, steps lost in the round-off of t, 10⁶ iterations,
+/// tolerances of 1 or more, constraint scaling beyond 1e150.
+#[test]
+fn analysis_settings_are_limited() {
+    let analysis = |body: &str| format!("{CANTILEVER}\n[analysis]\n{body}\n");
+    assert_rejected(
+        "too_many_increments",
+        &analysis("end_time = 1.0e9\ninitial_increment = 0.1\nmax_increment = 0.1\nmin_increment = 0.01"),
+        &["analysis: end_time / max_increment = 1.000e10: the analysis would need more than 1e6 increments"],
+    );
+    assert_rejected(
+        "tiny_min_increment",
+        &analysis("min_increment = 1e-300"),
+        &[
+            "analysis: min_increment must be at least end_time·1e-12",
+            "got 1e-300",
+        ],
+    );
+    assert_rejected(
+        "many_iterations",
+        &analysis("max_iterations = 1000000"),
+        &["analysis: max_iterations must be from 1 to 1000, got 1000000"],
+    );
+    assert_rejected(
+        "loose_tolerance",
+        &analysis("residual_tolerance = 2.0\nconstraint_scale = 1e200"),
+        &[
+            "analysis: residual_tolerance must be below 1",
+            "analysis: constraint_scale must be at most 1e150",
+        ],
+    );
+}
+
+/// Values each in range whose products are not: the element is named, and
+/// the elements of a beam line sharing the problem are counted in one
+/// message.
+#[test]
+fn out_of_range_element_forces_are_named() {
+    assert_rejected(
+        "heavy_mass",
+        &format!(
+            "{CANTILEVER}\n[[point_masses]]\nid = 10\nnode = 3\nmass = 1e308\n\n[gravity]\nacceleration = [0.0, 0.0, -9.81]\n"
+        ),
+        &["point mass 10: its forces or stiffness in the reference configuration at t = 0.5 are not finite or exceed 1e150"],
+    );
+    let text = CANTILEVER
+        .replace("EA = 1.0e7", "EA = 1.0e160")
+        .replace(
+            "[[beams]]\nid = 1\nnodes = [1, 2]\nsection = \"s\"\n\n[[beams]]\nid = 2\nnodes = [2, 3]\nsection = \"s\"\n",
+            "[[beam_lines]]\nnodes = [1, 3]\nelements = 4\nsection = \"s\"\nfirst_node = 10\n",
+        )
+        .replace("[[nodes]]\nid = 2\nx = [0.5, 0.0, 0.0]\n", "");
+    let dir = scratch("stiff_line");
+    let (code, _, err) = run_model(&dir, "stiff.toml", &text);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("beam 1 (and 3 other beam elements): its forces or stiffness in the reference configuration at t = 0 are not finite or exceed 1e150"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}

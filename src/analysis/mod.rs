@@ -8,6 +8,7 @@
 
 pub mod constraints;
 pub mod newton;
+pub mod preflight;
 pub mod statics;
 
 pub use newton::{ConvergenceNorms, NewtonFailure};

@@ -332,6 +332,13 @@ impl Recorder {
             },
             model.settings.end_time
         ));
+        // warnings are shown by the caller; the log keeps them with the run
+        for w in &model.warnings {
+            recorder.log.line(&format!("warning: {w}"));
+        }
+        for line in model.load_history() {
+            recorder.line(&format!("load history: {line}"));
+        }
         recorder.log.flush()?;
         recorder.writer.write_summary(&recorder.summary)?;
         Ok(recorder)

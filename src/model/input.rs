@@ -10,6 +10,39 @@ use serde::{Deserialize, Serialize};
 /// Identifier of a node or an element, as written in the model file.
 pub type Id = u64;
 
+/// Largest id: TOML integers are 64-bit signed, so a model with a larger id
+/// (or generating one, see `beam_lines`) could not be written back.
+pub const MAX_ID: Id = i64::MAX as Id;
+
+/// The unit of the angles of an entry (`unit = "deg"`); radians by default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AngleUnit {
+    /// Radians.
+    #[default]
+    Rad,
+    /// Degrees.
+    Deg,
+}
+
+impl AngleUnit {
+    /// Radians per unit.
+    pub fn radians(self) -> f64 {
+        match self {
+            Self::Rad => 1.0,
+            Self::Deg => std::f64::consts::PI / 180.0,
+        }
+    }
+
+    /// Name used in files and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Rad => "rad",
+            Self::Deg => "deg",
+        }
+    }
+}
+
 /// A complete model definition.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -127,6 +160,11 @@ pub struct JointSpringInput {
     /// first.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coordinate: Option<String>,
+    /// Unit of the angles when the coordinate is an angle: `free_value`,
+    /// the abscissae of `table`, and the angle in `stiffness` (N·m per
+    /// unit), `damping` and `damping_table` (per unit per unit of `t`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
     /// Linear spring: stiffness (N/m or N·m/rad).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stiffness: Option<f64>,
@@ -169,8 +207,12 @@ pub struct DriverInput {
     /// ...`translation` (default) or `rotation`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<String>,
-    /// Value of the coordinate when the curve equals 1 (m or rad).
+    /// Value of the coordinate when the curve equals 1 (m, or rad unless
+    /// `unit` says otherwise).
     pub value: f64,
+    /// Unit of `value` for an angle coordinate or a node rotation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
     /// Curve `f(t)`, default the ramp `f(t) = t`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve: Option<String>,
@@ -275,6 +317,9 @@ pub struct NodeInput {
     /// Orientation as a rotation vector (global frame), default none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotation: Option<[f64; 3]>,
+    /// Unit of `rotation` (its length is the angle).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
 }
 
 /// Cross-section properties of a beam.
@@ -485,6 +530,9 @@ pub struct PrescribedInput {
     /// `R(t) = exp(f(t) ψ~) R₀`. Fixes all three rotations of the node.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotation: Option<[f64; 3]>,
+    /// Unit of `rotation`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
     /// Name of the curve `f(t)`; default `ramp` (`f(t) = t`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve: Option<String>,
@@ -506,7 +554,8 @@ pub struct LoadInput {
     /// components in the node's material frame, turning with the node.
     #[serde(default)]
     pub follower: bool,
-    /// Name of the load curve; default `ramp` (`f(t) = t`).
+    /// Name of the load curve; default `ramp` (`f(t) = t`), or `constant`
+    /// in a kinematic analysis.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve: Option<String>,
 }
@@ -517,7 +566,8 @@ pub struct LoadInput {
 pub struct GravityInput {
     /// Acceleration of gravity reached when the curve equals 1.
     pub acceleration: [f64; 3],
-    /// Name of the load curve; default `ramp`.
+    /// Name of the load curve; default `ramp`, or `constant` in a
+    /// kinematic analysis.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve: Option<String>,
 }
@@ -585,6 +635,7 @@ impl ModelInput {
             id,
             x,
             rotation: None,
+            unit: None,
         });
         self
     }
@@ -657,7 +708,8 @@ impl ModelInput {
         self
     }
 
-    /// Adds a dead nodal force and moment following the default ramp.
+    /// Adds a dead nodal force and moment following the default curve (the
+    /// ramp in statics, the constant in a kinematic analysis).
     pub fn add_load(&mut self, node: Id, force: [f64; 3], moment: [f64; 3]) -> &mut Self {
         self.loads.push(LoadInput {
             node,

@@ -3,7 +3,9 @@
 //!
 //! A [`Model`] is built from a [`input::ModelInput`] (read from a model file
 //! or written in Rust) by [`Model::from_input`], which checks everything and
-//! reports every problem it finds, each naming the entity concerned.
+//! reports every problem it finds, each naming the entity concerned, and
+//! keeps the warnings (input that is valid but probably not what was
+//! meant) in [`Model::warnings`] for the caller to show.
 
 mod build;
 pub mod input;
@@ -15,6 +17,11 @@ use crate::elements::{ConstraintScaling, Element, EvalContext};
 use crate::so3::{Rotation, Vec3};
 use crate::state::State;
 use input::Id;
+
+pub use build::{
+    LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MAX_LINE_ELEMENTS, MAX_MODEL_SIZE,
+    MIN_RELATIVE_INCREMENT,
+};
 
 /// Names of the six components of a node, in local unknown order.
 pub const COMPONENT_NAMES: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
@@ -93,8 +100,13 @@ pub struct Model {
     pub fixed: Vec<[bool; 6]>,
     /// Prescribed motions.
     pub prescribed: Vec<Prescribed>,
-    /// Load curves; index 0 is the built-in ramp.
+    /// Load curves; index 0 is the built-in ramp, 1 the built-in constant.
     pub curves: Vec<Curve>,
+    /// Which curve each load, the gravity, each prescribed motion, each
+    /// driver and each gradual initial strain follows.
+    pub curve_uses: Vec<CurveUse>,
+    /// Input that is valid but probably not what was meant.
+    pub warnings: Vec<ModelWarning>,
     /// Gravity acceleration and its curve.
     pub gravity: Option<(Vec3, CurveIndex)>,
     /// Analysis settings.
@@ -104,6 +116,27 @@ pub struct Model {
     pub length_scale: f64,
     /// Scaling and penalty of the constraint equations.
     pub scaling: ConstraintScaling,
+}
+
+/// A quantity that follows a curve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurveUse {
+    /// The entity, as in messages (`gravity`, `loads[2] (node 5)`, `driver 3`).
+    pub entity: String,
+    /// The curve.
+    pub curve: CurveIndex,
+    /// Whether the curve is the default one (no `curve` given).
+    pub by_default: bool,
+}
+
+/// Input that is valid but probably not what was meant, naming the entity.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{entity}: {message}")]
+pub struct ModelWarning {
+    /// The entity, as the user wrote it.
+    pub entity: String,
+    /// What looks wrong, and what to write instead.
+    pub message: String,
 }
 
 impl fmt::Debug for Model {
@@ -234,6 +267,45 @@ impl Model {
         }
     }
 
+    /// The load history in words, one line per curve: which loads, gravity,
+    /// prescribed motions, drivers and initial strains follow it, those
+    /// that follow it by default marked so (at most [`LISTED`] entities
+    /// named per line).
+    pub fn load_history(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        for (c, curve) in self.curves.iter().enumerate() {
+            let uses: Vec<&CurveUse> = self.curve_uses.iter().filter(|u| u.curve == c).collect();
+            if uses.is_empty() {
+                continue;
+            }
+            let mut named: Vec<String> = uses
+                .iter()
+                .take(LISTED)
+                .map(|u| {
+                    if u.by_default {
+                        format!("{} (default)", u.entity)
+                    } else {
+                        u.entity.clone()
+                    }
+                })
+                .collect();
+            if uses.len() > LISTED {
+                let defaults = uses[LISTED..].iter().filter(|u| u.by_default).count();
+                named.push(format!(
+                    "and {} more ({defaults} by default)",
+                    uses.len() - LISTED
+                ));
+            }
+            lines.push(format!(
+                "curve \"{}\" ({}) is followed by {}",
+                curve.name(),
+                curve.describe(),
+                named.join(", ")
+            ));
+        }
+        lines
+    }
+
     /// Index of the node with id `id`.
     pub fn node_index(&self, id: Id) -> Option<usize> {
         self.node_lookup.get(&id).copied()
@@ -268,6 +340,9 @@ impl Model {
         }
     }
 }
+
+/// Entities named per line of [`Model::load_history`].
+pub const LISTED: usize = 8;
 
 /// What is wrong with a model definition.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

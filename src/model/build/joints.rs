@@ -1,46 +1,29 @@
 //! Validation and construction of joints, joint springs and drivers.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
-use super::{Checker, NodeData};
-use crate::curves::CurveIndex;
+use super::curves::RAMP;
+use super::Builder;
 use crate::elements::Element;
 use crate::joints::types::{Coordinate, JointParameters};
 use crate::joints::{Driver, Joint, JointSpring, JointType, Law, Pair, PairCoordinate};
-use crate::model::input::{DriverInput, Id, JointInput, JointSpringInput, ModelInput};
+use crate::model::input::{AngleUnit, DriverInput, Id, JointInput, JointSpringInput};
 use crate::model::ModelErrorKind;
 use crate::so3::{self, Mat3, Vec3};
 
 /// Angle below which two axes count as parallel (rad).
 const PARALLEL: f64 = 1e-6;
 
-/// What the joint builder needs from the model builder.
-pub(super) struct Context<'a> {
-    pub ck: &'a mut Checker,
-    pub node_index: &'a HashMap<Id, usize>,
-    pub nodes: &'a [NodeData],
-    pub claim_id: &'a mut dyn FnMut(&mut Checker, &str, Id) -> bool,
-    pub find_curve: &'a dyn Fn(&mut Checker, &str, &Option<String>) -> CurveIndex,
-    pub elements: &'a mut Vec<Box<dyn Element>>,
-}
+/// Largest change of a driven angle in one increment: the branch of an
+/// angle is followed only while an increment turns it by less than half a
+/// turn (docs/joints.md §3.3).
+const MAX_TURN_PER_INCREMENT: f64 = std::f64::consts::PI;
 
-impl Context<'_> {
-    fn node(&mut self, entity: &str, id: Id) -> Option<usize> {
-        let found = self.node_index.get(&id).copied();
-        if found.is_none() {
-            self.ck.push(
-                ModelErrorKind::UnknownNode,
-                entity,
-                format!("node {id} does not exist"),
-            );
-        }
-        found
-    }
-
+impl Builder<'_> {
     fn unit(&mut self, entity: &str, what: &str, v: [f64; 3]) -> Option<Vec3> {
         let v = Vec3::from(v);
         let n = v.norm();
-        if v.iter().all(|c| c.is_finite()) && n > 0.0 {
+        if v.iter().all(|c| c.is_finite()) && n > 0.0 && n.is_finite() {
             Some(v / n)
         } else {
             self.ck.push(
@@ -56,6 +39,9 @@ impl Context<'_> {
     }
 }
 
+/// The builder, as the joint functions know it.
+type Context<'b, 'i> = Builder<'i>;
+
 /// A joint as built, for joint springs and drivers to refer to.
 struct Built {
     joint_type: JointType,
@@ -63,15 +49,24 @@ struct Built {
     pair: Pair,
 }
 
-/// Builds every joint, joint spring and driver of `input`.
-pub(super) fn build(cx: &mut Context, input: &ModelInput) {
-    let mut built: HashMap<Id, Built> = HashMap::new();
+/// Joints as built, for joint springs and drivers to refer to.
+#[derive(Default)]
+struct Joints {
+    built: HashMap<Id, Built>,
+    /// Ids of joints defined with errors (already reported).
+    invalid: HashSet<Id>,
+}
+
+/// Builds every joint, joint spring and driver of the input.
+pub(super) fn build(cx: &mut Builder) {
+    let input = cx.input;
+    let mut joints = Joints::default();
     for j in &input.joints {
         let entity = format!("joint {}", j.id);
-        let id_ok = (cx.claim_id)(cx.ck, &entity, j.id);
-        if let Some(joint) = joint(cx, &entity, j) {
-            if id_ok {
-                built.insert(
+        let id_ok = cx.claim_id(&entity, j.id);
+        match (joint(cx, &entity, j), id_ok) {
+            (Some(joint), true) => {
+                joints.built.insert(
                     j.id,
                     Built {
                         joint_type: joint.joint_type(),
@@ -81,19 +76,24 @@ pub(super) fn build(cx: &mut Context, input: &ModelInput) {
                 );
                 cx.elements.push(Box::new(joint));
             }
+            _ => {
+                if !joints.built.contains_key(&j.id) {
+                    joints.invalid.insert(j.id);
+                }
+            }
         }
     }
     for s in &input.joint_springs {
         let entity = format!("joint spring {}", s.id);
-        let id_ok = (cx.claim_id)(cx.ck, &entity, s.id);
-        if let (Some(e), true) = (joint_spring(cx, &entity, s, &built), id_ok) {
+        let id_ok = cx.claim_id(&entity, s.id);
+        if let (Some(e), true) = (joint_spring(cx, &entity, s, &joints), id_ok) {
             cx.elements.push(Box::new(e));
         }
     }
     for d in &input.drivers {
         let entity = format!("driver {}", d.id);
-        let id_ok = (cx.claim_id)(cx.ck, &entity, d.id);
-        if let (Some(e), true) = (driver(cx, &entity, d, &built), id_ok) {
+        let id_ok = cx.claim_id(&entity, d.id);
+        if let (Some(e), true) = (driver(cx, &entity, d, &joints), id_ok) {
             cx.elements.push(Box::new(e));
         }
     }
@@ -148,10 +148,6 @@ fn joint(cx: &mut Context, entity: &str, j: &JointInput) -> Option<Joint> {
         return None;
     }
     let idx: Vec<Option<usize>> = j.nodes.iter().map(|&n| cx.node(entity, n)).collect();
-    let idx: Vec<usize> = idx.into_iter().collect::<Option<_>>()?;
-    let a = idx[0];
-    let b = idx.get(1).copied();
-    let (xa, ra) = (cx.nodes[a].x, so3::matrix(&cx.nodes[a].q));
 
     // fields that only some types take
     let needs_axis = matches!(
@@ -189,60 +185,6 @@ fn joint(cx: &mut Context, entity: &str, j: &JointInput) -> Option<Joint> {
         cx,
     );
     unexpected("position", j.position.is_some() && t == JointType::Glue, cx);
-
-    if t == JointType::Slider {
-        if j.curve.len() < 2 {
-            cx.ck.push(
-                ModelErrorKind::Invalid,
-                entity,
-                "a slider needs `curve` with at least two nodes",
-            );
-            return None;
-        }
-        if b.is_some() {
-            cx.ck.push(
-                ModelErrorKind::Invalid,
-                entity,
-                "a slider takes one node in `nodes` (the sliding node) and its path in `curve`",
-            );
-            return None;
-        }
-        let curve: Vec<usize> = j
-            .curve
-            .iter()
-            .map(|&n| cx.node(entity, n))
-            .collect::<Option<_>>()?;
-        if curve.contains(&a) {
-            cx.ck.push(
-                ModelErrorKind::Invalid,
-                entity,
-                format!("the sliding node {} is also on its curve", j.nodes[0]),
-            );
-            return None;
-        }
-        for w in curve.windows(2) {
-            if (cx.nodes[w[1]].x - cx.nodes[w[0]].x).norm() == 0.0 {
-                cx.ck.push(
-                    ModelErrorKind::ZeroLength,
-                    entity,
-                    "two consecutive curve nodes coincide",
-                );
-                return None;
-            }
-        }
-        let p = j.position.map_or(xa, Vec3::from);
-        let pts: Vec<Vec3> = curve.iter().map(|&c| cx.nodes[c].x).collect();
-        let spline = j.spline.unwrap_or(true);
-        let s0 = project_on_curve(&pts, &p, spline);
-        return Some(Joint::slider(
-            j.id,
-            a,
-            ra.transpose() * (p - xa),
-            &curve,
-            spline,
-            s0,
-        ));
-    }
 
     // joint axes
     let e = if needs_axis {
@@ -333,6 +275,66 @@ fn joint(cx: &mut Context, entity: &str, j: &JointInput) -> Option<Joint> {
                 return None;
             }
         }
+    }
+
+    // the nodes (the checks above need none of them)
+    let idx: Vec<usize> = idx.into_iter().collect::<Option<_>>()?;
+    let a = idx[0];
+    let b = idx.get(1).copied();
+    let (xa, ra) = (cx.nodes[a].x, so3::matrix(&cx.nodes[a].q));
+
+    if t == JointType::Slider {
+        if j.curve.len() < 2 {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                "a slider needs `curve` with at least two nodes",
+            );
+            return None;
+        }
+        if b.is_some() {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                "a slider takes one node in `nodes` (the sliding node) and its path in `curve`",
+            );
+            return None;
+        }
+        let curve: Vec<usize> = j
+            .curve
+            .iter()
+            .map(|&n| cx.node(entity, n))
+            .collect::<Option<_>>()?;
+        if curve.contains(&a) {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("the sliding node {} is also on its curve", j.nodes[0]),
+            );
+            return None;
+        }
+        for w in curve.windows(2) {
+            if (cx.nodes[w[1]].x - cx.nodes[w[0]].x).norm() == 0.0 {
+                cx.ck.push(
+                    ModelErrorKind::ZeroLength,
+                    entity,
+                    "two consecutive curve nodes coincide",
+                );
+                return None;
+            }
+        }
+        let p = j.position.map_or(xa, Vec3::from);
+        let pts: Vec<Vec3> = curve.iter().map(|&c| cx.nodes[c].x).collect();
+        let spline = j.spline.unwrap_or(true);
+        let s0 = project_on_curve(&pts, &p, spline);
+        return Some(Joint::slider(
+            j.id,
+            a,
+            ra.transpose() * (p - xa),
+            &curve,
+            spline,
+            s0,
+        ));
     }
 
     let bb = b.map(|b| (cx.nodes[b].x, so3::matrix(&cx.nodes[b].q)));
@@ -430,14 +432,16 @@ fn joint_coordinate(
     entity: &str,
     joint: Id,
     coordinate: &Option<String>,
-    built: &HashMap<Id, Built>,
+    joints: &Joints,
 ) -> Option<PairCoordinate> {
-    let Some(b) = built.get(&joint) else {
-        cx.ck.push(
-            ModelErrorKind::UnknownNode,
-            entity,
-            format!("joint {joint} does not exist (or is invalid)"),
-        );
+    let Some(b) = joints.built.get(&joint) else {
+        if !joints.invalid.contains(&joint) {
+            cx.ck.push(
+                ModelErrorKind::UnknownNode,
+                entity,
+                format!("joint {joint} does not exist"),
+            );
+        }
         return None;
     };
     let coords = b.joint_type.coordinates();
@@ -477,7 +481,34 @@ fn joint_coordinate(
     }
 }
 
-/// A law from a linear coefficient or a table.
+/// Radians per unit of the angles of an entry acting on `source`; an error
+/// if a unit is given for a coordinate that is not an angle.
+fn angle_unit(
+    cx: &mut Context,
+    entity: &str,
+    unit: Option<AngleUnit>,
+    source: &PairCoordinate,
+) -> Option<f64> {
+    match unit {
+        Some(u) if !source.is_angle() => {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "unit = \"{}\" applies to angles, but coordinate {} is a length",
+                    u.name(),
+                    source.coordinate.name()
+                ),
+            );
+            None
+        }
+        u => Some(u.unwrap_or_default().radians()),
+    }
+}
+
+/// A law from a linear coefficient or a table, the coordinate (table
+/// abscissae) scaled by `unit` and the coefficient divided by it.
+#[allow(clippy::too_many_arguments)]
 fn law(
     cx: &mut Context,
     entity: &str,
@@ -485,6 +516,7 @@ fn law(
     linear: Option<f64>,
     x0: f64,
     table: &[[f64; 2]],
+    unit: f64,
 ) -> Result<Option<Law>, ()> {
     match (linear, table.is_empty()) {
         (Some(_), false) => {
@@ -496,40 +528,39 @@ fn law(
             Err(())
         }
         (Some(k), true) => {
-            if !(k.is_finite() && k >= 0.0) {
+            if !(k.is_finite() && k >= 0.0 && (k / unit).is_finite()) {
                 cx.ck.push(
                     ModelErrorKind::NonPositive,
                     entity,
-                    format!("{what} must be zero or positive, got {k}"),
+                    format!("{what} must be zero or positive and finite, got {k}"),
                 );
                 return Err(());
             }
-            Ok(Some(Law::Linear { k, x0 }))
+            Ok(Some(Law::Linear { k: k / unit, x0 }))
         }
         (None, false) => {
-            if what == "damping" && table.len() >= 2 {
-                let l = Law::Table(table.iter().map(|p| (p[0], p[1])).collect());
-                if l.eval(0.0).0 != 0.0 {
-                    cx.ck.push(
-                        ModelErrorKind::Invalid,
-                        entity,
-                        "the damping table must give zero force at zero rate",
-                    );
-                    return Err(());
-                }
-            }
-            if table.len() < 2
-                || table
-                    .iter()
-                    .any(|p| !(p[0].is_finite() && p[1].is_finite()))
-                || table.windows(2).any(|w| w[1][0] <= w[0][0])
+            let points: Vec<(f64, f64)> = table.iter().map(|p| (p[0] * unit, p[1])).collect();
+            if points.len() < 2
+                || points.iter().any(|p| !(p.0.is_finite() && p.1.is_finite()))
+                || points.windows(2).any(|w| {
+                    w[1].0 <= w[0].0
+                        || !(w[1].0 - w[0].0).is_finite()
+                        || !(w[1].1 - w[0].1).is_finite()
+                })
             {
-                cx.ck.push(ModelErrorKind::Invalid, entity, format!("the {what} table needs at least two finite points with strictly increasing abscissae"));
+                cx.ck.push(ModelErrorKind::Invalid, entity, format!("the {what} table needs at least two finite points with strictly increasing abscissae (and differences between them that do not overflow)"));
                 return Err(());
             }
-            Ok(Some(Law::Table(
-                table.iter().map(|p| (p[0], p[1])).collect(),
-            )))
+            let l = Law::Table(points);
+            if what == "damping" && l.eval(0.0).0 != 0.0 {
+                cx.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    "the damping table must give zero force at zero rate",
+                );
+                return Err(());
+            }
+            Ok(Some(l))
         }
         (None, true) => Ok(None),
     }
@@ -539,17 +570,30 @@ fn joint_spring(
     cx: &mut Context,
     entity: &str,
     s: &JointSpringInput,
-    built: &HashMap<Id, Built>,
+    joints: &Joints,
 ) -> Option<JointSpring> {
-    let source = joint_coordinate(cx, entity, s.joint, &s.coordinate, built);
-    let x0 = s.free_value.unwrap_or(0.0);
+    let source = joint_coordinate(cx, entity, s.joint, &s.coordinate, joints);
+    let unit = match &source {
+        Some(src) => angle_unit(cx, entity, s.unit, src)?,
+        None => 1.0,
+    };
+    let x0 = s.free_value.unwrap_or(0.0) * unit;
     if !x0.is_finite() {
         cx.ck
             .push(ModelErrorKind::Invalid, entity, "free_value must be finite");
         return None;
     }
-    let spring = law(cx, entity, "stiffness", s.stiffness, x0, &s.table).ok()?;
-    let damper = law(cx, entity, "damping", s.damping, 0.0, &s.damping_table).ok()?;
+    let spring = law(cx, entity, "stiffness", s.stiffness, x0, &s.table, unit);
+    let damper = law(
+        cx,
+        entity,
+        "damping",
+        s.damping,
+        0.0,
+        &s.damping_table,
+        unit,
+    );
+    let (spring, damper) = (spring.ok()?, damper.ok()?);
     if spring.is_none() && damper.is_none() {
         cx.ck.push(
             ModelErrorKind::Missing,
@@ -561,13 +605,8 @@ fn joint_spring(
     Some(JointSpring::new(s.id, source?, spring, damper))
 }
 
-fn driver(
-    cx: &mut Context,
-    entity: &str,
-    d: &DriverInput,
-    built: &HashMap<Id, Built>,
-) -> Option<Driver> {
-    let curve = (cx.find_curve)(cx.ck, entity, &d.curve);
+fn driver(cx: &mut Context, entity: &str, d: &DriverInput, joints: &Joints) -> Option<Driver> {
+    let curve = cx.curve(entity, &d.curve, RAMP);
     if !d.value.is_finite() {
         cx.ck.push(
             ModelErrorKind::Invalid,
@@ -586,14 +625,14 @@ fn driver(
                 );
                 return None;
             }
-            joint_coordinate(cx, entity, j, &d.coordinate, built)?
+            joint_coordinate(cx, entity, j, &d.coordinate, joints)?
         }
         (None, Some(n)) => {
             if d.coordinate.is_some() {
                 cx.ck.push(ModelErrorKind::Invalid, entity, "`coordinate` applies to joint drivers; a node driver takes `direction` and `motion`");
                 return None;
             }
-            let node = cx.node(entity, n)?;
+            let node = cx.node(entity, n);
             let Some(dir) = d.direction else {
                 cx.ck.push(
                     ModelErrorKind::Missing,
@@ -615,6 +654,7 @@ fn driver(
                     return None;
                 }
             };
+            let node = node?;
             let (x, r) = (cx.nodes[node].x, so3::matrix(&cx.nodes[node].q));
             let e = triad(&dir, None).expect("a unit vector has a normal");
             let pair = Pair::node_to_ground(&x, &r, &e);
@@ -633,19 +673,60 @@ fn driver(
             return None;
         }
     };
-    let driver = Driver::new(d.id, source, d.value, curve);
-    match d.active {
-        None => Some(driver),
-        Some([start, end]) if !start.is_nan() && !end.is_nan() && start < end => {
-            Some(driver.with_window(start, end))
-        }
+    let value = d.value * angle_unit(cx, entity, d.unit, &source)?;
+    let curve = curve?;
+    if !cx
+        .curves
+        .check_range(&mut cx.ck, entity, "value", value.abs(), curve)
+    {
+        return None;
+    }
+    let window = match d.active {
+        None => None,
+        Some([start, end]) if !start.is_nan() && !end.is_nan() && start < end => Some((start, end)),
         Some(w) => {
             cx.ck.push(
                 ModelErrorKind::Invalid,
                 entity,
                 format!("active must be [start, end] with start < end, got {w:?}"),
             );
-            None
+            return None;
         }
+    };
+    if source.is_angle() {
+        warn_fast_angle(cx, entity, d, value, curve);
+    }
+    let driver = Driver::new(d.id, source, value, curve);
+    Some(match window {
+        Some((start, end)) => driver.with_window(start, end),
+        None => driver,
+    })
+}
+
+/// Warns when a driven angle would turn by more than half a turn in one
+/// of the largest increments: the increments are then cut back until they
+/// ask less; a value meant in degrees and read in radians does this.
+fn warn_fast_angle(cx: &mut Context, entity: &str, d: &DriverInput, value: f64, curve: usize) {
+    let s = &cx.settings;
+    if s.arc_length || !(s.max_increment.is_finite() && s.max_increment > 0.0) {
+        return;
+    }
+    let end = cx.curves.end_time;
+    let h = s.max_increment;
+    let change = value.abs() * cx.curves.curves[curve].largest_change(h, end);
+    if change > MAX_TURN_PER_INCREMENT {
+        let hint = if d.unit.is_none() {
+            " If the value is in degrees, write unit = \"deg\"."
+        } else {
+            ""
+        };
+        cx.ck.warn(
+            entity,
+            format!(
+                "asks for {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot follow (docs/joints.md §3.3); increments will be cut back. Lower max_increment to at most {:.3e}.{hint}",
+                change.to_degrees(),
+                h * MAX_TURN_PER_INCREMENT / change
+            ),
+        );
     }
 }

@@ -1,0 +1,149 @@
+//! The checks of a model that need no analysis: what `unfold check` runs
+//! after the input is validated, and what the static analysis itself
+//! checks before its first increment, with the same errors.
+//!
+//! 1. The rank of the constraints at the reference configuration
+//!    (docs/joints.md §5): redundant constraint equations are counted, and
+//!    a kinematic analysis whose joints and drivers leave motions free is
+//!    rejected ([`StaticError::Indeterminate`]).
+//! 2. The initial stiffness: the tangent at `t = 0` is factored and solved
+//!    for a probe load that acts on every unknown (the analysis's first
+//!    correction acts only along the loads of `t = 0`, so a run with no
+//!    load at the start finds a mechanism only later); a singular tangent
+//!    (a mechanism in statics, a missing support) is named by node and
+//!    component, as a run names it ([`StaticError::Initial`] with
+//!    [`NewtonFailure::Singular`]), and so are non-finite values in the
+//!    reference configuration.
+//!
+//! Equilibrium itself is not sought: that is the analysis.
+
+use super::newton::{NewtonFailure, NewtonSolver};
+use super::statics::StaticError;
+use crate::dofs::DofKind;
+use crate::linalg::{smallest_relative_pivot, SparseLu};
+use crate::model::Model;
+
+/// A relative pivot below this marks the tangent as singular: the value of
+/// the Newton solver (`analysis::newton`), which reports the same failure
+/// when the first correction of a run meets it.
+const SINGULAR_PIVOT: f64 = 1e-11;
+
+/// Corrections larger than this (times the model size for translations,
+/// in radians for rotations) mean the tangent is singular or nearly so:
+/// the value of the Newton solver.
+const RUNAWAY_CORRECTION: f64 = 1e6;
+
+/// What the checks found in a sound model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Preflight {
+    /// Free unknowns, redundant constraints included (as in the log of a
+    /// run).
+    pub unknowns: usize,
+    /// Constraint equations that repeat others (removed by the analysis).
+    pub redundant_constraints: usize,
+    /// Motions the constraints leave free (to springs and beams in
+    /// statics; none in a kinematic analysis).
+    pub free_motions: usize,
+}
+
+/// Runs the checks of the module documentation on `model`.
+pub fn check(model: &Model) -> Result<Preflight, StaticError> {
+    let mut solver = NewtonSolver::new(model);
+    let unknowns = solver.dofs.n_equations();
+    let mut state = model.initial_state();
+    model.apply_prescribed(&mut state, 0.0);
+
+    // rank of the constraints, as StaticAnalysis::run
+    let rank = solver.constraint_rank(model, &state);
+    let free = rank.degrees_of_freedom();
+    if model.settings.kinematic && free > 0 {
+        let dofs: Vec<String> = rank
+            .freedom
+            .iter()
+            .take(free.min(6))
+            .map(|&(d, _)| solver.dof_label(model, d))
+            .collect();
+        return Err(StaticError::Indeterminate {
+            free,
+            dofs: dofs.join(", "),
+        });
+    }
+
+    // residual and tangent at t = 0, then the tangent's response to a
+    // probe load
+    solver.assemble(model, &state, 0.0, true);
+    if solver.residual().iter().any(|r| !r.is_finite()) {
+        return Err(StaticError::Initial(NewtonFailure::NonFinite {
+            iteration: 0,
+        }));
+    }
+    if let Some(failure) = singular_direction(model, &solver) {
+        return Err(StaticError::Initial(failure));
+    }
+    Ok(Preflight {
+        unknowns,
+        redundant_constraints: rank.redundant.len(),
+        free_motions: free,
+    })
+}
+
+/// Solves `K Δq = b` for a probe load `b` with every component of the size
+/// of the tangent's diagonal (times the model size `L` for forces, zero on
+/// constraint equations) and a pseudo-random sign and magnitude, so that
+/// it has a component along any direction without stiffness. As in the
+/// Newton solver, a correction beyond [`RUNAWAY_CORRECTION`] (`·L` for
+/// translations) marks a singular tangent, confirmed and located by the
+/// smallest relative pivot (below [`SINGULAR_PIVOT`]).
+fn singular_direction(model: &Model, solver: &NewtonSolver) -> Option<NewtonFailure> {
+    let k = solver.tangent();
+    let n = k.dim();
+    if n == 0 {
+        return None;
+    }
+    let length = model.length_scale;
+    let kinds: Vec<DofKind> = (0..n)
+        .map(|eq| solver.dofs.kind(solver.dofs.dof(eq)))
+        .collect();
+    let mut probe: Vec<f64> = (0..n)
+        .map(|eq| {
+            let size = match kinds[eq] {
+                DofKind::Translation => length,
+                DofKind::Rotation => 1.0,
+                DofKind::Extra => return 0.0,
+            };
+            let d = k.position(eq, eq).map_or(0.0, |p| k.values()[p].abs());
+            let d = if d > 0.0 {
+                d
+            } else {
+                k.column_max_abs(eq).max(1.0)
+            };
+            // a fixed sequence of factors in ±[0.5, 1.5] (Weyl sequence of
+            // the golden ratio)
+            let u = (eq as f64 * 0.618_033_988_749_895).fract();
+            let factor = if eq % 3 == 1 { -0.5 - u } else { 0.5 + u };
+            factor * d * size
+        })
+        .collect();
+    let solved = SparseLu::analyze(k).and_then(|mut lu| {
+        lu.factor(k)?;
+        lu.solve_in_place(&mut probe)
+    });
+    // (a non-finite correction runs away too)
+    let within = |dq: f64, limit: f64| dq.is_finite() && dq.abs() <= limit;
+    let runaway = solved.is_err()
+        || probe.iter().zip(&kinds).any(|(&dq, kind)| match kind {
+            DofKind::Translation => !within(dq, RUNAWAY_CORRECTION * length),
+            DofKind::Rotation => !within(dq, RUNAWAY_CORRECTION),
+            DofKind::Extra => false,
+        });
+    if !runaway {
+        return None;
+    }
+    match smallest_relative_pivot(k) {
+        Ok((eq, pivot)) if pivot < SINGULAR_PIVOT => Some(NewtonFailure::Singular {
+            dof: solver.dof_label(model, solver.dofs.dof(eq)),
+            pivot,
+        }),
+        _ => None,
+    }
+}

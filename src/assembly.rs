@@ -43,16 +43,62 @@ pub struct Assembler {
     residual_offsets: Vec<usize>,
 }
 
+/// The sparsity pattern of the tangent, in equation numbering.
+pub struct TangentPattern {
+    matrix: SparseMatrix,
+}
+
+impl TangentPattern {
+    /// Builds the pattern from the element connectivity: every pair of
+    /// free equations of one element, and every diagonal entry.
+    pub fn new(model: &Model, dofs: &DofMap) -> Self {
+        let mut entries = Vec::new();
+        for e in 0..model.elements.len() {
+            let d = dofs.element_dofs(model, e);
+            for &dj in &d {
+                let cj = dofs.equation(dj);
+                if cj == NO_EQUATION {
+                    continue;
+                }
+                for &di in &d {
+                    let ri = dofs.equation(di);
+                    if ri != NO_EQUATION {
+                        entries.push((ri, cj));
+                    }
+                }
+            }
+        }
+        // every free equation has a diagonal entry, even if no element
+        // touches it (a singular system is then reported, not a panic)
+        let neq = dofs.n_equations();
+        entries.extend((0..neq).map(|i| (i, i)));
+        Self {
+            matrix: SparseMatrix::from_pattern(neq, entries),
+        }
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.matrix.nnz()
+    }
+}
+
 impl Assembler {
     /// Builds the pattern and the scatter maps.
     pub fn new(model: &Model, dofs: &DofMap) -> Self {
+        Self::with_pattern(model, dofs, TangentPattern::new(model, dofs))
+    }
+
+    /// Builds the scatter maps from the element entries to `pattern`,
+    /// which must be the pattern of `model` and `dofs`.
+    pub fn with_pattern(model: &Model, dofs: &DofMap, pattern: TangentPattern) -> Self {
+        let matrix = pattern.matrix;
         let n_el = model.elements.len();
         let mut offsets = Vec::with_capacity(n_el + 1);
         let mut tangent_offsets = Vec::with_capacity(n_el + 1);
         let mut residual_offsets = Vec::with_capacity(n_el + 1);
         let (mut o, mut to, mut ro) = (0, 0, 0);
         let mut residual_map = Vec::new();
-        let mut entries = Vec::new();
         let element_dofs: Vec<Vec<usize>> =
             (0..n_el).map(|e| dofs.element_dofs(model, e)).collect();
         for d in &element_dofs {
@@ -64,27 +110,10 @@ impl Assembler {
             to += n * n;
             ro += n;
             residual_map.extend(d.iter().map(|&x| x as u32));
-            for &dj in d {
-                let cj = dofs.equation(dj);
-                if cj == NO_EQUATION {
-                    continue;
-                }
-                for &di in d {
-                    let ri = dofs.equation(di);
-                    if ri != NO_EQUATION {
-                        entries.push((ri, cj));
-                    }
-                }
-            }
         }
         offsets.push(o);
         tangent_offsets.push(to);
         residual_offsets.push(ro);
-        // every free equation has a diagonal entry, even if no element
-        // touches it (a singular system is then reported, not a panic)
-        let neq = dofs.n_equations();
-        entries.extend((0..neq).map(|i| (i, i)));
-        let matrix = SparseMatrix::from_pattern(neq, entries);
         assert!(
             matrix.nnz() < NONE as usize,
             "too many non-zeros for 32-bit maps"

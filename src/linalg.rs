@@ -52,10 +52,9 @@ pub struct SparseMatrix {
 impl SparseMatrix {
     /// Builds the pattern from `(row, col)` pairs (duplicates allowed) of an
     /// `n × n` matrix; all values start at zero.
-    pub fn from_pattern(n: usize, mut entries: Vec<(usize, usize)>) -> Self {
-        // sort by column, then row; remove duplicates
-        entries.sort_unstable_by_key(|&(r, c)| (c, r));
-        entries.dedup();
+    pub fn from_pattern(n: usize, entries: Vec<(usize, usize)>) -> Self {
+        // bucket the rows by column (counting sort), then sort and
+        // deduplicate each column on its own
         let mut col_ptr = vec![0usize; n + 1];
         for &(_, c) in &entries {
             col_ptr[c + 1] += 1;
@@ -63,13 +62,46 @@ impl SparseMatrix {
         for j in 0..n {
             col_ptr[j + 1] += col_ptr[j];
         }
-        let row_idx: Vec<usize> = entries.iter().map(|&(r, _)| r).collect();
+        let mut fill = col_ptr.clone();
+        let mut rows = vec![0usize; entries.len()];
+        for &(r, c) in &entries {
+            rows[fill[c]] = r;
+            fill[c] += 1;
+        }
+        let mut row_idx = Vec::with_capacity(rows.len());
+        let mut unique_ptr = Vec::with_capacity(n + 1);
+        unique_ptr.push(0);
+        for j in 0..n {
+            let column = &mut rows[col_ptr[j]..col_ptr[j + 1]];
+            column.sort_unstable();
+            let start = row_idx.len();
+            for &r in column.iter() {
+                if row_idx.len() == start || row_idx.last() != Some(&r) {
+                    row_idx.push(r);
+                }
+            }
+            unique_ptr.push(row_idx.len());
+        }
+        Self::from_columns(n, unique_ptr, row_idx)
+    }
+
+    /// Builds an `n × n` pattern from its compressed columns: column `j`
+    /// has the rows `row_idx[col_ptr[j]..col_ptr[j + 1]]`, strictly
+    /// increasing. All values start at zero.
+    #[track_caller]
+    pub fn from_columns(n: usize, col_ptr: Vec<usize>, row_idx: Vec<usize>) -> Self {
         let nnz = row_idx.len();
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         Self {
             symbolic,
             values: vec![0.0; nnz],
         }
+    }
+
+    /// Start of column `j` in the value array.
+    #[inline]
+    pub fn column_start(&self, j: usize) -> usize {
+        self.symbolic.col_ptr()[j]
     }
 
     /// Number of rows (and columns).
@@ -343,6 +375,29 @@ mod tests {
                 .fold(0.0, f64::max);
             assert!(err < 1e-13, "residual {err:e}");
         }
+    }
+
+    #[test]
+    fn pattern_from_unsorted_pairs_with_duplicates() {
+        let a = SparseMatrix::from_pattern(
+            3,
+            vec![
+                (2, 0),
+                (0, 0),
+                (2, 0),
+                (1, 2),
+                (0, 2),
+                (1, 2),
+                (2, 2),
+                (0, 0),
+            ],
+        );
+        let stored: Vec<(usize, usize)> = a.entries().map(|(r, c, _)| (r, c)).collect();
+        assert_eq!(stored, [(0, 0), (2, 0), (0, 2), (1, 2), (2, 2)]);
+        assert_eq!(a.position(1, 2), Some(3));
+        assert_eq!(a.column_start(1), 2);
+        assert_eq!(a.column_start(2), 2);
+        assert_eq!(a.position(1, 1), None);
     }
 
     #[test]

@@ -7,15 +7,57 @@
 //! tangent of a material-rotation formulation is not symmetric away from
 //! equilibrium, follower loads are not symmetric either, and the saddle-point
 //! systems of Lagrange-multiplier constraints are indefinite. The symbolic
-//! analysis (ordering, elimination tree, supernodes) is computed once per
-//! sparsity pattern and reused; the numeric factor and its workspace are
-//! kept between factorisations, so a Newton iteration allocates little.
-//! Only this file knows faer's API.
+//! analysis (ordering, column elimination tree, predicted fill, supernodes)
+//! is computed once per sparsity pattern and reused; the numeric factor and
+//! its workspace are kept between factorisations, so a Newton iteration
+//! allocates little. Only this file knows faer's API.
+//!
+//! # Choice of the numeric kernel
+//!
+//! faer factors either column by column (*simplicial*) or by supernodes
+//! with dense block kernels (*supernodal*). The analysis predicts the work
+//! of the factorisation from the column counts of the Cholesky factor of
+//! `(AQ)ᵀ(AQ)` (George & Ng's bound on `L` and `U` under any row pivoting):
+//! with `h_j` and `r_j` the entries of column `j` of `L` and of `U`, the
+//! flops per factor entry are `Σ h_j (1 + r_j) / Σ (h_j + r_j)`, faer's own
+//! estimate. The supernodal kernel is chosen above
+//! [`SUPERNODAL_FLOPS_PER_ENTRY`] = 9 (faer's default cut is 40).
+//!
+//! Measured factor + solve (`cargo bench --bench lu_kernel`, 2 cores
+//! shared with other work, median of alternated repetitions; times in ms):
+//!
+//! | tangent | unknowns | flops/entry | simplicial | supernodal | rule |
+//! |---|---|---|---|---|---|
+//! | cantilever, 1,000 beams | 6,000 | 6.4 | 4.0 | 3.1 | simplicial |
+//! | cantilever, 10,000 beams | 60,000 | 6.4 | 49 | 45 | simplicial |
+//! | cantilever, 100,000 beams | 600,000 | 6.4 | 813 | 505 | simplicial |
+//! | joint chain, 100 joints | 1,700 | 7.6 | 1.14 | 0.97 | simplicial |
+//! | joint chain, 1,000 joints | 17,000 | 7.6 | 25.6 | 26.9 | simplicial |
+//! | joint chain, 10,000 joints | 170,000 | 7.6 | 266 | 356 | simplicial |
+//! | mast cell, folded | 420 | 10.5 | 0.54 | 0.27 | supernodal |
+//! | lattice mast, 8 bays | 738 | 34 | 11.2 | 6.2 | supernodal |
+//! | lattice mast, 30 bays | 2,718 | 37 | 76 | 28 | supernodal |
+//! | lattice mast, 99 bays | 8,928 | 37 | 262 | 86 | supernodal |
+//! | beam grid, 20 × 20 nodes | 2,280 | 69 | 201 | 33 | supernodal |
+//! | beam grid, 40 × 40 nodes | 9,360 | 112 | 1,874 | 187 | supernodal |
+//! | beam grid, 60 × 60 nodes | 21,240 | 150 | 8,166 | 498 | supernodal |
+//!
+//! Above 10 flops per entry (3-D lattices, grids, the mast cell) the
+//! supernodal kernel is 2 to 16 times faster, and faster at every size.
+//! Below 8 (beams and chains of links: thin factors) the two are close and
+//! the order changes from run to run: over three runs the supernodal/
+//! simplicial time ratio was 0.62–1.05 on the cantilevers and 0.83–0.86
+//! on the 100-joint chain, but 1.05–1.29 and 1.26–1.45 on the chains of
+//! 1,000 and 10,000 joints, the largest systems where the choice matters.
+//! The cut at 9 lies between the two groups (7.6 and 10.5).
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
-use faer::sparse::linalg::{LuError, SupernodalThreshold};
+use faer::perm::PermRef;
+use faer::sparse::linalg::lu::factorize_symbolic_lu;
+use faer::sparse::linalg::lu::simplicial::{self, SimplicialLu};
+use faer::sparse::linalg::lu::supernodal::{self, SupernodalLu, SymbolicSupernodalLu};
+use faer::sparse::linalg::{colamd, qr, LuError};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Spec};
 
@@ -165,20 +207,63 @@ impl SparseMatrix {
     }
 }
 
+/// The numeric kernel of the sparse LU.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LuKernel {
+    /// Column by column (left-looking, sparse triangular solves): no dense
+    /// blocks, cheapest when the factors stay thin.
+    Simplicial,
+    /// By supernodes (columns with a common structure) with dense block
+    /// kernels: pays off when the fronts are wide.
+    Supernodal,
+}
+
+/// Predicted flops per factor entry above which the supernodal kernel is
+/// chosen: between the beams and chains of links (6.4–7.6, where the
+/// simplicial kernel is as fast or faster on large systems) and the mast
+/// cell, lattices and grids (10.5 and more, where the supernodal kernel is
+/// 2 to 16 times faster); the measurements are in the module header.
+pub const SUPERNODAL_FLOPS_PER_ENTRY: f64 = 9.0;
+
 /// Sparse LU factorisation with a reusable symbolic analysis.
 pub struct SparseLu {
-    symbolic: SymbolicLu<usize>,
-    numeric: NumericLu<usize, f64>,
+    /// Fill-reducing column ordering (COLAMD), `A Q`.
+    col_perm_fwd: Vec<usize>,
+    col_perm_inv: Vec<usize>,
+    /// Row pivoting of the last factorisation, `P A Q = L U`.
+    row_perm_fwd: Vec<usize>,
+    row_perm_inv: Vec<usize>,
+    /// Predicted flops per entry of `L + U` (without pivoting).
+    flops_per_entry: f64,
+    factors: Factors,
     factor_mem: MemBuffer,
     solve_mem: MemBuffer,
     par: Par,
     factored: bool,
 }
 
+/// The factors of either kernel, with what each needs.
+enum Factors {
+    Simplicial(SimplicialLu<usize, f64>),
+    Supernodal(Box<SupernodalFactors>),
+}
+
+struct SupernodalFactors {
+    symbolic: SymbolicSupernodalLu<usize>,
+    lu: SupernodalLu<usize, f64>,
+    /// `Aᵀ`, which the supernodal kernel reads besides `A`: its pattern,
+    /// its values, and the position in `A`'s values of each of them.
+    transpose: SymbolicSparseColMat<usize>,
+    transpose_values: Vec<f64>,
+    transpose_source: Vec<usize>,
+}
+
 impl std::fmt::Debug for SparseLu {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SparseLu")
-            .field("dim", &self.symbolic.nrows())
+            .field("dim", &self.col_perm_fwd.len())
+            .field("kernel", &self.kernel())
+            .field("flops_per_entry", &self.flops_per_entry)
             .field("factored", &self.factored)
             .finish()
     }
@@ -193,34 +278,195 @@ fn par_from_threads() -> Par {
     }
 }
 
+fn internal(e: &dyn std::fmt::Debug) -> SolveError {
+    SolveError::Internal(format!("{e:?}"))
+}
+
+fn workspace(req: StackReq, what: &str) -> Result<MemBuffer, SolveError> {
+    MemBuffer::try_new(req)
+        .map_err(|_| SolveError::Internal(format!("out of memory for the {what} workspace")))
+}
+
+/// The pattern of `Aᵀ` (sorted columns) and, for each of its entries, the
+/// position of the same entry in `A`'s values.
+fn transpose_pattern(a: &SparseMatrix) -> (SymbolicSparseColMat<usize>, Vec<usize>) {
+    let n = a.dim();
+    let (ptr, rows) = (a.symbolic.col_ptr(), a.symbolic.row_idx());
+    let mut t_ptr = vec![0usize; n + 1];
+    for &r in rows {
+        t_ptr[r + 1] += 1;
+    }
+    for i in 0..n {
+        t_ptr[i + 1] += t_ptr[i];
+    }
+    let mut fill = t_ptr.clone();
+    let mut t_rows = vec![0usize; rows.len()];
+    let mut source = vec![0usize; rows.len()];
+    for j in 0..n {
+        for k in ptr[j]..ptr[j + 1] {
+            let r = rows[k];
+            t_rows[fill[r]] = j;
+            source[fill[r]] = k;
+            fill[r] += 1;
+        }
+    }
+    let t = SymbolicSparseColMat::new_checked(n, n, t_ptr, None, t_rows);
+    (t, source)
+}
+
 impl SparseLu {
     /// Symbolic analysis of the pattern of `a` (fill-reducing ordering,
-    /// elimination tree, supernodes). Valid for every matrix with the same
-    /// pattern.
+    /// elimination tree, predicted fill, supernodes), with the kernel the
+    /// predicted work calls for ([`SUPERNODAL_FLOPS_PER_ENTRY`]). Valid for
+    /// every matrix with the same pattern.
     pub fn analyze(a: &SparseMatrix) -> Result<Self, SolveError> {
-        let params = LuSymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::AUTO,
-            ..Default::default()
-        };
-        let symbolic = factorize_symbolic_lu(a.symbolic.as_ref(), params)
-            .map_err(|e| SolveError::Internal(format!("{e:?}")))?;
+        Self::analyze_for(a, None)
+    }
+
+    /// Symbolic analysis for the numeric kernel `kernel`, whatever the
+    /// prediction.
+    pub fn analyze_with(a: &SparseMatrix, kernel: LuKernel) -> Result<Self, SolveError> {
+        Self::analyze_for(a, Some(kernel))
+    }
+
+    fn analyze_for(a: &SparseMatrix, kernel: Option<LuKernel>) -> Result<Self, SolveError> {
+        let n = a.dim();
+        let pattern = a.symbolic.as_ref();
+        let (transpose, transpose_source) = transpose_pattern(a);
+        let mut mem = workspace(
+            StackReq::any_of(&[
+                colamd::order_scratch::<usize>(n, n, a.nnz()),
+                qr::col_etree_scratch::<usize>(n, n),
+                qr::postorder_scratch::<usize>(n),
+                qr::column_counts_aat_scratch::<usize>(n, n),
+                supernodal::factorize_supernodal_symbolic_lu_scratch::<usize>(n, n),
+            ]),
+            "symbolic analysis",
+        )?;
+        let stack = MemStack::new(&mut mem);
+
+        // fill-reducing column ordering Q (COLAMD)
+        let mut col_perm_fwd = vec![0usize; n];
+        let mut col_perm_inv = vec![0usize; n];
+        colamd::order(
+            &mut col_perm_fwd,
+            &mut col_perm_inv,
+            pattern,
+            Default::default(),
+            stack,
+        )
+        .map_err(|e| internal(&e))?;
+        let col_perm = PermRef::new_checked(&col_perm_fwd, &col_perm_inv, n);
+
+        // column elimination tree (that of (AQ)ᵀ(AQ)), its postorder, and
+        // the column counts of its Cholesky factor: the structure of U
+        // and an upper bound on L whatever the row pivoting (George & Ng)
+        let mut etree = vec![0usize; n];
+        let etree = qr::col_etree(pattern, Some(col_perm), &mut etree, stack);
+        let mut post = vec![0usize; n];
+        qr::postorder(&mut post, etree, stack);
+        let mut col_counts = vec![0usize; n];
+        let mut min_col = vec![0usize; n];
+        qr::column_counts_ata(
+            &mut col_counts,
+            &mut min_col,
+            transpose.as_ref(),
+            Some(col_perm),
+            etree,
+            &post,
+            stack,
+        );
+
+        // predicted work per factor entry, as faer estimates it: column j
+        // of L has h_j entries (rows whose first column is j, plus those
+        // inherited from its children in the tree), column j of U r_j;
+        // flops Σ h_j (1 + r_j) over entries Σ (h_j + r_j)
+        let parent = etree.into_inner();
+        let mut h = vec![0usize; n];
+        for &first in &min_col {
+            if (first as isize) >= 0 {
+                h[first] += 1;
+            }
+        }
+        for j in 0..n {
+            if parent[j] >= 0 {
+                h[parent[j] as usize] += h[j].saturating_sub(1);
+            }
+        }
+        let (mut flops, mut entries) = (0.0f64, 0.0f64);
+        for (&hj, &rj) in h.iter().zip(&col_counts) {
+            let (hj, rj) = (hj as f64, rj as f64);
+            flops += hj + hj * rj;
+            entries += hj + rj;
+        }
+        let flops_per_entry = if entries > 0.0 { flops / entries } else { 0.0 };
+        let kernel = kernel.unwrap_or(if flops_per_entry > SUPERNODAL_FLOPS_PER_ENTRY {
+            LuKernel::Supernodal
+        } else {
+            LuKernel::Simplicial
+        });
+
         let par = par_from_threads();
         let lu_params: Spec<PartialPivLuParams, f64> = Default::default();
-        let factor_mem =
-            MemBuffer::try_new(symbolic.factorize_numeric_lu_scratch::<f64>(par, lu_params))
-                .map_err(|_| {
-                    SolveError::Internal("out of memory for the factorisation workspace".into())
-                })?;
-        let solve_mem = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, par))
-            .map_err(|_| SolveError::Internal("out of memory for the solve workspace".into()))?;
+        let (factors, factor_req, solve_req) = match kernel {
+            LuKernel::Simplicial => (
+                Factors::Simplicial(SimplicialLu::new()),
+                simplicial::factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n),
+                simplicial::solve_in_place_scratch::<usize, f64>(n, 1, par),
+            ),
+            LuKernel::Supernodal => {
+                let symbolic = supernodal::factorize_supernodal_symbolic_lu(
+                    pattern,
+                    Some(col_perm),
+                    &min_col,
+                    etree,
+                    &col_counts,
+                    stack,
+                    Default::default(),
+                )
+                .map_err(|e| internal(&e))?;
+                let factor_req = supernodal::factorize_supernodal_numeric_lu_scratch::<usize, f64>(
+                    &symbolic, lu_params,
+                );
+                (
+                    Factors::Supernodal(Box::new(SupernodalFactors {
+                        symbolic,
+                        lu: SupernodalLu::new(),
+                        transpose,
+                        transpose_values: vec![0.0; a.nnz()],
+                        transpose_source,
+                    })),
+                    factor_req,
+                    supernodal::solve_in_place_scratch::<usize, f64>(n, 1, par),
+                )
+            }
+        };
         Ok(Self {
-            symbolic,
-            numeric: NumericLu::new(),
-            factor_mem,
-            solve_mem,
+            col_perm_fwd,
+            col_perm_inv,
+            row_perm_fwd: vec![0; n],
+            row_perm_inv: vec![0; n],
+            flops_per_entry,
+            factors,
+            factor_mem: workspace(factor_req, "factorisation")?,
+            solve_mem: workspace(solve_req, "solve")?,
             par,
             factored: false,
         })
+    }
+
+    /// The numeric kernel of this analysis.
+    pub fn kernel(&self) -> LuKernel {
+        match self.factors {
+            Factors::Simplicial(_) => LuKernel::Simplicial,
+            Factors::Supernodal(_) => LuKernel::Supernodal,
+        }
+    }
+
+    /// Predicted flops per entry of the factors (without pivoting), the
+    /// quantity that chooses the kernel.
+    pub fn flops_per_entry(&self) -> f64 {
+        self.flops_per_entry
     }
 
     /// Numeric factorisation of `a`, which must have the analysed pattern.
@@ -229,22 +475,52 @@ impl SparseLu {
         if a.values.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NonFinite);
         }
+        let n = self.col_perm_fwd.len();
+        let col_perm = PermRef::new_checked(&self.col_perm_fwd, &self.col_perm_inv, n);
         let stack = MemStack::new(&mut self.factor_mem);
-        match self.symbolic.factorize_numeric_lu(
-            &mut self.numeric,
-            a.as_faer(),
-            self.par,
-            stack,
-            Default::default(),
-        ) {
-            Ok(_) => {}
+        let result = match &mut self.factors {
+            Factors::Simplicial(lu) => simplicial::factorize_simplicial_numeric_lu(
+                &mut self.row_perm_fwd,
+                &mut self.row_perm_inv,
+                lu,
+                a.as_faer(),
+                col_perm,
+                stack,
+            ),
+            Factors::Supernodal(f) => {
+                let SupernodalFactors {
+                    symbolic,
+                    lu,
+                    transpose,
+                    transpose_values,
+                    transpose_source,
+                } = &mut **f;
+                for (v, &k) in transpose_values.iter_mut().zip(transpose_source.iter()) {
+                    *v = a.values[k];
+                }
+                supernodal::factorize_supernodal_numeric_lu(
+                    &mut self.row_perm_fwd,
+                    &mut self.row_perm_inv,
+                    lu,
+                    a.as_faer(),
+                    SparseColMatRef::new(transpose.as_ref(), transpose_values),
+                    col_perm,
+                    symbolic,
+                    self.par,
+                    stack,
+                    Default::default(),
+                )
+            }
+        };
+        match result {
+            Ok(()) => {}
             Err(LuError::SymbolicSingular { index }) => {
                 return Err(SolveError::Singular {
-                    equation: self.symbolic.col_perm().arrays().0[index],
+                    equation: self.col_perm_fwd[index],
                     pivot: 0.0,
                 })
             }
-            Err(e) => return Err(SolveError::Internal(format!("{e:?}"))),
+            Err(e) => return Err(internal(&e)),
         }
         self.factored = true;
         Ok(())
@@ -256,11 +532,18 @@ impl SparseLu {
     pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), SolveError> {
         assert!(self.factored, "solve before a successful factorisation");
         let n = rhs.len();
-        // `numeric` comes from `factorize_numeric_lu` of this `symbolic`
-        let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(&self.symbolic, &self.numeric);
+        let row_perm = PermRef::new_checked(&self.row_perm_fwd, &self.row_perm_inv, n);
+        let col_perm = PermRef::new_checked(&self.col_perm_fwd, &self.col_perm_inv, n);
         let stack = MemStack::new(&mut self.solve_mem);
         let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-        lu.solve_in_place_with_conj(Conj::No, x, self.par, stack);
+        match &self.factors {
+            Factors::Simplicial(lu) => {
+                lu.solve_in_place_with_conj(row_perm, col_perm, Conj::No, x, self.par, stack)
+            }
+            Factors::Supernodal(f) => {
+                f.lu.solve_in_place_with_conj(row_perm, col_perm, Conj::No, x, self.par, stack)
+            }
+        }
         if rhs.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NonFinite);
         }
@@ -274,12 +557,10 @@ impl SparseLu {
 /// simplicial factorisation whose factors can be inspected, and is never
 /// called on the Newton hot path.
 pub fn smallest_relative_pivot(a: &SparseMatrix) -> Result<(usize, f64), SolveError> {
-    use faer::sparse::linalg::lu::simplicial;
-    let internal = |e: &dyn std::fmt::Debug| SolveError::Internal(format!("{e:?}"));
     let symbolic =
         factorize_symbolic_lu(a.symbolic.as_ref(), Default::default()).map_err(|e| internal(&e))?;
     let n = a.dim();
-    let mut lu = simplicial::SimplicialLu::<usize, f64>::new();
+    let mut lu = SimplicialLu::<usize, f64>::new();
     let mut row_perm = vec![0usize; n];
     let mut row_perm_inv = vec![0usize; n];
     let mut mem = MemBuffer::try_new(simplicial::factorize_simplicial_numeric_lu_scratch::<
@@ -359,21 +640,91 @@ mod tests {
     #[test]
     fn lu_solves_saddle_point_systems_and_reuses_the_analysis() {
         let (a, b) = saddle(1.0);
+        for kernel in [LuKernel::Simplicial, LuKernel::Supernodal] {
+            let mut lu = SparseLu::analyze_with(&a, kernel).unwrap();
+            assert_eq!(lu.kernel(), kernel);
+            solves_for_two_scales(&mut lu, &b);
+        }
         let mut lu = SparseLu::analyze(&a).unwrap();
+        solves_for_two_scales(&mut lu, &b);
+    }
+
+    fn solves_for_two_scales(lu: &mut SparseLu, b: &[f64]) {
         for scale in [1.0, 3.5] {
             // new values, same pattern: the symbolic analysis is reused
             let (a, _) = saddle(scale);
             lu.factor(&a).unwrap();
-            let mut x = b.clone();
+            let mut x = b.to_vec();
             lu.solve_in_place(&mut x).unwrap();
             let mut ax = vec![0.0; 6];
             a.mul_vec(&x, &mut ax);
             let err = ax
                 .iter()
-                .zip(&b)
+                .zip(b)
                 .map(|(p, q)| (p - q).abs())
                 .fold(0.0, f64::max);
             assert!(err < 1e-13, "residual {err:e}");
+        }
+    }
+
+    /// An `n × n` matrix with the pattern of `pairs` and non-symmetric
+    /// values, diagonally dominant.
+    fn matrix(n: usize, pairs: Vec<(usize, usize)>) -> SparseMatrix {
+        let mut a = SparseMatrix::from_pattern(n, pairs);
+        let entries: Vec<(usize, usize)> = a.entries().map(|(i, j, _)| (i, j)).collect();
+        for (i, j) in entries {
+            let p = a.position(i, j).unwrap();
+            a.values_mut()[p] = if i == j {
+                4.0 * n as f64
+            } else {
+                1.0 + 0.1 * ((3 * i + 7 * j) % 11) as f64
+            };
+        }
+        a
+    }
+
+    #[test]
+    fn kernel_follows_the_predicted_work_and_both_kernels_agree() {
+        // a tridiagonal matrix factors without fill: about one flop per
+        // entry, simplicial; a dense one costs ~n/3 flops per entry,
+        // supernodal
+        let n = 200;
+        let band = matrix(
+            n,
+            (0..n)
+                .flat_map(|i| [(i, i), (i, (i + 1) % n), ((i + 1) % n, i)])
+                .filter(|&(i, j)| i.abs_diff(j) <= 1)
+                .collect(),
+        );
+        let dense = matrix(
+            90,
+            (0..90).flat_map(|i| (0..90).map(move |j| (i, j))).collect(),
+        );
+        let lu = SparseLu::analyze(&band).unwrap();
+        assert_eq!(lu.kernel(), LuKernel::Simplicial);
+        assert!(lu.flops_per_entry() < 2.0, "{}", lu.flops_per_entry());
+        let lu = SparseLu::analyze(&dense).unwrap();
+        assert_eq!(lu.kernel(), LuKernel::Supernodal);
+        assert!(lu.flops_per_entry() > 10.0, "{}", lu.flops_per_entry());
+        for a in [&band, &dense] {
+            let b: Vec<f64> = (0..a.dim()).map(|i| (i % 7) as f64 - 3.0).collect();
+            let solutions = [LuKernel::Simplicial, LuKernel::Supernodal].map(|kernel| {
+                let mut lu = SparseLu::analyze_with(a, kernel).unwrap();
+                lu.factor(a).unwrap();
+                let mut x = b.clone();
+                lu.solve_in_place(&mut x).unwrap();
+                x
+            });
+            for x in &solutions {
+                let mut ax = vec![0.0; a.dim()];
+                a.mul_vec(x, &mut ax);
+                let err = ax
+                    .iter()
+                    .zip(&b)
+                    .map(|(p, q)| (p - q).abs())
+                    .fold(0.0, f64::max);
+                assert!(err < 1e-12, "residual {err:e}");
+            }
         }
     }
 

@@ -93,3 +93,34 @@ pub fn sizes(default: &[usize]) -> Vec<usize> {
         sizes
     }
 }
+
+/// A square grid of `k × k` nodes, 0.1 m apart, joined by beams along both
+/// directions, clamped along one edge and loaded at the opposite corner: a
+/// plate-like frame whose factors have wide fronts.
+#[allow(dead_code)]
+pub fn grid(k: usize) -> Model {
+    let mut m = ModelInput::new(format!("grid of {k} x {k} nodes"));
+    m.add_section("s", [2.1e8, 8.1e7, 8.1e7, 1.6e5, 2.1e5, 2.1e5]);
+    let id = |i: usize, j: usize| (i * k + j + 1) as u64;
+    for i in 0..k {
+        for j in 0..k {
+            m.add_node(id(i, j), [0.1 * i as f64, 0.1 * j as f64, 0.0]);
+        }
+    }
+    let mut e = 0;
+    for i in 0..k {
+        for j in 0..k {
+            if i + 1 < k {
+                e += 1;
+                m.add_beam(e, [id(i, j), id(i + 1, j)], "s", Some([0.0, 0.0, 1.0]));
+            }
+            if j + 1 < k {
+                e += 1;
+                m.add_beam(e, [id(i, j), id(i, j + 1)], "s", Some([0.0, 0.0, 1.0]));
+            }
+        }
+        m.fix(id(i, 0), &["all"]);
+    }
+    m.add_load(id(k - 1, k - 1), [0.0, 0.0, -1.0], [0.0; 3]);
+    Model::from_input(&m).expect("valid benchmark model")
+}

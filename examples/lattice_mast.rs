@@ -26,6 +26,7 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 
 use unfold::analysis::StaticAnalysis;
+use unfold::elements::ElementKind;
 use unfold::io::results::ResultWriter;
 use unfold::model::input::{BeamLineInput, Id, LoadInput, ModelInput, SectionInput};
 use unfold::model::Model;
@@ -154,10 +155,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let model = Model::from_input(&input)?;
     let mut writer = ResultWriter::create(&out, &model)?;
     let mut analysis = StaticAnalysis::new(&model);
+    // loads are elements of the model too: count them apart
+    let loads = model
+        .elements
+        .iter()
+        .filter(|e| e.kind() == ElementKind::NodalLoad)
+        .count();
     println!(
-        "{} nodes, {} elements, {} unknowns",
+        "{} nodes, {} beam elements, {} nodal loads, {} unknowns",
         model.n_nodes(),
-        model.elements.len(),
+        model.elements.len() - loads,
+        loads,
         analysis.n_equations()
     );
     let outcome = analysis.run(&mut writer);

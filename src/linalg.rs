@@ -287,9 +287,12 @@ fn workspace(req: StackReq, what: &str) -> Result<MemBuffer, SolveError> {
         .map_err(|_| SolveError::Internal(format!("out of memory for the {what} workspace")))
 }
 
-/// The pattern of `Aᵀ` (sorted columns) and, for each of its entries, the
-/// position of the same entry in `A`'s values.
-fn transpose_pattern(a: &SparseMatrix) -> (SymbolicSparseColMat<usize>, Vec<usize>) {
+/// The pattern of `Aᵀ` (sorted columns) and, if `with_source`, the
+/// position in `A`'s values of each of its entries.
+fn transpose_pattern(
+    a: &SparseMatrix,
+    with_source: bool,
+) -> (SymbolicSparseColMat<usize>, Vec<usize>) {
     let n = a.dim();
     let (ptr, rows) = (a.symbolic.col_ptr(), a.symbolic.row_idx());
     let mut t_ptr = vec![0usize; n + 1];
@@ -301,12 +304,18 @@ fn transpose_pattern(a: &SparseMatrix) -> (SymbolicSparseColMat<usize>, Vec<usiz
     }
     let mut fill = t_ptr.clone();
     let mut t_rows = vec![0usize; rows.len()];
-    let mut source = vec![0usize; rows.len()];
+    let mut source = if with_source {
+        vec![0usize; rows.len()]
+    } else {
+        Vec::new()
+    };
     for j in 0..n {
         for k in ptr[j]..ptr[j + 1] {
             let r = rows[k];
             t_rows[fill[r]] = j;
-            source[fill[r]] = k;
+            if with_source {
+                source[fill[r]] = k;
+            }
             fill[r] += 1;
         }
     }
@@ -332,7 +341,7 @@ impl SparseLu {
     fn analyze_for(a: &SparseMatrix, kernel: Option<LuKernel>) -> Result<Self, SolveError> {
         let n = a.dim();
         let pattern = a.symbolic.as_ref();
-        let (transpose, transpose_source) = transpose_pattern(a);
+        let (transpose, _) = transpose_pattern(a, false);
         let mut mem = workspace(
             StackReq::any_of(&[
                 colamd::order_scratch::<usize>(n, n, a.nnz()),
@@ -428,6 +437,7 @@ impl SparseLu {
                 let factor_req = supernodal::factorize_supernodal_numeric_lu_scratch::<usize, f64>(
                     &symbolic, lu_params,
                 );
+                let (transpose, transpose_source) = transpose_pattern(a, true);
                 (
                     Factors::Supernodal(Box::new(SupernodalFactors {
                         symbolic,

@@ -8,7 +8,7 @@
 //! numbered node by node in reverse Cuthill–McKee order of the node graph,
 //! which keeps the equations of neighbouring nodes close (a banded pattern
 //! and local memory access in assembly); the sparse LU then applies its own
-//! fill-reducing column ordering (COLAMD) on top.
+//! fill-reducing column ordering (COLAMD, on the same blocks) on top.
 //!
 //! The equations come in *blocks*: the free components of one node, or the
 //! kept extra unknowns of one element, always have consecutive equation

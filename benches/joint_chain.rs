@@ -7,71 +7,17 @@
 //!
 //! Run with `cargo bench --bench joint_chain` (add sizes, e.g. `-- 100 1000`).
 
+mod common;
+
 use std::time::Instant;
 
 use unfold::analysis::newton::NewtonSolver;
-use unfold::joints::JointType;
-use unfold::model::input::{JointInput, ModelInput};
-use unfold::model::Model;
 use unfold::so3::{self, Vec3};
 
-fn chain(n: usize) -> Model {
-    let mut m = ModelInput::new(format!("chain of {n} hinged links"));
-    m.add_section("s", [2.1e8, 8.1e7, 8.1e7, 1.6e5, 2.1e5, 2.1e5]);
-    let l = 0.1;
-    for i in 0..n {
-        // link i: nodes 2i+1 (start) and 2i+2 (end)
-        let x0 = l * i as f64;
-        m.add_node(2 * i as u64 + 1, [x0, 0.0, 0.0]);
-        m.add_node(2 * i as u64 + 2, [x0 + l, 0.0, 0.0]);
-        m.add_beam(
-            i as u64 + 1,
-            [2 * i as u64 + 1, 2 * i as u64 + 2],
-            "s",
-            Some([0.0, 0.0, 1.0]),
-        );
-        let nodes = if i == 0 {
-            vec![1]
-        } else {
-            vec![2 * i as u64, 2 * i as u64 + 1]
-        };
-        m.joints.push(JointInput {
-            id: 100_000 + i as u64,
-            kind: JointType::Revolute,
-            nodes,
-            axis: Some([0.0, 0.0, 1.0]),
-            ..Default::default()
-        });
-    }
-    // hinge springs keep the chain determinate
-    for i in 0..n {
-        m.joint_springs
-            .push(unfold::model::input::JointSpringInput {
-                id: 200_000 + i as u64,
-                joint: 100_000 + i as u64,
-                stiffness: Some(10.0),
-                ..Default::default()
-            });
-    }
-    m.add_load(2 * n as u64, [0.0, 1.0, 0.0], [0.0; 3]);
-    Model::from_input(&m).expect("valid benchmark model")
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    v[v.len() / 2]
-}
+use common::{chain, median, sizes};
 
 fn main() {
-    let sizes: Vec<usize> = std::env::args()
-        .skip(1)
-        .filter_map(|a| a.parse().ok())
-        .collect();
-    let sizes = if sizes.is_empty() {
-        vec![100, 1_000, 10_000]
-    } else {
-        sizes
-    };
+    let sizes = sizes(&[100, 1_000, 10_000]);
     println!(
         "threads: {}; times in ms (median of repetitions)",
         rayon::current_num_threads()

@@ -1,70 +1,87 @@
-//! Benchmark: assembly and one Newton iteration (factorisation + solve) on
-//! a straight cantilever of 1,000, 10,000 and 100,000 beam elements.
+//! Benchmark: set-up, assembly and one Newton iteration (factorisation +
+//! solve) on a straight cantilever of 1,000, 10,000 and 100,000 beam
+//! elements.
 //!
 //! Run with `cargo bench --bench newton_iteration` (add `-- 1000 10000` to
-//! choose sizes). For each size it reports the one-off set-up (numbering,
-//! sparse pattern, symbolic analysis) and the median over repetitions of:
-//! residual + tangent assembly, numeric LU factorisation + solve, and the
-//! whole iteration; then how the time grows with size.
+//! choose sizes). For each size it reports
+//! - the one-off set-up, phase by phase (median of repetitions): dof
+//!   numbering (reverse Cuthill–McKee), sparsity pattern, scatter maps
+//!   (element entries to matrix positions) and the symbolic analysis of the
+//!   LU (ordering, elimination tree, supernodes);
+//! - the median over repetitions of: residual + tangent assembly, numeric
+//!   LU factorisation + solve, and the whole iteration; then how the time
+//!   grows with size.
+
+mod common;
 
 use std::time::Instant;
 
 use unfold::analysis::newton::NewtonSolver;
-use unfold::model::input::ModelInput;
-use unfold::model::Model;
+use unfold::assembly::{Assembler, TangentPattern};
+use unfold::dofs::DofMap;
+use unfold::linalg::SparseLu;
 use unfold::so3::{self, Vec3};
 
-fn cantilever(n: usize) -> Model {
-    let mut m = ModelInput::new(format!("cantilever of {n} elements"));
-    let l = 10.0;
-    m.add_node(1, [0.0; 3]);
-    m.add_node(2, [l, 0.0, 0.0]);
-    m.add_section("s", [2.1e8, 8.1e7, 8.1e7, 1.6e5, 2.1e5, 2.1e5]);
-    m.beam_lines.push(unfold::model::input::BeamLineInput {
-        nodes: [1, 2],
-        elements: n,
-        section: "s".into(),
-        orientation: Some([0.0, 0.0, 1.0]),
-        first_node: Some(3),
-        first_element: Some(1),
-        arc_center: None,
-        initial_strain: None,
-        initial_strain_curve: None,
-    });
-    m.fix(1, &["all"]);
-    m.add_load(2, [0.0, 1.0, -1.0], [0.5, 0.0, 0.0]);
-    Model::from_input(&m).expect("valid benchmark model")
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    v[v.len() / 2]
-}
+use common::{cantilever, median, sizes};
 
 fn main() {
-    let sizes: Vec<usize> = std::env::args()
-        .skip(1)
-        .filter_map(|a| a.parse().ok())
-        .collect();
-    let sizes = if sizes.is_empty() {
-        vec![1_000, 10_000, 100_000]
-    } else {
-        sizes
-    };
+    let sizes = sizes(&[1_000, 10_000, 100_000]);
     println!(
         "threads: {}; times in ms (median of repetitions)",
         rayon::current_num_threads()
     );
+
+    // set-up, phase by phase
     println!(
         "{:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}",
-        "elements", "unknowns", "nnz", "setup", "symbolic", "assembly", "factor+slv", "iteration"
+        "elements", "unknowns", "nnz", "numbering", "pattern", "scatter", "symbolic", "setup"
+    );
+    for &n in &sizes {
+        let model = cantilever(n);
+        let reps = if n >= 100_000 { 3 } else { 7 };
+        let mut phases = [vec![], vec![], vec![], vec![], vec![]];
+        let (mut neq, mut nnz) = (0, 0);
+        for _ in 0..reps {
+            let t0 = Instant::now();
+            let dofs = DofMap::new(&model);
+            let t1 = Instant::now();
+            let pattern = TangentPattern::new(&model, &dofs);
+            let t2 = Instant::now();
+            let assembler = Assembler::with_pattern(&model, &dofs, pattern);
+            let t3 = Instant::now();
+            let lu = SparseLu::analyze(&assembler.matrix).expect("symbolic analysis");
+            let t4 = Instant::now();
+            let times = [t1 - t0, t2 - t1, t3 - t2, t4 - t3, t4 - t0];
+            for (p, t) in phases.iter_mut().zip(times) {
+                p.push(t.as_secs_f64());
+            }
+            (neq, nnz) = (dofs.n_equations(), assembler.matrix.nnz());
+            // dropped outside the timed region
+            drop((lu, assembler));
+        }
+        let [a, b, c, d, e] = phases.map(median);
+        println!(
+            "{:>9} {:>9} {:>10} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
+            n,
+            neq,
+            nnz,
+            1e3 * a,
+            1e3 * b,
+            1e3 * c,
+            1e3 * d,
+            1e3 * e
+        );
+    }
+
+    // Newton iteration
+    println!(
+        "{:>9} {:>9} {:>10} {:>10} {:>10}",
+        "elements", "unknowns", "assembly", "factor+slv", "iteration"
     );
     let mut rows = Vec::new();
     for &n in &sizes {
         let model = cantilever(n);
-        let t0 = Instant::now();
         let mut solver = NewtonSolver::new(&model);
-        let setup = t0.elapsed().as_secs_f64();
 
         // a deformed state, so that every geometric term is exercised
         let mut state = model.initial_state();
@@ -74,9 +91,7 @@ fn main() {
             *q *= so3::exp(&Vec3::new(0.1 * s, 0.2 * s, 0.05 * s));
         }
         solver.assemble(&model, &state, 1.0, true);
-        let t1 = Instant::now();
         solver.analyze().expect("symbolic analysis");
-        let symbolic = t1.elapsed().as_secs_f64();
 
         let reps = if n >= 100_000 { 5 } else { 11 };
         let (mut assembly, mut solve, mut total) = (Vec::new(), Vec::new(), Vec::new());
@@ -93,12 +108,9 @@ fn main() {
         }
         let row = (n, median(assembly), median(solve), median(total));
         println!(
-            "{:>9} {:>9} {:>10} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
+            "{:>9} {:>9} {:>10.1} {:>10.1} {:>10.1}",
             n,
             solver.dofs.n_equations(),
-            solver.nnz(),
-            1e3 * setup,
-            1e3 * symbolic,
             1e3 * row.1,
             1e3 * row.2,
             1e3 * row.3

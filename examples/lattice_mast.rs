@@ -30,6 +30,7 @@ use unfold::analysis::StaticAnalysis;
 use unfold::io::run::{
     signal_name, stop_on_signals, Interrupted, Recorder, SignalEvent, Silent, StopRequest,
 };
+use unfold::elements::ElementKind;
 use unfold::model::input::{BeamLineInput, Id, LoadInput, ModelInput, SectionInput};
 use unfold::model::Model;
 
@@ -156,10 +157,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let model = Model::from_input(&input)?;
     let mut analysis = StaticAnalysis::new(&model);
+    // loads are elements of the model too: count them apart
+    let loads = model
+        .elements
+        .iter()
+        .filter(|e| e.kind() == ElementKind::NodalLoad)
+        .count();
     println!(
-        "{} nodes, {} elements, {} unknowns",
+        "{} nodes, {} beam elements, {} nodal loads, {} unknowns",
         model.n_nodes(),
-        model.elements.len(),
+        model.elements.len() - loads,
+        loads,
         analysis.n_equations()
     );
     // the result files, log.txt and summary.json of `unfold run`; SIGINT

@@ -1,8 +1,10 @@
 //! Assembly of the global residual and tangent.
 //!
-//! The sparsity pattern is built once from the element connectivity, with a
-//! map from every local tangent entry of every element to its position in
-//! the compressed-column value array. Each evaluation then
+//! The sparsity pattern is built once from the element connectivity, by
+//! blocks of equations (a node's, an element's extra unknowns: see
+//! [`TangentPattern`]), with a map from every local tangent entry of every
+//! element to its position in the compressed-column value array, read off
+//! the block structure. Each evaluation then
 //! 1. evaluates all elements in parallel, each into its own preallocated
 //!    slice of one buffer (no locks, no allocation);
 //! 2. scatters the local residuals and tangents through the maps.
@@ -43,72 +45,246 @@ pub struct Assembler {
     residual_offsets: Vec<usize>,
 }
 
+/// The sparsity pattern of the tangent, in equation numbering, built by
+/// blocks from the element graph.
+///
+/// A *block* is a node (its free components) or the extra unknowns of an
+/// element: its equations are consecutive ([`DofMap::node_equations`]),
+/// so the pattern is a block pattern. Block `b` couples with block `c`
+/// when an element has both; every column of block `b` then has the same
+/// rows: the equations of the blocks coupled with `b`, in equation order.
+/// The pattern is built block column by block column, without sorting the
+/// entries globally, and the position of the element entry `(i, j)` in
+/// the value array is the start of column `j`, plus the offset of the
+/// block of `i` in the block column of `j`, plus the place of `i` in its
+/// block.
+pub struct TangentPattern {
+    matrix: SparseMatrix,
+    /// Equations of each block: nodes first, then the extra unknowns of
+    /// each element.
+    blocks: Vec<[usize; 2]>,
+    /// Start of each block column in `coupled` (one more for the end).
+    coupled_ptr: Vec<usize>,
+    /// Blocks coupled with each block, in equation order.
+    coupled: Vec<usize>,
+    /// Offset of each coupled block's first row in the columns of the
+    /// block column.
+    coupled_offset: Vec<usize>,
+}
+
+impl TangentPattern {
+    /// Builds the pattern from the element connectivity: every pair of
+    /// free equations of one element, and every diagonal entry (even of an
+    /// equation that no element touches: a singular system is then
+    /// reported, not a panic).
+    pub fn new(model: &Model, dofs: &DofMap) -> Self {
+        let n_nodes = model.n_nodes();
+        let n_el = model.elements.len();
+        let n_blocks = n_nodes + n_el;
+        let blocks: Vec<[usize; 2]> = (0..n_nodes)
+            .map(|i| dofs.node_equations(i))
+            .chain((0..n_el).map(|e| dofs.extra_equations(e)))
+            .map(|r| [r.start, r.end])
+            .collect();
+        let is_empty = |b: usize| blocks[b][0] == blocks[b][1];
+
+        // elements touching each block (compressed rows)
+        let mut touch_ptr = vec![0usize; n_blocks + 1];
+        for (e, element) in model.elements.iter().enumerate() {
+            for b in element_blocks(element.nodes(), n_nodes + e) {
+                touch_ptr[b + 1] += 1;
+            }
+        }
+        for b in 0..n_blocks {
+            touch_ptr[b + 1] += touch_ptr[b];
+        }
+        let mut fill = touch_ptr.clone();
+        let mut touching = vec![0usize; touch_ptr[n_blocks]];
+        for (e, element) in model.elements.iter().enumerate() {
+            for b in element_blocks(element.nodes(), n_nodes + e) {
+                touching[fill[b]] = e;
+                fill[b] += 1;
+            }
+        }
+
+        // blocks coupled with each block: itself and the blocks of the
+        // elements touching it, each once (marked with the column block),
+        // sorted by first equation; and the rows of the block column
+        let mut coupled_ptr = Vec::with_capacity(n_blocks + 1);
+        let mut coupled = Vec::with_capacity(2 * touching.len() + n_blocks);
+        let mut coupled_offset = Vec::with_capacity(coupled.capacity());
+        let mut column_rows = vec![0usize; n_blocks];
+        let mut mark = vec![usize::MAX; n_blocks];
+        coupled_ptr.push(0);
+        for b in 0..n_blocks {
+            let start = coupled.len();
+            if !is_empty(b) {
+                mark[b] = b;
+                coupled.push(b);
+                for &e in &touching[touch_ptr[b]..touch_ptr[b + 1]] {
+                    for c in element_blocks(model.elements[e].nodes(), n_nodes + e) {
+                        if mark[c] != b && !is_empty(c) {
+                            mark[c] = b;
+                            coupled.push(c);
+                        }
+                    }
+                }
+                coupled[start..].sort_unstable_by_key(|&c| blocks[c][0]);
+                let mut rows = 0;
+                for &c in &coupled[start..] {
+                    coupled_offset.push(rows);
+                    rows += blocks[c][1] - blocks[c][0];
+                }
+                column_rows[b] = rows;
+            }
+            coupled_ptr.push(coupled.len());
+        }
+
+        // compressed columns: every column of a block has its block's rows
+        let neq = dofs.n_equations();
+        let mut col_ptr = vec![0usize; neq + 1];
+        for (b, &[first, end]) in blocks.iter().enumerate() {
+            for j in first..end {
+                col_ptr[j + 1] = column_rows[b];
+            }
+        }
+        for j in 0..neq {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        let mut row_idx = vec![0usize; col_ptr[neq]];
+        for (b, &[first, end]) in blocks.iter().enumerate() {
+            let coupled_rows = coupled[coupled_ptr[b]..coupled_ptr[b + 1]]
+                .iter()
+                .flat_map(|&c| blocks[c][0]..blocks[c][1]);
+            for j in first..end {
+                for (slot, r) in row_idx[col_ptr[j]..col_ptr[j + 1]]
+                    .iter_mut()
+                    .zip(coupled_rows.clone())
+                {
+                    *slot = r;
+                }
+            }
+        }
+        Self {
+            matrix: SparseMatrix::from_columns(neq, col_ptr, row_idx),
+            blocks,
+            coupled_ptr,
+            coupled,
+            coupled_offset,
+        }
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.matrix.nnz()
+    }
+
+    /// Whether block `b` has no equation.
+    fn is_empty(&self, b: usize) -> bool {
+        self.blocks[b][0] == self.blocks[b][1]
+    }
+
+    /// Offset of the rows of block `row_block` in the columns of block
+    /// `column_block`, which must be coupled.
+    fn offset(&self, column_block: usize, row_block: usize) -> usize {
+        let range = self.coupled_ptr[column_block]..self.coupled_ptr[column_block + 1];
+        let first = self.blocks[row_block][0];
+        let k = self.coupled[range.clone()]
+            .binary_search_by_key(&first, |&c| self.blocks[c][0])
+            .expect("coupled blocks");
+        self.coupled_offset[range.start + k]
+    }
+}
+
+/// Blocks of an element: its nodes, then its extra unknowns (block
+/// `extra_block`).
+fn element_blocks(nodes: &[usize], extra_block: usize) -> impl Iterator<Item = usize> + '_ {
+    nodes.iter().copied().chain(std::iter::once(extra_block))
+}
+
 impl Assembler {
     /// Builds the pattern and the scatter maps.
     pub fn new(model: &Model, dofs: &DofMap) -> Self {
+        Self::with_pattern(model, dofs, TangentPattern::new(model, dofs))
+    }
+
+    /// Builds the scatter maps from the element entries to `pattern`,
+    /// which must be the pattern of `model` and `dofs`.
+    pub fn with_pattern(model: &Model, dofs: &DofMap, pattern: TangentPattern) -> Self {
+        let n_nodes = model.n_nodes();
         let n_el = model.elements.len();
         let mut offsets = Vec::with_capacity(n_el + 1);
         let mut tangent_offsets = Vec::with_capacity(n_el + 1);
         let mut residual_offsets = Vec::with_capacity(n_el + 1);
         let (mut o, mut to, mut ro) = (0, 0, 0);
-        let mut residual_map = Vec::new();
-        let mut entries = Vec::new();
-        let element_dofs: Vec<Vec<usize>> =
-            (0..n_el).map(|e| dofs.element_dofs(model, e)).collect();
-        for d in &element_dofs {
-            let n = d.len();
+        for element in &model.elements {
+            let n = element.n_local();
             offsets.push(o);
             tangent_offsets.push(to);
             residual_offsets.push(ro);
             o += n * n + n;
             to += n * n;
             ro += n;
-            residual_map.extend(d.iter().map(|&x| x as u32));
-            for &dj in d {
-                let cj = dofs.equation(dj);
-                if cj == NO_EQUATION {
-                    continue;
-                }
-                for &di in d {
-                    let ri = dofs.equation(di);
-                    if ri != NO_EQUATION {
-                        entries.push((ri, cj));
-                    }
-                }
-            }
         }
         offsets.push(o);
         tangent_offsets.push(to);
         residual_offsets.push(ro);
-        // every free equation has a diagonal entry, even if no element
-        // touches it (a singular system is then reported, not a panic)
-        let neq = dofs.n_equations();
-        entries.extend((0..neq).map(|i| (i, i)));
-        let matrix = SparseMatrix::from_pattern(neq, entries);
         assert!(
-            matrix.nnz() < NONE as usize,
-            "too many non-zeros for 32-bit maps"
+            pattern.nnz() < NONE as usize && dofs.n_dofs() < NONE as usize,
+            "too many non-zeros or dofs for 32-bit maps"
         );
+
+        let mut residual_map = Vec::with_capacity(ro);
         let mut tangent_map = vec![NONE; to];
-        for (e, d) in element_dofs.iter().enumerate() {
-            let n = d.len();
-            let base = tangent_offsets[e];
-            for (j, &dj) in d.iter().enumerate() {
-                let cj = dofs.equation(dj);
+        // per element: the dof, the equation and the block (index into
+        // `element_blocks`) of each local unknown, and the offset of every
+        // pair of blocks
+        let mut local: Vec<(usize, usize, usize)> = Vec::new();
+        let mut element_blocks: Vec<usize> = Vec::new();
+        let mut pair_offset: Vec<usize> = Vec::new();
+        for (e, element) in model.elements.iter().enumerate() {
+            local.clear();
+            element_blocks.clear();
+            for (k, &node) in element.nodes().iter().enumerate() {
+                element_blocks.push(node);
+                local.extend((6 * node..6 * node + 6).map(|d| (d, dofs.equation(d), k)));
+            }
+            let extra = dofs.element_extra_dofs(model, e);
+            if !extra.is_empty() {
+                let k = element_blocks.len();
+                element_blocks.push(n_nodes + e);
+                local.extend(extra.map(|d| (d, dofs.equation(d), k)));
+            }
+            residual_map.extend(local.iter().map(|&(d, _, _)| d as u32));
+
+            // offsets of the rows of block a in the columns of block b
+            let nb = element_blocks.len();
+            pair_offset.clear();
+            for &b in &element_blocks {
+                for &a in &element_blocks {
+                    let coupled = !pattern.is_empty(a) && !pattern.is_empty(b);
+                    pair_offset.push(if coupled { pattern.offset(b, a) } else { 0 });
+                }
+            }
+
+            let n = local.len();
+            let map = &mut tangent_map[tangent_offsets[e]..tangent_offsets[e + 1]];
+            for (j, &(_, cj, kb)) in local.iter().enumerate() {
                 if cj == NO_EQUATION {
                     continue;
                 }
-                for (i, &di) in d.iter().enumerate() {
-                    let ri = dofs.equation(di);
+                let column = pattern.matrix.column_start(cj);
+                for (i, &(_, ri, ka)) in local.iter().enumerate() {
                     if ri != NO_EQUATION {
-                        tangent_map[base + j * n + i] =
-                            matrix.position(ri, cj).expect("entry in pattern") as u32;
+                        let first = pattern.blocks[element_blocks[ka]][0];
+                        let p = column + pair_offset[kb * nb + ka] + (ri - first);
+                        map[j * n + i] = p as u32;
                     }
                 }
             }
         }
         Self {
-            matrix,
+            matrix: pattern.matrix,
             residual: vec![0.0; dofs.n_dofs()],
             flux: vec![0.0; dofs.n_dofs()],
             offsets,
@@ -188,4 +364,98 @@ fn evaluate_range(
         || evaluate_range(&elements[..mid], left, &offsets[..=mid], ctx, state),
         || evaluate_range(&elements[mid..], right, &offsets[mid..], ctx, state),
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::joints::JointType;
+    use crate::model::input::{JointInput, JointSpringInput, ModelInput};
+    use std::collections::BTreeSet;
+
+    /// Three beam links hinged to each other and to the ground (revolute
+    /// joints with multipliers), hinge springs, a partly fixed node, a
+    /// fully fixed node that no element touches, and a load.
+    fn hinged_links() -> Model {
+        let mut m = ModelInput::new("hinged links");
+        m.add_section("s", [2.1e8, 8.1e7, 8.1e7, 1.6e5, 2.1e5, 2.1e5]);
+        for i in 0..3u64 {
+            let x0 = 0.1 * i as f64;
+            m.add_node(2 * i + 1, [x0, 0.0, 0.0]);
+            m.add_node(2 * i + 2, [x0 + 0.1, 0.0, 0.0]);
+            m.add_beam(i + 1, [2 * i + 1, 2 * i + 2], "s", Some([0.0, 0.0, 1.0]));
+            let nodes = if i == 0 {
+                vec![1]
+            } else {
+                vec![2 * i, 2 * i + 1]
+            };
+            m.joints.push(JointInput {
+                id: 100 + i,
+                kind: JointType::Revolute,
+                nodes,
+                axis: Some([0.0, 0.0, 1.0]),
+                ..Default::default()
+            });
+            m.joint_springs.push(JointSpringInput {
+                id: 200 + i,
+                joint: 100 + i,
+                stiffness: Some(10.0),
+                ..Default::default()
+            });
+        }
+        m.add_node(99, [1.0, 1.0, 0.0]);
+        m.fix(99, &["all"]);
+        m.fix(4, &["z", "rx"]);
+        m.add_load(6, [0.0, 1.0, 0.0], [0.0; 3]);
+        Model::from_input(&m).expect("valid model")
+    }
+
+    /// The block pattern is the set of equation pairs of every element plus
+    /// the diagonal, and every scatter-map entry points at its own pair:
+    /// checked against a direct enumeration and a search in each column.
+    fn check_pattern_and_maps(model: &Model, dofs: &DofMap) {
+        let assembler = Assembler::new(model, dofs);
+        let matrix = &assembler.matrix;
+        let mut expected = BTreeSet::new();
+        for e in 0..model.elements.len() {
+            let d = dofs.element_dofs(model, e);
+            let n = d.len();
+            let map = &assembler.tangent_map
+                [assembler.tangent_offsets[e]..assembler.tangent_offsets[e + 1]];
+            assert_eq!(map.len(), n * n);
+            let rmap = &assembler.residual_map
+                [assembler.residual_offsets[e]..assembler.residual_offsets[e + 1]];
+            assert_eq!(rmap, d.iter().map(|&x| x as u32).collect::<Vec<_>>());
+            for (j, &dj) in d.iter().enumerate() {
+                for (i, &di) in d.iter().enumerate() {
+                    let (r, c) = (dofs.equation(di), dofs.equation(dj));
+                    if r == NO_EQUATION || c == NO_EQUATION {
+                        assert_eq!(map[j * n + i], NONE);
+                    } else {
+                        expected.insert((r, c));
+                        assert_eq!(Some(map[j * n + i] as usize), matrix.position(r, c));
+                    }
+                }
+            }
+        }
+        expected.extend((0..dofs.n_equations()).map(|i| (i, i)));
+        let stored: BTreeSet<_> = matrix.entries().map(|(r, c, _)| (r, c)).collect();
+        assert_eq!(stored, expected);
+        assert_eq!(matrix.nnz(), expected.len());
+    }
+
+    #[test]
+    fn block_pattern_and_scatter_maps_match_the_element_entries() {
+        let model = hinged_links();
+        let dofs = DofMap::new(&model);
+        assert!(dofs.n_equations() < dofs.n_dofs());
+        check_pattern_and_maps(&model, &dofs);
+        // with some multipliers left out (a whole joint's and single ones)
+        let n_extra = dofs.n_dofs() - 6 * model.n_nodes();
+        assert!(n_extra >= 15);
+        let suppressed: Vec<usize> = (0..5).chain([7, 12, 14]).collect();
+        let dofs = DofMap::with_suppressed(&model, &suppressed);
+        assert_eq!(dofs.n_equations(), DofMap::new(&model).n_equations() - 8);
+        check_pattern_and_maps(&model, &dofs);
+    }
 }

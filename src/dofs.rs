@@ -8,9 +8,16 @@
 //! numbered node by node in reverse Cuthill–McKee order of the node graph,
 //! which keeps the equations of neighbouring nodes close (a banded pattern
 //! and local memory access in assembly); the sparse LU then applies its own
-//! fill-reducing column ordering (COLAMD) on top.
+//! fill-reducing column ordering (COLAMD, on the same blocks) on top.
+//!
+//! The equations come in *blocks*: the free components of one node, or the
+//! kept extra unknowns of one element, always have consecutive equation
+//! numbers in local order. Assembly builds the tangent's pattern block by
+//! block from this ([`DofMap::node_equations`],
+//! [`DofMap::extra_equations`]).
 
 use std::collections::VecDeque;
+use std::ops::Range;
 
 use crate::model::Model;
 
@@ -38,6 +45,11 @@ pub struct DofMap {
     dof: Vec<usize>,
     /// Offset of each element's extra unknowns in the extra block.
     extra_offset: Vec<usize>,
+    /// First equation of each node's free components and one past the
+    /// last (equal if the node is fixed).
+    node_equations: Vec<[usize; 2]>,
+    /// The same for the kept extra unknowns of each element.
+    extra_equations: Vec<[usize; 2]>,
 }
 
 impl DofMap {
@@ -60,26 +72,41 @@ impl DofMap {
         let n_dofs = 6 * n_nodes + n_extra;
         let mut equation = vec![NO_EQUATION; n_dofs];
         let mut dof = Vec::with_capacity(n_dofs);
+        let mut node_equations = vec![[0, 0]; n_nodes];
         for node in node_order(model) {
+            let first = dof.len();
             for c in 0..6 {
                 if !model.fixed[node][c] {
                     equation[6 * node + c] = dof.len();
                     dof.push(6 * node + c);
                 }
             }
+            node_equations[node] = [first, dof.len()];
         }
-        for k in 0..n_extra {
-            if suppressed.contains(&k) {
-                continue;
+        let mut kept = vec![true; n_extra];
+        for &k in suppressed {
+            if let Some(keep) = kept.get_mut(k) {
+                *keep = false;
             }
-            equation[6 * n_nodes + k] = dof.len();
-            dof.push(6 * n_nodes + k);
+        }
+        let mut extra_equations = Vec::with_capacity(model.elements.len());
+        for (e, element) in model.elements.iter().enumerate() {
+            let first = dof.len();
+            for k in extra_offset[e]..extra_offset[e] + element.n_extra() {
+                if kept[k] {
+                    equation[6 * n_nodes + k] = dof.len();
+                    dof.push(6 * n_nodes + k);
+                }
+            }
+            extra_equations.push([first, dof.len()]);
         }
         Self {
             n_nodes,
             equation,
             dof,
             extra_offset,
+            node_equations,
+            extra_equations,
         }
     }
 
@@ -105,6 +132,22 @@ impl DofMap {
         self.dof[equation]
     }
 
+    /// Equations of the free components of `node`, consecutive and in
+    /// component order (empty if the node is fixed).
+    #[inline]
+    pub fn node_equations(&self, node: usize) -> Range<usize> {
+        let [a, b] = self.node_equations[node];
+        a..b
+    }
+
+    /// Equations of the kept extra unknowns of `element`, consecutive and
+    /// in local order.
+    #[inline]
+    pub fn extra_equations(&self, element: usize) -> Range<usize> {
+        let [a, b] = self.extra_equations[element];
+        a..b
+    }
+
     /// Kind of a dof.
     #[inline]
     pub fn kind(&self, dof: usize) -> DofKind {
@@ -124,15 +167,19 @@ impl DofMap {
 
     /// Dofs of an element's local unknowns, in local order.
     pub fn element_dofs(&self, model: &Model, element: usize) -> Vec<usize> {
-        let e = &model.elements[element];
-        let mut d: Vec<usize> = e
+        let mut d: Vec<usize> = model.elements[element]
             .nodes()
             .iter()
             .flat_map(|&n| (0..6).map(move |c| 6 * n + c))
             .collect();
-        let base = 6 * self.n_nodes + self.extra_offset[element];
-        d.extend(base..base + e.n_extra());
+        d.extend(self.element_extra_dofs(model, element));
         d
+    }
+
+    /// Dofs of an element's extra unknowns, in local order.
+    pub fn element_extra_dofs(&self, model: &Model, element: usize) -> Range<usize> {
+        let base = 6 * self.n_nodes + self.extra_offset[element];
+        base..base + model.elements[element].n_extra()
     }
 }
 

@@ -1,0 +1,136 @@
+//! Benchmark: numeric LU factorisation + solve with the simplicial and the
+//! supernodal kernel of the sparse LU, on the tangents of
+//! - a straight cantilever (1,000 / 10,000 / 100,000 beam elements),
+//! - a chain of hinged links (100 / 1,000 / 10,000 revolute joints),
+//! - the folding mast cell of `examples/mast_cell.rs` (folded state),
+//! - the lattice mast of `examples/lattice_mast.rs` (8 / 30 / 99 bays),
+//! - a square grid of beams (20², 40², 60² nodes),
+//!
+//! with the kernel the rule in `src/linalg.rs` picks. These are the
+//! measurements behind that rule.
+//!
+//! Run with `cargo bench --bench lu_kernel`.
+
+#[allow(dead_code)]
+mod common;
+#[allow(dead_code)]
+#[path = "../examples/lattice_mast.rs"]
+mod lattice_mast;
+#[allow(dead_code)]
+#[path = "../examples/mast_cell.rs"]
+mod mast_cell;
+
+use std::time::{Duration, Instant};
+
+use unfold::analysis::newton::NewtonSolver;
+use unfold::linalg::{LuKernel, SparseLu, SparseMatrix};
+use unfold::model::Model;
+use unfold::so3::{self, Vec3};
+use unfold::state::State;
+
+use common::{cantilever, chain, grid, median};
+
+/// A deformed state of `model` with non-zero multipliers, so that every
+/// geometric term is in the tangent.
+fn deformed(model: &Model) -> State {
+    let mut state = model.initial_state();
+    let n = state.x.len() as f64;
+    for (i, (x, q)) in state.x.iter_mut().zip(state.q.iter_mut()).enumerate() {
+        let s = i as f64 / n;
+        *x += Vec3::new(-0.01 * s, 0.05 * s * s, 0.001 * s);
+        *q *= so3::exp(&Vec3::new(0.01 * s, 0.02 * s, 0.3 * s));
+    }
+    for (k, v) in state.extra.iter_mut().enumerate() {
+        *v = 1e-3 * (k % 7) as f64;
+    }
+    state
+}
+
+/// Median times of factor + solve of `a` with the simplicial and the
+/// supernodal kernel, alternated repetition by repetition (so that a
+/// change of load on the machine weighs on both alike) for about a second
+/// (at least 5 repetitions each).
+fn factor_solve(a: &SparseMatrix) -> (f64, f64) {
+    let mut lu = [LuKernel::Simplicial, LuKernel::Supernodal]
+        .map(|k| SparseLu::analyze_with(a, k).expect("symbolic analysis"));
+    let b: Vec<f64> = (0..a.dim()).map(|i| 1.0 + (i % 5) as f64).collect();
+    let mut x = b.clone();
+    let mut times = [Vec::new(), Vec::new()];
+    let start = Instant::now();
+    while times[0].len() < 5 || (start.elapsed() < Duration::from_secs(1) && times[0].len() < 201) {
+        for (lu, t) in lu.iter_mut().zip(times.iter_mut()) {
+            x.copy_from_slice(&b);
+            let t0 = Instant::now();
+            lu.factor(a).expect("factorisation");
+            lu.solve_in_place(&mut x).expect("solve");
+            t.push(t0.elapsed().as_secs_f64());
+        }
+    }
+    let [s, p] = times;
+    (median(s), median(p))
+}
+
+fn report(name: &str, solver: &NewtonSolver) {
+    let a = solver.tangent();
+    let (simplicial, supernodal) = factor_solve(a);
+    let chosen = SparseLu::analyze(a).expect("symbolic analysis");
+    println!(
+        "{:<22} {:>8} {:>10} {:>9.2} {:>11.3} {:>11.3} {:>7.2} {:>11}",
+        name,
+        a.dim(),
+        a.nnz(),
+        chosen.flops_per_entry(),
+        1e3 * simplicial,
+        1e3 * supernodal,
+        supernodal / simplicial,
+        format!("{:?}", chosen.kernel()),
+    );
+}
+
+fn main() {
+    println!(
+        "threads: {}; factor + solve in ms (median of repetitions)",
+        rayon::current_num_threads()
+    );
+    println!(
+        "{:<22} {:>8} {:>10} {:>9} {:>11} {:>11} {:>7} {:>11}",
+        "model", "unknowns", "nnz", "flops/nnz", "simplicial", "supernodal", "ratio", "rule"
+    );
+    for n in [1_000, 10_000, 100_000] {
+        let model = cantilever(n);
+        let mut solver = NewtonSolver::new(&model);
+        solver.assemble(&model, &deformed(&model), 1.0, true);
+        report(&format!("cantilever {n}"), &solver);
+    }
+    for n in [100, 1_000, 10_000] {
+        let model = chain(n);
+        let mut solver = NewtonSolver::new(&model);
+        solver.assemble(&model, &deformed(&model), 1.0, true);
+        report(&format!("joint chain {n}"), &solver);
+    }
+    {
+        // the tangent of the folded cell, with the redundant constraints
+        // left out as the analysis does
+        let design = mast_cell::Design::default();
+        let input = mast_cell::build_design(&design, 24).expect("mast cell");
+        let model = Model::from_input(&input).expect("mast cell model");
+        let run = mast_cell::run(&design, &input, None, false).expect("mast cell run");
+        let state = run.outcome.state;
+        let mut solver = NewtonSolver::new(&model);
+        solver.constraint_rank(&model, &state);
+        solver.assemble(&model, &state, state.time, true);
+        report("mast cell (folded)", &solver);
+    }
+    for bays in [8, 30, 99] {
+        let model = Model::from_input(&lattice_mast::build(bays)).expect("lattice mast");
+        let mut solver = NewtonSolver::new(&model);
+        solver.assemble(&model, &deformed(&model), 1.0, true);
+        report(&format!("lattice mast {bays}"), &solver);
+    }
+    for k in [20, 40, 60] {
+        let model = grid(k);
+        let mut solver = NewtonSolver::new(&model);
+        solver.assemble(&model, &deformed(&model), 1.0, true);
+        report(&format!("grid {k}x{k}"), &solver);
+    }
+}

@@ -7,8 +7,8 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Identifier of a node or an element, as written in the model file.
-pub type Id = u64;
+pub use super::Id;
+pub use crate::elements::spring::SpringKind;
 
 /// Largest id: TOML integers are 64-bit signed, so a model with a larger id
 /// (or generating one, see `beam_lines`) could not be written back.
@@ -460,19 +460,6 @@ pub struct PointMassInput {
     pub node: Id,
     /// Mass.
     pub mass: f64,
-}
-
-/// What a spring resists.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub enum SpringKind {
-    /// Relative displacement along the global axes: `f = diag(k) Δu`.
-    Translational,
-    /// Relative rotation, measured in the first node's material frame (or
-    /// the global frame for a spring to ground): `m = diag(k) ψ`.
-    Rotational,
-    /// Change of the distance between the two nodes: `f = k (ℓ − ℓ₀)`.
-    Axial,
 }
 
 /// A linear spring between two nodes, or between a node and the ground.

@@ -16,7 +16,10 @@ use crate::curves::{Curve, CurveIndex};
 use crate::elements::{ConstraintScaling, Element, EvalContext};
 use crate::so3::{Rotation, Vec3};
 use crate::state::State;
-use input::Id;
+
+/// Identifier of a node or an element, as written in the model file and in
+/// the result files.
+pub type Id = u64;
 
 pub use build::{
     LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MAX_LINE_ELEMENTS, MAX_MODEL_SIZE,

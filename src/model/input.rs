@@ -362,6 +362,24 @@ pub struct SectionInput {
     pub inertia_per_length: Option<[f64; 3]>,
 }
 
+impl SectionInput {
+    /// A section of diagonal stiffnesses `[EA, GA2, GA3, GJ, EI2, EI3]`,
+    /// without mass.
+    pub fn diagonal(name: impl Into<String>, diagonal: [f64; 6]) -> Self {
+        let [ea, ga2, ga3, gj, ei2, ei3] = diagonal.map(Some);
+        Self {
+            name: name.into(),
+            ea,
+            ga2,
+            ga3,
+            gj,
+            ei2,
+            ei3,
+            ..Self::default()
+        }
+    }
+}
+
 /// A two-node beam element.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -488,6 +506,18 @@ pub enum StiffnessInput {
     PerAxis([f64; 3]),
 }
 
+impl From<f64> for StiffnessInput {
+    fn from(k: f64) -> Self {
+        Self::Isotropic(k)
+    }
+}
+
+impl From<[f64; 3]> for StiffnessInput {
+    fn from(k: [f64; 3]) -> Self {
+        Self::PerAxis(k)
+    }
+}
+
 /// Fixed degrees of freedom of a node.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -605,7 +635,7 @@ pub struct CurveInput {
     pub to: Option<f64>,
 }
 
-// ---------- builder helpers for models written in Rust ----------
+// ---------- helpers for models written in Rust (see also crate::model::builder) ----------
 
 impl ModelInput {
     /// An empty model with a title.
@@ -630,17 +660,7 @@ impl ModelInput {
     /// Adds a section with the diagonal stiffnesses
     /// `[EA, GA2, GA3, GJ, EI2, EI3]`.
     pub fn add_section(&mut self, name: impl Into<String>, diagonal: [f64; 6]) -> &mut Self {
-        let [ea, ga2, ga3, gj, ei2, ei3] = diagonal;
-        self.sections.push(SectionInput {
-            name: name.into(),
-            ea: Some(ea),
-            ga2: Some(ga2),
-            ga3: Some(ga3),
-            gj: Some(gj),
-            ei2: Some(ei2),
-            ei3: Some(ei3),
-            ..SectionInput::default()
-        });
+        self.sections.push(SectionInput::diagonal(name, diagonal));
         self
     }
 

@@ -334,6 +334,11 @@ impl Model {
             title: input.title.clone().unwrap_or_default(),
             node_ids,
             node_lookup: node_index,
+            element_lookup: elements
+                .iter()
+                .enumerate()
+                .map(|(i, e)| ((e.kind(), e.id()), i))
+                .collect(),
             reference_x: nodes.iter().map(|n| n.x).collect(),
             reference_q: nodes.iter().map(|n| n.q).collect(),
             elements,

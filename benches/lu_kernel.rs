@@ -112,9 +112,9 @@ fn main() {
         // the tangent of the folded cell, with the redundant constraints
         // left out as the analysis does
         let design = mast_cell::Design::default();
-        let input = mast_cell::build_design(&design, 24).expect("mast cell");
-        let model = Model::from_input(&input).expect("mast cell model");
-        let run = mast_cell::run(&design, &input, None, false).expect("mast cell run");
+        let cell = mast_cell::build_design(&design, 24).expect("mast cell");
+        let model = Model::from_input(&cell.input).expect("mast cell model");
+        let run = mast_cell::run(&design, &cell, None, false).expect("mast cell run");
         let state = run.outcome.state;
         let mut solver = NewtonSolver::new(&model);
         solver.constraint_rank(&model, &state);

@@ -27,121 +27,88 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 
 use unfold::analysis::StaticAnalysis;
+use unfold::elements::ElementKind;
 use unfold::io::run::{
     signal_name, stop_on_signals, Interrupted, Recorder, SignalEvent, Silent, StopRequest,
 };
-use unfold::elements::ElementKind;
-use unfold::model::input::{BeamLineInput, Id, LoadInput, ModelInput, SectionInput};
-use unfold::model::Model;
+use unfold::model::builder::*;
+use unfold::model::input::ModelInput;
 
 /// Circular tube section of outer diameter `d`, wall `t` (solid for
 /// `t ≥ d/2`), from `E` and `G`; shear factor 0.5 for thin tubes, 0.9 for
 /// solid rods.
-fn tube(name: &str, e: f64, g: f64, d: f64, t: f64) -> SectionInput {
+fn tube(e: f64, g: f64, d: f64, t: f64) -> Section {
     let ro = d / 2.0;
     let ri = (ro - t).max(0.0);
     let a = PI * (ro * ro - ri * ri);
     let i = PI / 4.0 * (ro.powi(4) - ri.powi(4));
     let kappa = if ri > 0.0 { 0.5 } else { 0.9 };
-    SectionInput {
-        name: name.into(),
-        ea: Some(e * a),
-        ga2: Some(kappa * g * a),
-        ga3: Some(kappa * g * a),
-        gj: Some(g * 2.0 * i),
-        ei2: Some(e * i),
-        ei3: Some(e * i),
-        ..SectionInput::default()
-    }
+    Section::diagonal(
+        e * a,
+        kappa * g * a,
+        kappa * g * a,
+        g * 2.0 * i,
+        e * i,
+        e * i,
+    )
 }
 
-/// Node id of corner `k` (0, 1, 2) at level `j`.
-fn corner(j: usize, k: usize) -> Id {
-    (100 * j + k + 1) as Id
-}
-
-/// Builds the mast with `bays` bays.
-pub fn build(bays: usize) -> ModelInput {
+/// The mast with `bays` bays, and the corners of its tip.
+pub fn mast(bays: usize) -> (ModelBuilder, [NodeHandle; 3]) {
     let (radius, bay) = (0.15, 0.25);
-    let mut m = ModelInput::new(format!("Triangular lattice mast, {bays} bays"));
-    m.analysis.initial_increment = Some(0.25);
-    m.sections.push(tube("cfrp_tube", 120e9, 5e9, 0.012, 0.001));
-    m.sections.push(tube("cable", 200e9, 77e9, 0.002, 0.001));
+    let mut m = ModelBuilder::new(format!("Triangular lattice mast, {bays} bays"));
+    m.analysis(Analysis::statics().initial_increment(0.25));
+    let cfrp_tube = m.section(tube(120e9, 5e9, 0.012, 0.001).named("cfrp_tube"));
+    let cable = m.section(tube(200e9, 77e9, 0.002, 0.001).named("cable"));
 
-    // corners of every level
-    for j in 0..=bays {
-        for k in 0..3 {
-            let a = 2.0 * PI * k as f64 / 3.0;
-            m.add_node(
-                corner(j, k),
-                [radius * a.cos(), radius * a.sin(), bay * j as f64],
-            );
-        }
-    }
-    // interior nodes and elements are numbered from 10000 up
-    let mut next_node: Id = 10_000;
-    let mut next_element: Id = 1;
-    let mut member = |m: &mut ModelInput, a: Id, b: Id, section: &str, strain: Option<[f64; 6]>| {
-        m.beam_lines.push(BeamLineInput {
-            nodes: [a, b],
-            elements: 2,
-            section: section.into(),
-            // local axis 2 towards the mast axis direction z, or x for
-            // members along z
-            orientation: None,
-            first_node: Some(next_node),
-            first_element: Some(next_element),
-            arc_center: None,
-            initial_strain: strain,
-            initial_strain_curve: None,
-        });
-        next_node += 1;
-        next_element += 2;
-    };
-    let pretension = Some([-1e-3, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    // corners of every level: node 100 j + k + 1 is corner k of level j
+    let corner: Vec<[NodeHandle; 3]> = (0..=bays)
+        .map(|j| {
+            std::array::from_fn(|k| {
+                let a = 2.0 * PI * k as f64 / 3.0;
+                let x = [radius * a.cos(), radius * a.sin(), bay * j as f64];
+                m.node_with_id((100 * j + k + 1) as Id, x)
+            })
+        })
+        .collect();
+    // members of 2 elements (local axis 2 by default: towards z, or x for
+    // members along z); the cables pretensioned by a shortening
     for j in 0..bays {
         for k in 0..3 {
             let k1 = (k + 1) % 3;
             // longeron, batten of the upper triangle, crossed diagonals of
             // the face
-            member(&mut m, corner(j, k), corner(j + 1, k), "cfrp_tube", None);
-            member(
-                &mut m,
-                corner(j + 1, k),
-                corner(j + 1, k1),
-                "cfrp_tube",
-                None,
-            );
-            member(&mut m, corner(j, k), corner(j + 1, k1), "cable", pretension);
-            member(&mut m, corner(j, k1), corner(j + 1, k), "cable", pretension);
+            let (lower, upper) = (corner[j], corner[j + 1]);
+            m.beam_line(lower[k], upper[k], 2, cfrp_tube);
+            m.beam_line(upper[k], upper[k1], 2, cfrp_tube);
+            for (a, b) in [(lower[k], upper[k1]), (lower[k1], upper[k])] {
+                m.add(BeamLine::between(a, b, 2, cable).axial_strain(-1e-3));
+            }
         }
     }
-    // base battens
+    // base battens; the base is clamped
     for k in 0..3 {
-        member(
-            &mut m,
-            corner(0, k),
-            corner(0, (k + 1) % 3),
-            "cfrp_tube",
-            None,
-        );
-        m.fix(corner(0, k), &["all"]);
+        m.beam_line(corner[0][k], corner[0][(k + 1) % 3], 2, cfrp_tube);
+        m.fix(corner[0][k], Dofs::ALL);
     }
     // tip: lateral force along x shared by the three corners, and a torque
     // about z as three tangential forces
     let (force, torque) = (40.0, 6.0);
-    for k in 0..3 {
+    let tip = corner[bays];
+    for (k, node) in tip.into_iter().enumerate() {
         let a = 2.0 * PI * k as f64 / 3.0;
         let f_t = torque / (3.0 * radius);
-        m.loads.push(LoadInput {
-            node: corner(bays, k),
-            force: Some([force / 3.0 - f_t * a.sin(), f_t * a.cos(), 0.0]),
-            moment: None,
-            follower: false,
-            curve: None,
-        });
+        m.add(Load::force(
+            node,
+            [force / 3.0 - f_t * a.sin(), f_t * a.cos(), 0.0],
+        ));
     }
-    m
+    (m, tip)
+}
+
+/// The model file of the mast with `bays` bays.
+pub fn build(bays: usize) -> ModelInput {
+    mast(bays).0.into_input()
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -149,13 +116,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let bays: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(8);
     let out = PathBuf::from(args.next().unwrap_or_else(|| "results/lattice_mast".into()));
 
-    let input = build(bays);
+    let (mast, tip) = mast(bays);
     std::fs::create_dir_all(&out)?;
     let file = out.join("lattice_mast.toml");
-    std::fs::write(&file, input.to_toml()?)?;
+    std::fs::write(&file, mast.to_toml()?)?;
     println!("model written to {}", file.display());
 
-    let model = Model::from_input(&input)?;
+    let model = mast.build()?;
     let mut analysis = StaticAnalysis::new(&model);
     // loads are elements of the model too: count them apart
     let loads = model
@@ -195,9 +162,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         return Err(e.into());
     }
-    let tip: Vec<usize> = (0..3)
-        .map(|k| model.node_index(corner(bays, k)).unwrap())
-        .collect();
+    let tip = tip.map(|n| model.node(n));
     let mean = |v: &[unfold::so3::Vec3]| tip.iter().map(|&i| v[i]).sum::<unfold::so3::Vec3>() / 3.0;
     let u = mean(&outcome.state.x) - mean(&model.reference_x);
     // twist: rotation of the top triangle about its centre, from corner 0

@@ -42,13 +42,9 @@ use unfold::io::plot::{Axis, Chart, Series};
 use unfold::io::run::{
     signal_name, stop_on_signals, Interrupted, Recorder, SignalEvent, Silent, StopRequest,
 };
-use unfold::joints::JointType;
-use unfold::model::input::{
-    BeamLineInput, CurveInput, DriverInput, Id, InertiaInput, JointInput, ModelInput,
-    RigidBodyInput, SectionInput,
-};
-use unfold::model::Model;
-use unfold::so3::{self, Mat3, Vec3};
+use unfold::model::builder::*;
+use unfold::model::input::ModelInput;
+use unfold::so3::{self, Rotation, Vec3};
 use unfold::state::State;
 
 /// A thin-walled circular tube.
@@ -82,27 +78,12 @@ impl Tube {
         (ro, ro - self.wall)
     }
 
-    /// Sectional stiffnesses `[EA, GA2, GA3, GJ, EI2, EI3]`, shear factor
-    /// 0.5 (thin circular tube).
-    pub fn stiffness(&self) -> [f64; 6] {
+    /// The section: `EA`, `GA2 = GA3` with the shear factor 0.5 of a thin
+    /// circular tube, `GJ = G·2I`, `EI2 = EI3`.
+    pub fn section(&self) -> Section {
         let (a, i) = (self.area(), self.inertia());
         let ga = 0.5 * self.g * a;
-        [self.e * a, ga, ga, self.g * 2.0 * i, self.e * i, self.e * i]
-    }
-
-    /// The section of the model file.
-    pub fn section(&self, name: &str) -> SectionInput {
-        let [ea, ga2, ga3, gj, ei2, ei3] = self.stiffness();
-        SectionInput {
-            name: name.into(),
-            ea: Some(ea),
-            ga2: Some(ga2),
-            ga3: Some(ga3),
-            gj: Some(gj),
-            ei2: Some(ei2),
-            ei3: Some(ei3),
-            ..SectionInput::default()
-        }
+        Section::diagonal(self.e * a, ga, ga, self.g * 2.0 * i, self.e * i, self.e * i)
     }
 }
 
@@ -215,22 +196,11 @@ fn corner_angle(k: usize) -> f64 {
     2.0 * PI * k as f64 / 3.0
 }
 
-/// The smallest rotation taking the direction `a` to the direction `b`.
-fn minimal_rotation(a: &Vec3, b: &Vec3) -> Mat3 {
-    let (a, b) = (a.normalize(), b.normalize());
-    let c = a.cross(&b);
-    let angle = c.norm().atan2(a.dot(&b));
-    so3::exp_matrix(&(c.normalize() * angle))
-}
-
-/// Unit axis of a rotation (Rodrigues), sign immaterial for a hinge.
-fn rotation_axis(r: &Mat3) -> Vec3 {
-    so3::log(&so3::from_matrix(r)).normalize()
-}
-
-/// Rotation about the vertical axis.
-fn rot_z(angle: f64) -> Mat3 {
-    so3::exp_matrix(&(Vec3::z() * angle))
+/// The axis of a revolute joint between bodies A and B that turn by `r_a`
+/// and `r_b` from one configuration to the other: it keeps `R_A e = R_B e`,
+/// so `e` is the axis of `R_Aᵀ R_B` (sign immaterial for a hinge).
+fn hinge_axis(r_a: &Rotation, r_b: &Rotation) -> Vec3 {
+    so3::log(&(r_a.inverse() * r_b)).normalize()
 }
 
 impl Design {
@@ -295,9 +265,10 @@ impl Design {
         });
 
         // rotation of every body from the deployed to the folded
-        // configuration; bars turn by the smallest rotation that aligns
+        // configuration: the corner bodies stay, the top ones turn about
+        // the vertical, the bars turn by the smallest rotation that aligns
         // them (no spin about their own axis)
-        let r_top = rot_z(twist);
+        let (fixed, r_top) = (Rotation::identity(), so3::exp(&(Vec3::z() * twist)));
         let mut axes = Axes {
             longeron_bottom: [Vec3::zeros(); 3],
             longeron_top: [Vec3::zeros(); 3],
@@ -307,17 +278,17 @@ impl Design {
         };
         for k in 0..3 {
             let k1 = (k + 1) % 3;
-            let r_longeron = minimal_rotation(&(top[k] - bottom[k]), &(top_folded[k] - bottom[k]));
-            // a revolute joint between bodies A and B keeps the axis e
-            // with R_A e = R_B e: e is the axis of R_Aᵀ R_B
-            axes.longeron_bottom[k] = rotation_axis(&r_longeron);
-            axes.longeron_top[k] = rotation_axis(&(r_top.transpose() * r_longeron));
-            let r_lower = minimal_rotation(&(knee[k] - bottom[k]), &(knee_folded[k] - bottom[k]));
+            let r_longeron =
+                so3::rotation_between(&(top[k] - bottom[k]), &(top_folded[k] - bottom[k]));
+            let r_lower =
+                so3::rotation_between(&(knee[k] - bottom[k]), &(knee_folded[k] - bottom[k]));
             let r_upper =
-                minimal_rotation(&(top[k1] - knee[k]), &(top_folded[k1] - knee_folded[k]));
-            axes.diagonal_bottom[k] = rotation_axis(&r_lower);
-            axes.knee[k] = rotation_axis(&(r_lower.transpose() * r_upper));
-            axes.diagonal_top[k] = rotation_axis(&(r_top.transpose() * r_upper));
+                so3::rotation_between(&(top[k1] - knee[k]), &(top_folded[k1] - knee_folded[k]));
+            axes.longeron_bottom[k] = hinge_axis(&fixed, &r_longeron);
+            axes.longeron_top[k] = hinge_axis(&r_top, &r_longeron);
+            axes.diagonal_bottom[k] = hinge_axis(&fixed, &r_lower);
+            axes.knee[k] = hinge_axis(&r_lower, &r_upper);
+            axes.diagonal_top[k] = hinge_axis(&r_top, &r_upper);
         }
         Geometry {
             bottom,
@@ -333,60 +304,33 @@ impl Design {
     }
 }
 
-// ---------- numbering ----------
+// ---------- the model ----------
 
-/// Corner node (and corner body) `k` of the bottom (`level` 0) or top
-/// (`level` 1) triangle.
-pub fn corner(level: usize, k: usize) -> Id {
-    (10 * level + k + 1) as Id
+/// The parts of the cell that drivers and results refer to.
+#[derive(Clone, Debug)]
+pub struct Parts {
+    /// Corner nodes of the bottom triangle, each carrying a corner body.
+    pub bottom: [NodeHandle; 3],
+    /// Corner nodes of the top triangle, each carrying a corner body.
+    pub top: [NodeHandle; 3],
+    /// The knee of each diagonal: the end node of its lower half.
+    pub knees: [NodeHandle; 3],
+    /// Elements of each longeron, from the bottom up.
+    pub longerons: [Vec<BeamHandle>; 3],
+    /// Elements of each diagonal: its lower half from the bottom, then its
+    /// upper half from the knee.
+    pub diagonals: [Vec<BeamHandle>; 3],
+    /// The drivers pushing the knees inward (none in the cell alone).
+    pub knee_drivers: Vec<DriverHandle>,
 }
 
-/// End nodes of longeron `k`: at the bottom and at the top corner.
-pub fn longeron_ends(k: usize) -> [Id; 2] {
-    let base = (100 + 10 * k) as Id;
-    [base + 1, base + 2]
-}
-
-/// Nodes of diagonal `k`: bottom end, knee of the lower half, knee of the
-/// upper half, top end.
-pub fn diagonal_nodes(k: usize) -> [Id; 4] {
-    let base = (200 + 10 * k) as Id;
-    [base + 1, base + 2, base + 3, base + 4]
-}
-
-/// Elements of longeron `k`, from the bottom up.
-pub fn longeron_elements(design: &Design, k: usize) -> Vec<Id> {
-    let n = design.elements.0;
-    (0..n).map(|i| (1 + k * n + i) as Id).collect()
-}
-
-/// Elements of diagonal `k` (lower half from the bottom, then upper half
-/// from the knee).
-pub fn diagonal_elements(design: &Design, k: usize) -> Vec<Id> {
-    let (nl, nd, _) = design.elements;
-    let first = 1 + 3 * nl + 2 * nd * k;
-    (0..2 * nd).map(|i| (first + i) as Id).collect()
-}
-
-/// Id of rigid body `k` of a level.
-fn body_id(level: usize, k: usize) -> Id {
-    (1000 + 10 * level + k) as Id
-}
-
-/// Curve of the knees' inward displacement.
-pub const KNEE_CURVE: &str = "push_knees";
-/// Curve of the top corners' vertical displacement (with `drive_top`).
-pub const TOP_CURVE: &str = "lower_top";
-
-/// Driver of the inward displacement of knee `k`.
-pub fn knee_driver(k: usize) -> Id {
-    (2001 + k) as Id
-}
-
-/// Driver of the vertical displacement of top corner `k` (with
-/// `drive_top`).
-pub fn top_driver(k: usize) -> Id {
-    (2011 + k) as Id
+/// A model of the cell: its definition, and the parts it is read by.
+#[derive(Clone, Debug)]
+pub struct Cell {
+    /// The model definition (written as `mast_cell.toml`).
+    pub input: ModelInput,
+    /// Its parts.
+    pub parts: Parts,
 }
 
 /// Points of the piecewise-linear stage (b) curves.
@@ -394,115 +338,87 @@ const CURVE_POINTS: usize = 80;
 
 /// The cell without drivers: bars, corner bodies, hinges, supports and
 /// the pretension of the diagonals.
-pub fn cell(d: &Design) -> ModelInput {
+pub fn cell(d: &Design) -> (ModelBuilder, Parts) {
     let g = d.geometry();
-    let mut m = ModelInput::new(format!(
+    let mut m = ModelBuilder::new(format!(
         "Folding of a triangular mast cell: r = {} m, L = {} m, folded to {} m",
         d.radius, d.height, d.folded_height
     ));
-    m.analysis.kind = "kinetostatic".into();
-    m.sections.push(d.bar.section("bar"));
-    m.sections.push(d.batten.section("batten"));
+    m.analysis(Analysis::kinetostatic());
+    let bar = m.section(d.bar.section().named("bar"));
+    let batten = m.section(d.batten.section().named("batten"));
 
+    // corners
+    let corners: [[NodeHandle; 2]; 3] =
+        std::array::from_fn(|k| [m.node(g.bottom[k]), m.node(g.top[k])]);
+    let (bottom, top) = (corners.map(|c| c[0]), corners.map(|c| c[1]));
+
+    // every bar has end nodes of its own, at the corners and at the knees,
+    // hinged there
+    let mut longeron = Vec::new();
+    let mut diagonal = Vec::new();
     for k in 0..3 {
-        m.add_node(corner(0, k), g.bottom[k].into());
-        m.add_node(corner(1, k), g.top[k].into());
-    }
-    // bar ends: nodes of their own at the corners and knees, joined by
-    // hinges
-    for k in 0..3 {
-        let [lb, lt] = longeron_ends(k);
-        m.add_node(lb, g.bottom[k].into());
-        m.add_node(lt, g.top[k].into());
-        let [db, kl, ku, dt] = diagonal_nodes(k);
-        m.add_node(db, g.bottom[k].into());
-        m.add_node(kl, g.knee[k].into());
-        m.add_node(ku, g.knee[k].into());
-        m.add_node(dt, g.top[(k + 1) % 3].into());
+        longeron.push([m.node(g.bottom[k]), m.node(g.top[k])]);
+        diagonal.push([
+            m.node(g.bottom[k]),
+            m.node(g.knee[k]),
+            m.node(g.knee[k]),
+            m.node(g.top[(k + 1) % 3]),
+        ]);
     }
 
-    // beams 1.. in the order of `longeron_elements` and `diagonal_elements`;
-    // interior nodes from 10000
+    // bars: longerons, diagonals in two halves shortened for the
+    // pretension; the battens join the corners rigidly
     let (nl, nd, nb) = d.elements;
-    let mut next_node: Id = 10_000;
-    let mut next_element: Id = 1;
-    let mut line = |m: &mut ModelInput, ends: [Id; 2], n: usize, section: &str, strain: f64| {
-        m.beam_lines.push(BeamLineInput {
-            nodes: ends,
-            elements: n,
-            section: section.into(),
-            orientation: None,
-            first_node: Some(next_node),
-            first_element: Some(next_element),
-            arc_center: None,
-            initial_strain: (strain != 0.0).then_some([strain, 0.0, 0.0, 0.0, 0.0, 0.0]),
-            initial_strain_curve: None,
-        });
-        next_node += n as Id - 1;
-        next_element += n as Id;
-    };
-    for k in 0..3 {
-        line(&mut m, longeron_ends(k), nl, "bar", 0.0);
-    }
-    for k in 0..3 {
-        let [db, kl, ku, dt] = diagonal_nodes(k);
-        line(&mut m, [db, kl], nd, "bar", d.pretension_strain);
-        line(&mut m, [ku, dt], nd, "bar", d.pretension_strain);
-    }
-    for level in 0..2 {
+    let longerons = std::array::from_fn(|k| m.beam_line(longeron[k][0], longeron[k][1], nl, bar));
+    let diagonals = std::array::from_fn(|k| {
+        let [lower_end, knee_lower, knee_upper, upper_end] = diagonal[k];
+        [[lower_end, knee_lower], [knee_upper, upper_end]]
+            .into_iter()
+            .flat_map(|[a, b]| {
+                m.add(BeamLine::between(a, b, nd, bar).axial_strain(d.pretension_strain))
+                    .elements
+            })
+            .collect()
+    });
+    for level in [bottom, top] {
         for k in 0..3 {
-            line(
-                &mut m,
-                [corner(level, k), corner(level, (k + 1) % 3)],
-                nb,
-                "batten",
-                0.0,
-            );
+            m.beam_line(level[k], level[(k + 1) % 3], nb, batten);
         }
     }
 
     // corner bodies; the bottom ones are clamped
     let (mass, inertia) = d.corner_mass;
-    for level in 0..2 {
-        for k in 0..3 {
-            m.rigid_bodies.push(RigidBodyInput {
-                id: body_id(level, k),
-                node: corner(level, k),
-                mass,
-                inertia: Some(InertiaInput::Diagonal([inertia; 3])),
-                center_of_mass: None,
-            });
-        }
+    for node in bottom.into_iter().chain(top) {
+        m.add(RigidBody::at(node, mass).inertia([inertia; 3]));
     }
-    for k in 0..3 {
-        m.fix(corner(0, k), &["all"]);
+    for node in bottom {
+        m.fix(node, Dofs::ALL);
     }
 
     // revolute joints: 2 per longeron, 3 per diagonal, at the node of their
     // first body
-    let mut joint_id: Id = 1100;
-    let mut hinge = |m: &mut ModelInput, a: Id, b: Id, axis: &Vec3| {
-        joint_id += 1;
-        m.joints.push(JointInput {
-            id: joint_id,
-            kind: JointType::Revolute,
-            nodes: vec![a, b],
-            axis: Some((*axis).into()),
-            ..JointInput::default()
-        });
+    let axes = &g.axes;
+    for k in 0..3 {
+        let [lower_end, upper_end] = longeron[k];
+        m.add(Joint::revolute(bottom[k], lower_end).axis(axes.longeron_bottom[k]));
+        m.add(Joint::revolute(top[k], upper_end).axis(axes.longeron_top[k]));
+    }
+    for k in 0..3 {
+        let [lower_end, knee_lower, knee_upper, upper_end] = diagonal[k];
+        m.add(Joint::revolute(bottom[k], lower_end).axis(axes.diagonal_bottom[k]));
+        m.add(Joint::revolute(knee_lower, knee_upper).axis(axes.knee[k]));
+        m.add(Joint::revolute(top[(k + 1) % 3], upper_end).axis(axes.diagonal_top[k]));
+    }
+    let parts = Parts {
+        bottom,
+        top,
+        knees: std::array::from_fn(|k| diagonal[k][1]),
+        longerons: longerons.map(|l: BeamLineHandle| l.elements),
+        diagonals,
+        knee_drivers: Vec::new(),
     };
-    for k in 0..3 {
-        let [lb, lt] = longeron_ends(k);
-        hinge(&mut m, corner(0, k), lb, &g.axes.longeron_bottom[k]);
-        hinge(&mut m, corner(1, k), lt, &g.axes.longeron_top[k]);
-    }
-    for k in 0..3 {
-        let [db, kl, ku, dt] = diagonal_nodes(k);
-        hinge(&mut m, corner(0, k), db, &g.axes.diagonal_bottom[k]);
-        hinge(&mut m, kl, ku, &g.axes.knee[k]);
-        hinge(&mut m, corner(1, (k + 1) % 3), dt, &g.axes.diagonal_top[k]);
-    }
-    m
+    (m, parts)
 }
 
 /// The pretensioned configuration after assembly, before any driver acts
@@ -519,28 +435,28 @@ pub struct Assembly {
 /// Solves the equilibrium of the [`cell`] without drivers.
 pub fn assemble(d: &Design) -> Result<Assembly, Box<dyn Error>> {
     let g = d.geometry();
-    let mut m = cell(d);
+    let (mut m, parts) = cell(d);
     // nothing depends on t: the equilibrium at t = 0 and one trivial increment
-    m.analysis.initial_increment = Some(1.0);
-    let model = Model::from_input(&m)?;
+    m.analysis(Analysis::kinetostatic().initial_increment(1.0));
+    let model = m.build()?;
     let outcome = StaticAnalysis::new(&model).run(&mut NoObserver);
     if let Some(e) = outcome.error {
         return Err(format!("assembly of the pretensioned cell: {e}").into());
     }
-    let displacement = |id: Id| {
-        let i = model.node_index(id).expect("node of the cell");
+    let displacement = |node: NodeHandle| {
+        let i = model.node(node);
         outcome.state.x[i] - model.reference_x[i]
     };
     Ok(Assembly {
-        top_drop: displacement(corner(1, 0)).z,
-        knee_inward: displacement(diagonal_nodes(0)[1]).dot(&g.inward[0]),
+        top_drop: displacement(parts.top[0]).z,
+        knee_inward: displacement(parts.knees[0]).dot(&g.inward[0]),
     })
 }
 
 /// Builds the model with the default design, with the analysis divided
 /// into `increments` equal increments (the solver cuts them back if
 /// needed), half for each stage.
-pub fn build(increments: usize) -> ModelInput {
+pub fn build(increments: usize) -> Cell {
     build_design(&Design::default(), increments).expect("the default design assembles")
 }
 
@@ -548,15 +464,18 @@ pub fn build(increments: usize) -> ModelInput {
 /// analysis settings. The drivers start from the [`assemble`]d
 /// configuration, so that at `t = 0` they carry no load and the pretension
 /// is balanced inside the cell.
-pub fn build_design(d: &Design, increments: usize) -> Result<ModelInput, Box<dyn Error>> {
+pub fn build_design(d: &Design, increments: usize) -> Result<Cell, Box<dyn Error>> {
     let g = d.geometry();
     let a = assemble(d)?;
-    let mut m = cell(d);
-    m.analysis.end_time = 2.0;
+    let (mut m, mut parts) = cell(d);
     let step = 2.0 / increments.max(1) as f64;
-    m.analysis.initial_increment = Some(step);
-    m.analysis.max_increment = Some(step);
-    m.analysis.min_increment = Some(step * 1e-4);
+    m.analysis(
+        Analysis::kinetostatic()
+            .end_time(2.0)
+            .initial_increment(step)
+            .max_increment(step)
+            .min_increment(step * 1e-4),
+    );
 
     // Knees: stage (a) pushes them inward by `unlock` from where the
     // assembly put them; stage (b) moves them as straight bars would when
@@ -581,60 +500,43 @@ pub fn build_design(d: &Design, increments: usize) -> Result<ModelInput, Box<dyn
         let u = d.height_at(g.twist * s) - d.height + a.top_drop * (1.0 - s);
         lower.push([1.0 + s, u / drop]);
     }
-    m.curves.push(CurveInput {
-        name: KNEE_CURVE.into(),
-        points: push,
-        ..Default::default()
-    });
+    let push = m.curve(LoadCurve::points(push).named("push_knees"));
     for k in 0..3 {
-        m.drivers.push(DriverInput {
-            id: knee_driver(k),
-            node: Some(diagonal_nodes(k)[1]),
-            direction: Some(g.inward[k].into()),
-            value: knee_final,
-            curve: Some(KNEE_CURVE.into()),
-            active: d.release_knees.then_some([0.0, 1.0]),
-            ..DriverInput::default()
-        });
+        let mut driver = Driver::translation(parts.knees[k], g.inward[k])
+            .value(knee_final)
+            .curve(push);
+        if d.release_knees {
+            driver = driver.active(0.0, 1.0);
+        }
+        parts.knee_drivers.push(m.add(driver));
     }
     if d.drive_top {
-        m.curves.push(CurveInput {
-            name: TOP_CURVE.into(),
-            points: lower,
-            ..Default::default()
-        });
+        let lower = m.curve(LoadCurve::points(lower).named("lower_top"));
         for k in 0..3 {
-            m.drivers.push(DriverInput {
-                id: top_driver(k),
-                node: Some(corner(1, k)),
-                direction: Some([0.0, 0.0, 1.0]),
-                value: drop,
-                curve: Some(TOP_CURVE.into()),
-                active: d.release_knees.then_some([1.0, f64::INFINITY]),
-                ..DriverInput::default()
-            });
+            let mut driver = Driver::translation(parts.top[k], [0.0, 0.0, 1.0])
+                .value(drop)
+                .curve(lower);
+            if d.release_knees {
+                driver = driver.active(1.0, f64::INFINITY);
+            }
+            m.add(driver);
         }
         if d.release_knees {
             // the seventh constraint: the top's rotation about the axis,
             // as the straight longerons would turn it
-            m.curves.push(CurveInput {
-                name: "turn_top".into(),
-                points: vec![[1.0, 0.0], [2.0, 1.0]],
-                ..Default::default()
-            });
-            m.drivers.push(DriverInput {
-                id: 2021,
-                node: Some(corner(1, 0)),
-                direction: Some([0.0, 0.0, 1.0]),
-                motion: Some("rotation".into()),
-                value: g.twist,
-                curve: Some("turn_top".into()),
-                active: Some([1.0, 1.9]),
-                ..DriverInput::default()
-            });
+            let turn = m.curve(LoadCurve::points([[1.0, 0.0], [2.0, 1.0]]).named("turn_top"));
+            m.add(
+                Driver::rotation(parts.top[0], [0.0, 0.0, 1.0])
+                    .value(g.twist)
+                    .curve(turn)
+                    .active(1.0, 1.9),
+            );
         }
     }
-    Ok(m)
+    Ok(Cell {
+        input: m.into_input(),
+        parts,
+    })
 }
 
 // ---------- results along the fold ----------
@@ -694,30 +596,18 @@ pub struct Record {
 struct FoldObserver {
     recorder: Option<Recorder>,
     design: Design,
+    parts: Parts,
     records: Vec<Record>,
     log: bool,
 }
 
-/// Results of the element with `id` and `kind` (its `result_names`).
-fn element_results(model: &Model, state: &State, time: f64, kind: ElementKind, id: Id) -> Vec<f64> {
-    let e = model
-        .elements
-        .iter()
-        .find(|e| e.kind() == kind && e.id() == id)
-        .expect("element of the cell");
-    let mut out = vec![0.0; e.result_names().len()];
-    e.results(&model.context(time, false), state, &mut out);
-    out
-}
-
-fn member(model: &Model, state: &State, time: f64, ids: &[Id]) -> MemberForces {
+fn member(model: &Model, state: &State, beams: &[BeamHandle]) -> MemberForces {
     let mut f = MemberForces::default();
-    for &id in ids {
-        // N, V2, V3, T, M2, M3
-        let r = element_results(model, state, time, ElementKind::Beam, id);
-        f.axial.push(r[0]);
-        f.torsion.push(r[3]);
-        f.bending.push(r[4].hypot(r[5]));
+    for &beam in beams {
+        let s = model.section_forces(beam, state);
+        f.axial.push(s.force.x);
+        f.torsion.push(s.moment.x);
+        f.bending.push(s.moment.y.hypot(s.moment.z));
     }
     f
 }
@@ -748,36 +638,31 @@ impl Observer for FoldObserver {
         state: &State,
         residual: &[f64],
     ) -> std::io::Result<()> {
-        let d = &self.design;
-        let g = d.geometry();
-        let node = |id: Id| model.node_index(id).expect("node of the cell");
-        let displacement = |id: Id| {
-            let i = node(id);
+        let (g, p) = (self.design.geometry(), &self.parts);
+        let displacement = |node: NodeHandle| {
+            let i = model.node(node);
             state.x[i] - model.reference_x[i]
         };
-        let r = so3::matrix(&state.q[node(corner(1, 0))]);
-        let t = info.time;
+        let r = so3::matrix(&state.q[model.node(p.top[0])]);
         let record = Record {
             increment: info.increment,
-            time: t,
+            time: info.time,
             iterations: info.iterations,
-            top_drop: std::array::from_fn(|k| displacement(corner(1, k)).z),
+            top_drop: std::array::from_fn(|k| displacement(p.top[k]).z),
             twist: r[(1, 0)].atan2(r[(0, 0)]),
-            knee_inward: std::array::from_fn(|k| {
-                displacement(diagonal_nodes(k)[1]).dot(&g.inward[k])
-            }),
-            // coordinate, target, load
+            knee_inward: std::array::from_fn(|k| displacement(p.knees[k]).dot(&g.inward[k])),
             knee_load: std::array::from_fn(|k| {
-                element_results(model, state, t, ElementKind::Driver, knee_driver(k))[2]
+                let load = model.results(p.knee_drivers[k], state).get("load");
+                load.expect("a driver's load")
             }),
-            longerons: std::array::from_fn(|k| member(model, state, t, &longeron_elements(d, k))),
-            diagonals: std::array::from_fn(|k| member(model, state, t, &diagonal_elements(d, k))),
+            longerons: std::array::from_fn(|k| member(model, state, &p.longerons[k])),
+            diagonals: std::array::from_fn(|k| member(model, state, &p.diagonals[k])),
         };
         if self.log {
             println!(
                 "increment {:3}  t = {:.4}  iterations {:2}  top {:8.4} m  twist {:7.2}°  knee {:7.4} m  longeron: bending {:6.2} N·m, torsion {:5.2} N·m",
                 info.increment,
-                t,
+                info.time,
                 info.iterations,
                 record.top_drop[0],
                 record.twist.to_degrees(),
@@ -833,28 +718,28 @@ pub struct Run {
     pub outcome: StaticOutcome,
 }
 
-/// Runs the model `input` built from `design`; with `out`, writes the
-/// result files there (VTK, CSV, `log.txt`, `summary.json`, the longeron
-/// moments and their plot). With `log`, prints a line per increment.
+/// Runs the `cell` built from `design`; with `out`, writes the result
+/// files there (VTK, CSV, `log.txt`, `summary.json`, the longeron moments
+/// and their plot). With `log`, prints a line per increment.
 pub fn run(
     design: &Design,
-    input: &ModelInput,
+    cell: &Cell,
     out: Option<&Path>,
     log: bool,
 ) -> Result<Run, Box<dyn Error>> {
-    run_until(design, input, out, log, &StopRequest::new())
+    run_until(design, cell, out, log, &StopRequest::new())
 }
 
 /// [`run`], stopping after the increment during which `stop` is
 /// requested.
 pub fn run_until(
     design: &Design,
-    input: &ModelInput,
+    cell: &Cell,
     out: Option<&Path>,
     log: bool,
     stop: &StopRequest,
 ) -> Result<Run, Box<dyn Error>> {
-    let model = Model::from_input(input)?;
+    let model = Model::from_input(&cell.input)?;
     let mut analysis = StaticAnalysis::new(&model);
     let recorder = match out {
         Some(dir) => {
@@ -866,6 +751,7 @@ pub fn run_until(
     let mut observer = FoldObserver {
         recorder,
         design: design.clone(),
+        parts: cell.parts.clone(),
         records: Vec::new(),
         log,
     };
@@ -992,10 +878,10 @@ fn main() -> Result<(), Box<dyn Error>> {
         .unwrap_or(96);
 
     let start = Instant::now();
-    let input = build_design(&design, increments)?;
+    let cell = build_design(&design, increments)?;
     std::fs::create_dir_all(&out)?;
     let file = out.join("mast_cell.toml");
-    std::fs::write(&file, input.to_toml()?)?;
+    std::fs::write(&file, cell.input.to_toml()?)?;
     println!("model written to {}", file.display());
 
     // SIGINT, SIGTERM: stop after the current increment, results kept
@@ -1007,7 +893,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         ),
         SignalEvent::Ending(s) => eprintln!("{}: stopping at once", signal_name(s)),
     })?;
-    let run = run_until(&design, &input, Some(&out), true, &stop)?;
+    let run = run_until(&design, &cell, Some(&out), true, &stop)?;
     let f = &run.figures;
     println!(
         "{} elements: {} beams, {} rigid bodies, {} revolute joints; {} drivers; {} nodes; {} unknowns ({} redundant constraint equations)",

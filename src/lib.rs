@@ -12,8 +12,8 @@
 //!
 //! Layout:
 //! - [`so3`]: finite rotations (exponential, logarithm, tangent operators);
-//! - [`model`]: the model definition (file schema and Rust API) and its
-//!   validated form;
+//! - [`model`]: the model definition (file schema, and the builders of
+//!   [`model::builder`] in Rust) and its validated form;
 //! - [`elements`]: beams, rigid bodies, springs, nodal loads;
 //! - [`dofs`], [`assembly`], [`linalg`]: numbering, sparse assembly, sparse
 //!   direct solver;
@@ -21,27 +21,27 @@
 //! - [`io`]: model files in, results (CSV, JSON, VTK) out.
 //!
 //! ```
-//! use unfold::model::{input::ModelInput, Model};
-//! use unfold::analysis::{StaticAnalysis, NoObserver};
+//! use unfold::analysis::{NoObserver, StaticAnalysis};
+//! use unfold::model::builder::*;
 //!
 //! // a 2 m cantilever of 8 elements (EI = 1e5 N·m²) with a 1 N tip load
-//! let mut m = ModelInput::new("cantilever");
-//! for i in 0..9 {
-//!     m.add_node(i + 1, [0.25 * i as f64, 0.0, 0.0]);
-//! }
-//! m.add_section("s", [1e8, 4e7, 4e7, 1e5, 1e5, 1e5]);
-//! for i in 1..9 {
-//!     m.add_beam(i, [i, i + 1], "s", Some([0.0, 0.0, 1.0]));
-//! }
-//! m.fix(1, &["all"]);
-//! m.add_load(9, [0.0, 0.0, -1.0], [0.0; 3]);
-//! let model = Model::from_input(&m).unwrap();
+//! let mut m = ModelBuilder::new("cantilever");
+//! let (root, tip) = (m.node([0.0, 0.0, 0.0]), m.node([2.0, 0.0, 0.0]));
+//! let s = m.section(Section::diagonal(1e8, 4e7, 4e7, 1e5, 1e5, 1e5));
+//! m.add(BeamLine::between(root, tip, 8, s).orientation([0.0, 0.0, 1.0]));
+//! m.fix(root, Dofs::ALL);
+//! m.add(Load::force(tip, [0.0, 0.0, -1.0]));
+//! let model = m.build().unwrap();
 //! let outcome = StaticAnalysis::new(&model).run(&mut NoObserver);
 //! assert!(outcome.error.is_none());
 //! // tip deflection ≈ P L³/3EI = 8/3e5, within 1 % with 8 elements
-//! let tip = outcome.state.x[8].z;
+//! let tip = outcome.state.x[model.node(tip)].z;
 //! assert!((tip + 8.0 / 3e5).abs() < 1e-2 * 8.0 / 3e5);
 //! ```
+//!
+//! The same model can be read from a model file
+//! ([`io::model_file::read_model`], docs/model-format.md), or written as
+//! the file schema [`model::input::ModelInput`] directly.
 
 #![warn(missing_docs)]
 #![allow(non_snake_case)]
@@ -59,3 +59,8 @@ pub mod linalg;
 pub mod model;
 pub mod so3;
 pub mod state;
+
+/// The Rust example of README.md, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeExample;

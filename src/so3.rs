@@ -378,12 +378,61 @@ pub fn frame_from_axis_and_vector(e1: &Vec3, v2: &Vec3) -> Option<Mat3> {
     Some(Mat3::from_columns(&[t1, t2, t3]))
 }
 
+/// The smallest rotation taking the direction of `a` to that of `b`:
+/// about `a × b` by the angle between them, `atan2(|a × b|, a·b)`. Two
+/// opposite directions give a half turn about a direction normal to `a`;
+/// a zero vector gives the identity.
+pub fn rotation_between(a: &Vec3, b: &Vec3) -> Rotation {
+    let (la, lb) = (a.norm(), b.norm());
+    if la == 0.0 || lb == 0.0 {
+        return Rotation::identity();
+    }
+    let (a, b) = (a / la, b / lb);
+    let c = a.cross(&b);
+    let s = c.norm();
+    let angle = s.atan2(a.dot(&b));
+    if s > 0.0 {
+        exp(&(c * (angle / s)))
+    } else if angle == 0.0 {
+        Rotation::identity()
+    } else {
+        let other = if a.x.abs() < 0.9 {
+            Vec3::x()
+        } else {
+            Vec3::y()
+        };
+        exp(&(a.cross(&other).normalize() * angle))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use proptest::prelude::*;
     use std::f64::consts::PI;
+
+    proptest! {
+        /// `rotation_between` takes `a` to `b` about an axis normal to both.
+        #[test]
+        fn rotation_between_takes_one_direction_to_the_other(a in vec3(2.0), b in vec3(2.0)) {
+            prop_assume!(a.norm() > 1e-3 && b.norm() > 1e-3);
+            let r = rotation_between(&a, &b);
+            let (ea, eb) = (a.normalize(), b.normalize());
+            prop_assert!((r * ea - eb).norm() < 1e-14);
+            let psi = log(&r);
+            prop_assert!(psi.dot(&ea).abs() < 1e-13 && psi.dot(&eb).abs() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn rotation_between_opposite_and_equal_directions() {
+        let a = Vec3::new(0.3, -1.0, 2.0);
+        assert_eq!(rotation_between(&a, &(2.0 * a)), Rotation::identity());
+        let r = rotation_between(&a, &(-a));
+        assert_relative_eq!(r * a, -a, epsilon = 1e-14);
+        assert_relative_eq!(log(&r).norm(), PI, epsilon = 1e-14);
+    }
 
     fn vec3(max: f64) -> impl Strategy<Value = Vec3> {
         (-max..max, -max..max, -max..max).prop_map(|(a, b, c)| Vec3::new(a, b, c))

@@ -9,7 +9,8 @@ use std::f64::consts::PI;
 use common::{example, line, node, run};
 use unfold::analysis::IncrementInfo;
 use unfold::elements::EvalContext;
-use unfold::model::input::{BeamLineInput, ModelInput};
+use unfold::model::builder::*;
+use unfold::model::input::ModelInput;
 use unfold::so3::{self, Vec3};
 
 /// Rectangular steel section 40 mm (local axis 2) × 20 mm (local axis 3):
@@ -38,24 +39,24 @@ fn linear_cantilever_matches_timoshenko() {
     // beam along x, local axis 2 = z, local axis 3 = x × z = −y
     for (length, direction) in [(2.0f64, 2usize), (2.0, 1), (0.2, 2), (0.2, 1)] {
         let p = 10.0;
-        let mut m = ModelInput::new("linear cantilever");
-        m.add_section("steel", [ea, ga2, ga3, gj, ei2, ei3]);
-        line(
+        let mut m = ModelBuilder::new("linear cantilever");
+        let steel = m.section(Section::diagonal(ea, ga2, ga3, gj, ei2, ei3).named("steel"));
+        let beam = line(
             &mut m,
             [0.0; 3],
             [length, 0.0, 0.0],
             10,
-            "steel",
+            steel,
             [0.0, 0.0, 1.0],
         );
-        m.fix(1, &["all"]);
+        m.fix(beam.start(), Dofs::ALL);
         let mut f = [0.0; 3];
         f[direction] = p;
-        m.add_load(2, f, [0.0; 3]);
-        m.analysis.initial_increment = Some(1.0);
-        let (model, outcome, _) = run(&m);
+        m.add(Load::force(beam.end(), f));
+        m.analysis(Analysis::statics().initial_increment(1.0));
+        let (model, outcome, _) = run(m.input());
         assert!(outcome.error.is_none(), "{:?}", outcome.error);
-        let tip = outcome.state.x[node(&model, 2)] - model.reference_x[node(&model, 2)];
+        let tip = outcome.state.x[model.node(beam.end())] - model.reference_position(beam.end());
         // load along z bends about local 3 with shear along local 2, and
         // load along y bends about local 2 with shear along local 3
         let (ei, ga) = if direction == 2 {
@@ -71,23 +72,23 @@ fn linear_cantilever_matches_timoshenko() {
 }
 
 /// A cantilever of `n` elements, length 1, EI = 10, loaded at its tip by a
-/// moment about z growing to `2π EI/L` at t = 1.
-fn rollup(n: usize, end_time: f64) -> ModelInput {
-    let mut m = ModelInput::new("roll-up");
-    m.add_section("strip", [1e5, 4e4, 4e4, 10.0, 10.0, 10.0]);
-    line(
-        &mut m,
+/// moment about z growing to `2π EI/L` at t = 1; and its tip.
+fn rollup(n: usize, end_time: f64) -> (ModelInput, NodeHandle) {
+    let mut m = ModelBuilder::new("roll-up");
+    let strip = m.section(Section::diagonal(1e5, 4e4, 4e4, 10.0, 10.0, 10.0).named("strip"));
+    let beam = line(&mut m, [0.0; 3], [1.0, 0.0, 0.0], n, strip, [0.0, 1.0, 0.0]);
+    m.fix(beam.start(), Dofs::ALL);
+    m.add(Load::force_and_moment(
+        beam.end(),
         [0.0; 3],
-        [1.0, 0.0, 0.0],
-        n,
-        "strip",
-        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 2.0 * PI * 10.0],
+    ));
+    m.analysis(
+        Analysis::statics()
+            .end_time(end_time)
+            .initial_increment(0.1),
     );
-    m.fix(1, &["all"]);
-    m.add_load(2, [0.0; 3], [0.0, 0.0, 2.0 * PI * 10.0]);
-    m.analysis.end_time = end_time;
-    m.analysis.initial_increment = Some(0.1);
-    m
+    (m.into_input(), beam.end())
 }
 
 fn report(name: &str, increments: &[IncrementInfo]) -> (usize, usize) {
@@ -110,10 +111,11 @@ fn report(name: &str, increments: &[IncrementInfo]) -> (usize, usize) {
 /// Newton tolerance (1e-8 relative).
 #[test]
 fn rollup_into_full_circle() {
-    let (model, outcome, increments) = run(&rollup(10, 1.0));
+    let (input, tip) = rollup(10, 1.0);
+    let (model, outcome, increments) = run(&input);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     report("roll-up to 2π", &increments);
-    let tip = node(&model, 2);
+    let tip = model.node(tip);
     let gap = outcome.state.x[tip].norm();
     println!("tip distance to the clamped end: {gap:.3e} L");
     assert!(gap < 1e-6, "tip at {:?}", outcome.state.x[tip]);
@@ -144,10 +146,11 @@ fn rollup_into_full_circle() {
 fn rollup_half_moment_reaches_the_analytic_circle() {
     let mut errors = Vec::new();
     for n in [10, 20] {
-        let (model, outcome, increments) = run(&rollup(n, 0.5));
+        let (input, tip) = rollup(n, 0.5);
+        let (model, outcome, increments) = run(&input);
         assert!(outcome.error.is_none(), "{:?}", outcome.error);
         report(&format!("roll-up to π, {n} elements"), &increments);
-        let tip = node(&model, 2);
+        let tip = model.node(tip);
         let radius = 1.0 / PI; // EI/M with M = π EI/L, L = 1
         let expected = Vec3::new(0.0, 2.0 * radius, 0.0);
         let error = (outcome.state.x[tip] - expected).norm();
@@ -225,7 +228,7 @@ fn assert_quadratic(input: &ModelInput, force: f64, moment: f64) -> usize {
 #[test]
 fn newton_converges_quadratically_on_the_rollup() {
     let m = 2.0 * PI * 10.0;
-    let judged = assert_quadratic(&rollup(10, 1.0), m, m);
+    let judged = assert_quadratic(&rollup(10, 1.0).0, m, m);
     assert_eq!(judged, 10);
 }
 
@@ -278,31 +281,21 @@ fn bend_45_matches_simo_vu_quoc() {
 fn right_angle_frame_small_load() {
     let [ea, ga2, ga3, gj, ei2, ei3] = steel_section();
     let (a, b, p): (f64, f64, f64) = (1.0, 0.6, 1.0);
-    let mut m = ModelInput::new("L frame");
-    m.add_section("steel", [ea, ga2, ga3, gj, ei2, ei3]);
-    m.add_node(1, [0.0; 3]);
-    m.add_node(2, [a, 0.0, 0.0]);
-    m.add_node(3, [a, b, 0.0]);
+    let mut m = ModelBuilder::new("L frame");
+    let steel = m.section(Section::diagonal(ea, ga2, ga3, gj, ei2, ei3).named("steel"));
+    let clamp = m.node([0.0; 3]);
+    let corner = m.node([a, 0.0, 0.0]);
+    let tip = m.node([a, b, 0.0]);
     // leg 1 along x, leg 2 along y; local axis 2 = z for both
-    for (k, (ends, first)) in [([1, 2], 10), ([2, 3], 30)].into_iter().enumerate() {
-        m.beam_lines.push(BeamLineInput {
-            nodes: ends,
-            elements: 10,
-            section: "steel".into(),
-            orientation: Some([0.0, 0.0, 1.0]),
-            first_node: Some(first),
-            first_element: Some(1 + 10 * k as u64),
-            arc_center: None,
-            initial_strain: None,
-            initial_strain_curve: None,
-        });
+    for (start, end) in [(clamp, corner), (corner, tip)] {
+        m.add(BeamLine::between(start, end, 10, steel).orientation([0.0, 0.0, 1.0]));
     }
-    m.fix(1, &["all"]);
-    m.add_load(3, [0.0, 0.0, p], [0.0; 3]);
-    m.analysis.initial_increment = Some(1.0);
-    let (model, outcome, _) = run(&m);
+    m.fix(clamp, Dofs::ALL);
+    m.add(Load::force(tip, [0.0, 0.0, p]));
+    m.analysis(Analysis::statics().initial_increment(1.0));
+    let (model, outcome, _) = run(m.input());
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
-    let w = outcome.state.x[node(&model, 3)].z;
+    let w = outcome.state.x[model.node(tip)].z;
     // out-of-plane bending of both legs uses EI3 (about local 3) and GA2
     let expected = p * a.powi(3) / (3.0 * ei3)
         + p * b.powi(3) / (3.0 * ei3)
@@ -408,27 +401,22 @@ fn rigid_motion_leaves_strains_and_forces_unchanged() {
 fn natural_curvature_gives_a_stress_free_arc() {
     let l = 1.0;
     let kappa = PI / 2.0 / l;
-    let mut m = ModelInput::new("naturally curved strip");
-    m.add_section("strip", [1e5, 4e4, 4e4, 10.0, 10.0, 10.0]);
-    m.add_node(1, [0.0; 3]).add_node(2, [l, 0.0, 0.0]);
-    m.beam_lines.push(BeamLineInput {
-        nodes: [1, 2],
-        elements: 10,
-        section: "strip".into(),
-        orientation: Some([0.0, 1.0, 0.0]),
-        first_node: Some(3),
-        first_element: Some(1),
-        arc_center: None,
-        // local axis 3 = x × y = z: curvature about local 3 bends towards +y
-        initial_strain: Some([0.0, 0.0, 0.0, 0.0, 0.0, kappa]),
-        initial_strain_curve: Some("ramp".into()),
-    });
-    m.fix(1, &["all"]);
-    let (model, outcome, increments) = run(&m);
+    let mut m = ModelBuilder::new("naturally curved strip");
+    let strip = m.section(Section::diagonal(1e5, 4e4, 4e4, 10.0, 10.0, 10.0).named("strip"));
+    let (root, end) = (m.node([0.0; 3]), m.node([l, 0.0, 0.0]));
+    m.add(
+        BeamLine::between(root, end, 10, strip)
+            .orientation([0.0, 1.0, 0.0])
+            // local axis 3 = x × y = z: curvature about local 3 bends towards +y
+            .initial_strain([0.0, 0.0, 0.0, 0.0, 0.0, kappa])
+            .initial_strain_curve(CurveHandle::RAMP),
+    );
+    m.fix(root, Dofs::ALL);
+    let (model, outcome, increments) = run(m.input());
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     report("natural curvature", &increments);
     let r = 1.0 / kappa;
-    let tip = outcome.state.x[node(&model, 2)];
+    let tip = outcome.state.x[model.node(end)];
     let error = (tip - Vec3::new(r, r, 0.0)).norm() / r;
     println!(
         "tip {tip:?}, arc ({r}, {r}): error {:.3} % of R",
@@ -465,44 +453,21 @@ fn natural_curvature_gives_a_stress_free_arc() {
 fn gravity_on_beam_mass_and_offset_rigid_body() {
     let [ea, ga2, ga3, gj, ei2, ei3] = steel_section();
     let (l, ml, mass, c, g): (f64, f64, f64, f64, f64) = (2.0, 6.3, 3.0, 0.2, 9.81);
-    let mut m = ModelInput::new("cantilever under gravity");
-    m.sections.push(unfold::model::input::SectionInput {
-        name: "steel".into(),
-        ea: Some(ea),
-        ga2: Some(ga2),
-        ga3: Some(ga3),
-        gj: Some(gj),
-        ei2: Some(ei2),
-        ei3: Some(ei3),
-        mass_per_length: Some(ml),
-        ..Default::default()
-    });
-    line(
-        &mut m,
-        [0.0; 3],
-        [l, 0.0, 0.0],
-        10,
-        "steel",
-        [0.0, 0.0, 1.0],
+    let mut m = ModelBuilder::new("cantilever under gravity");
+    let steel = Section::diagonal(ea, ga2, ga3, gj, ei2, ei3).mass_per_length(ml);
+    let steel = m.section(steel.named("steel"));
+    let beam = line(&mut m, [0.0; 3], [l, 0.0, 0.0], 10, steel, [0.0, 0.0, 1.0]);
+    m.fix(beam.start(), Dofs::ALL);
+    m.add(
+        RigidBody::at(beam.end(), mass)
+            .inertia([0.01, 0.02, 0.02])
+            .center_of_mass([c, 0.0, 0.0]),
     );
-    m.fix(1, &["all"]);
-    m.rigid_bodies.push(unfold::model::input::RigidBodyInput {
-        id: 100,
-        node: 2,
-        mass,
-        inertia: Some(unfold::model::input::InertiaInput::Diagonal([
-            0.01, 0.02, 0.02,
-        ])),
-        center_of_mass: Some([c, 0.0, 0.0]),
-    });
-    m.gravity = Some(unfold::model::input::GravityInput {
-        acceleration: [0.0, 0.0, -g],
-        curve: None,
-    });
-    m.analysis.initial_increment = Some(1.0);
-    let (model, outcome, _) = run(&m);
+    m.gravity([0.0, 0.0, -g]);
+    m.analysis(Analysis::statics().initial_increment(1.0));
+    let (model, outcome, _) = run(m.input());
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
-    let w = -outcome.state.x[node(&model, 2)].z;
+    let w = -outcome.state.x[model.node(beam.end())].z;
     // load along z: bending about local 3 (EI3), shear along local 2 (GA2)
     let (q, p) = (ml * g, mass * g);
     let expected = q * l.powi(4) / (8.0 * ei3)

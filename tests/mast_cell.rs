@@ -14,18 +14,18 @@
 #[path = "../examples/mast_cell.rs"]
 mod mast_cell;
 
-use mast_cell::{Design, MemberForces, Record};
+use mast_cell::{Cell, Design, MemberForces, Record};
 use unfold::model::Model;
 
 /// Increments of the test runs (half per stage); the example uses 96.
 const INCREMENTS: usize = 24;
 
-fn run(design: &Design) -> (Model, mast_cell::Run) {
-    let input = mast_cell::build_design(design, INCREMENTS).unwrap();
-    let model = Model::from_input(&input).unwrap();
-    let run = mast_cell::run(design, &input, None, false).unwrap();
+fn run(design: &Design) -> (Model, Cell, mast_cell::Run) {
+    let cell = mast_cell::build_design(design, INCREMENTS).unwrap();
+    let model = Model::from_input(&cell.input).unwrap();
+    let run = mast_cell::run(design, &cell, None, false).unwrap();
     assert!(run.outcome.error.is_none(), "{:?}", run.outcome.error);
-    (model, run)
+    (model, cell, run)
 }
 
 fn largest(r: &Record, f: fn(&MemberForces) -> f64) -> f64 {
@@ -41,13 +41,15 @@ fn spread(values: [f64; 3]) -> f64 {
 
 #[test]
 fn model_file_round_trips_and_has_the_papers_element_counts() {
-    let input = mast_cell::build(INCREMENTS);
+    let cell = mast_cell::build(INCREMENTS);
+    let (input, parts) = (cell.input, cell.parts);
     let text = input.to_toml().unwrap();
     let back =
         unfold::io::model_file::parse_model(&text, std::path::Path::new("mast_cell.toml")).unwrap();
     assert_eq!(back, input);
     let design = Design::default();
-    let run = mast_cell::run(&design, &back, None, false).unwrap();
+    let cell = Cell { input: back, parts };
+    let run = mast_cell::run(&design, &cell, None, false).unwrap();
     let f = &run.figures;
     // paper: 72 elements, 51 beams, 6 rigid bodies, 15 revolute joints
     assert_eq!((f.beams, f.rigid_bodies, f.joints), (51, 6, 15), "{f:?}");
@@ -63,7 +65,7 @@ fn model_file_round_trips_and_has_the_papers_element_counts() {
 fn the_cell_folds_and_is_stress_free_at_both_ends() {
     let design = Design::default();
     let g = design.geometry();
-    let (model, run) = run(&design);
+    let (model, cell, run) = run(&design);
     let (first, last) = (&run.records[0], run.records.last().unwrap());
     assert_eq!(last.time, 2.0);
 
@@ -73,13 +75,13 @@ fn the_cell_folds_and_is_stress_free_at_both_ends() {
     // tolerance: 1e-6 m (about 1e-6 of the cell size) is far above it.
     let state = &run.outcome.state;
     for k in 0..3 {
-        let top = model.node_index(mast_cell::corner(1, k)).unwrap();
+        let top = model.node(cell.parts.top[k]);
         let err = (state.x[top] - g.top_folded[k]).norm();
         assert!(
             err < 1e-6,
             "top corner {k}: {err:.3e} m from the folded position"
         );
-        let knee = model.node_index(mast_cell::diagonal_nodes(k)[1]).unwrap();
+        let knee = model.node(cell.parts.knees[k]);
         let err = (state.x[knee] - g.knee_folded[k]).norm();
         assert!(err < 1e-6, "knee {k}: {err:.3e} m from the folded position");
         // each knee went inward, by more than 20 cm
@@ -126,7 +128,7 @@ fn the_cell_folds_and_is_stress_free_at_both_ends() {
 #[test]
 fn pretension_is_symmetric_tension_in_diagonals_compression_in_longerons() {
     let design = Design::default();
-    let (_, run) = run(&design);
+    let (_, _, run) = run(&design);
     let first = &run.records[0];
     assert_eq!(first.time, 0.0);
     let (nl, nd, _) = design.elements;
@@ -177,12 +179,12 @@ fn imposing_the_top_too_over_controls_the_cell() {
     // same stress-free configuration, but the six drivers fight each other
     // through the bars (the cell has three soft modes, the knee folds);
     // measured axial forces 1.9 kN against 0.14 kN with the knees alone
-    let free = run(&Design::default()).1;
+    let free = run(&Design::default()).2;
     let design = Design {
         drive_top: true,
         ..Design::default()
     };
-    let (_, driven) = run(&design);
+    let (_, _, driven) = run(&design);
     assert_eq!(driven.figures.drivers, 6);
     let last = driven.records.last().unwrap();
     assert!(largest(last, MemberForces::max_bending) < 1e-6);
@@ -231,8 +233,7 @@ fn assembled_tangent_of_the_bent_cell_matches_finite_differences() {
             Ok(())
         }
     }
-    let input = mast_cell::build(INCREMENTS);
-    let model = Model::from_input(&input).unwrap();
+    let model = Model::from_input(&mast_cell::build(INCREMENTS).input).unwrap();
     let mut grab = Grab(None);
     let outcome = StaticAnalysis::new(&model).run(&mut grab);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);

@@ -30,7 +30,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{add_block, add_vec, CellShape, Element, ElementKind, ElementOutput, EvalContext};
 use crate::curves::{Curve, CurveIndex};
-use crate::model::input::Id;
+use crate::model::Id;
 use crate::so3::{self, skew, Mat3, Operator, Rotation, SkewSeries, Vec3};
 use crate::state::State;
 

@@ -13,7 +13,7 @@
 
 use super::{add_block, add_vec, Element, ElementKind, ElementOutput, EvalContext};
 use crate::curves::CurveIndex;
-use crate::model::input::Id;
+use crate::model::Id;
 use crate::so3::{self, skew, Vec3};
 use crate::state::State;
 

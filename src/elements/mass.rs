@@ -10,7 +10,7 @@
 //! ([`crate::elements::EvalContext::dynamics`]).
 
 use super::{add_block, add_vec, CellShape, Element, ElementKind, ElementOutput, EvalContext};
-use crate::model::input::Id;
+use crate::model::Id;
 use crate::so3::{self, skew, Mat3, Vec3};
 use crate::state::State;
 

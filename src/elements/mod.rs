@@ -23,81 +23,17 @@
 
 pub mod beam;
 pub mod inertia;
+mod kind;
 pub mod load;
 pub mod mass;
 pub mod spring;
 
 use crate::curves::Curve;
-use crate::model::input::Id;
+use crate::model::Id;
 use crate::so3::Vec3;
 use crate::state::State;
 
-/// The closed set of element kinds (for outputs and messages).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum ElementKind {
-    /// Geometrically exact beam.
-    Beam,
-    /// Rigid body attached to a node.
-    RigidBody,
-    /// Point mass attached to a node.
-    PointMass,
-    /// Linear spring.
-    Spring,
-    /// Nodal force and moment.
-    NodalLoad,
-    /// Kinematic constraint enforced with Lagrange multipliers (its extra
-    /// unknowns).
-    Constraint,
-    /// Kinematic pair of the joint library.
-    Joint,
-    /// Spring or damper on a joint coordinate.
-    JointSpring,
-    /// Prescribed history of a joint coordinate or node component.
-    Driver,
-}
-
-impl ElementKind {
-    /// Lower-case name used in messages and output file names.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Beam => "beam",
-            Self::RigidBody => "rigid body",
-            Self::PointMass => "point mass",
-            Self::Spring => "spring",
-            Self::NodalLoad => "load",
-            Self::Constraint => "constraint",
-            Self::Joint => "joint",
-            Self::JointSpring => "joint spring",
-            Self::Driver => "driver",
-        }
-    }
-
-    /// Numeric code written to VTK files (cell data `kind`).
-    pub fn code(self) -> i32 {
-        match self {
-            Self::Beam => 1,
-            Self::RigidBody => 2,
-            Self::PointMass => 3,
-            Self::Spring => 4,
-            Self::NodalLoad => 5,
-            Self::Constraint => 6,
-            Self::Joint => 7,
-            Self::JointSpring => 8,
-            Self::Driver => 9,
-        }
-    }
-}
-
-/// Shape of an element in the VTK output.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CellShape {
-    /// A line between the element's two nodes.
-    Line,
-    /// A vertex at the element's node.
-    Vertex,
-    /// Not drawn.
-    None,
-}
+pub use kind::{CellField, CellShape, ElementKind};
 
 /// Coefficients of a time integrator, for elements with inertia or damping.
 /// Reserved for dynamic analyses; statics passes `None`.

@@ -14,9 +14,22 @@
 //! and orientation.
 
 use super::{add_block, add_vec, CellShape, Element, ElementKind, ElementOutput, EvalContext};
-use crate::model::input::{Id, SpringKind};
+use crate::model::Id;
 use crate::so3::{self, Mat3, Operator, Rotation, SkewSeries, Vec3};
 use crate::state::State;
+
+/// What a spring resists (`kind` in the model file).
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum SpringKind {
+    /// Relative displacement along the global axes: `f = diag(k) Δu`.
+    Translational,
+    /// Relative rotation, measured in the first node's material frame (or
+    /// the global frame for a spring to ground): `m = diag(k) ψ`.
+    Rotational,
+    /// Change of the distance between the two nodes: `f = k (ℓ − ℓ₀)`.
+    Axial,
+}
 
 /// A linear spring.
 #[derive(Clone, Debug)]

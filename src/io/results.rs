@@ -1,15 +1,11 @@
 //! Result files of a run (docs/results.md):
 //! - `nodes.csv`: position, displacement and orientation of every node at
 //!   every output step;
-//! - `beams.csv`: section forces and moments of every beam;
-//! - `springs.csv`: force and deformation of every spring;
 //! - `reactions.csv`: support reactions (forces and moments, global frame);
-//! - `joints.csv`: relative coordinates of every joint and the load it
-//!   applies to its first body, in the joint axes and in the global axes;
-//! - `drivers.csv`: driven coordinate, its target, the actuator load and
-//!   the load on the driven body (global axes);
-//! - `joint_springs.csv`: coordinate, rate and force of joint springs and
-//!   dampers;
+//! - one table per kind of element that reports results
+//!   ([`ElementKind::results_file`]: `beams.csv`, `springs.csv`,
+//!   `joints.csv`, `drivers.csv`, `joint_springs.csv`), whose columns are
+//!   the element's [`crate::elements::Element::result_names`];
 //! - `steps.csv`: one line per output step (increment, load parameter,
 //!   iterations, final relative residual);
 //! - `vtk/step_NNNNN.vtu` and `unfold.pvd`: the configurations for ParaView;
@@ -27,7 +23,7 @@
 //!
 //! **The directory belongs to one run.** A lock file (`.unfold.lock`) is
 //! held for the life of the writer: a second run on the same directory is
-//! refused. Files that unfold writes ([`OWNED_FILES`], `vtk/step_*.vtu`)
+//! refused. Files that unfold writes ([`owned_files`], `vtk/step_*.vtu`)
 //! and that this run will not rewrite are removed when it starts, so that
 //! no result of an earlier model is left beside the new ones; other files
 //! are left alone.
@@ -45,22 +41,29 @@ use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
 
-/// Result files in the output directory that unfold writes (besides the
-/// grids `vtk/step_NNNNN.vtu`). A run removes those of them it will not
-/// rewrite, and their temporary files (`NAME.tmp`).
-pub const OWNED_FILES: [&str; 11] = [
+/// Result files in the output directory that unfold writes besides the
+/// tables of the element kinds ([`ElementKind::results_file`]) and the
+/// grids `vtk/step_NNNNN.vtu`.
+const RUN_FILES: [&str; 6] = [
     "log.txt",
     "steps.csv",
     "nodes.csv",
-    "beams.csv",
-    "springs.csv",
     "reactions.csv",
-    "joints.csv",
-    "drivers.csv",
-    "joint_springs.csv",
     "unfold.pvd",
     "summary.json",
 ];
+
+/// Result files in the output directory that unfold writes (besides the
+/// grids `vtk/step_NNNNN.vtu`): those of a run and the table of each kind
+/// of element. A run removes those of them it will not rewrite, and their
+/// temporary files (`NAME.tmp`).
+pub fn owned_files() -> impl Iterator<Item = &'static str> {
+    RUN_FILES.into_iter().chain(
+        ElementKind::ALL
+            .into_iter()
+            .filter_map(ElementKind::results_file),
+    )
+}
 
 /// The lock file of an output directory.
 pub const LOCK_FILE: &str = ".unfold.lock";
@@ -325,18 +328,7 @@ struct ElementTable {
     file: CsvFile,
     /// Elements (indices in `model.elements`) in increasing id.
     elements: Vec<usize>,
-    /// Number of result values.
-    width: usize,
 }
-
-/// File name and id column of the result table of each kind of element.
-const TABLES: [(ElementKind, &str, &str); 5] = [
-    (ElementKind::Beam, "beams.csv", "element"),
-    (ElementKind::Spring, "springs.csv", "element"),
-    (ElementKind::Joint, "joints.csv", "joint"),
-    (ElementKind::Driver, "drivers.csv", "driver"),
-    (ElementKind::JointSpring, "joint_springs.csv", "element"),
-];
 
 /// Writes result files as the analysis converges.
 pub struct ResultWriter {
@@ -351,6 +343,9 @@ pub struct ResultWriter {
     /// Supported nodes (indices) in increasing id, for reactions.
     supported: Vec<usize>,
     tables: Vec<ElementTable>,
+    /// Result values of one element: as long as the longest list of
+    /// result names of the model.
+    values: Vec<f64>,
     pvd: Vec<(f64, String)>,
     /// Every converged increment, for the summary.
     pub log: Vec<IncrementRecord>,
@@ -391,11 +386,14 @@ impl ResultWriter {
             "reactions.csv" => !supported.is_empty(),
             // written again by whoever writes the summary
             "summary.json" => false,
-            _ => TABLES.iter().find(|t| t.1 == name).is_none_or(|t| has(t.0)),
+            _ => ElementKind::ALL
+                .into_iter()
+                .find(|k| k.results_file() == Some(name))
+                .is_none_or(has),
         };
 
         // leftovers of an earlier run
-        for name in OWNED_FILES {
+        for name in owned_files() {
             if !writes(name) {
                 remove_if_present(&dir.join(name))?;
             }
@@ -414,8 +412,13 @@ impl ResultWriter {
 
         let mut node_order: Vec<usize> = (0..model.n_nodes()).collect();
         node_order.sort_by_key(|&i| model.node_ids[i]);
+        // one table per kind that has results, columns named by its
+        // elements (all of a kind report the same quantities)
         let mut tables = Vec::new();
-        for (kind, name, id_column) in TABLES {
+        for kind in ElementKind::ALL {
+            let Some(name) = kind.results_file() else {
+                continue;
+            };
             let mut elements: Vec<usize> = (0..model.elements.len())
                 .filter(|&k| model.elements[k].kind() == kind)
                 .collect();
@@ -424,16 +427,24 @@ impl ResultWriter {
             };
             elements.sort_by_key(|&k| model.elements[k].id());
             let names = model.elements[first].result_names();
+            debug_assert!(elements
+                .iter()
+                .all(|&k| model.elements[k].result_names() == names));
             tables.push(ElementTable {
                 kind,
                 file: CsvFile::create(
                     dir.join(name),
-                    &format!("step,time,{id_column},{}", names.join(",")),
+                    &format!("step,time,{},{}", kind.id_column(), names.join(",")),
                 )?,
                 elements,
-                width: names.len(),
             });
         }
+        let longest = model
+            .elements
+            .iter()
+            .map(|e| e.result_names().len())
+            .max()
+            .unwrap_or(0);
         Ok(Self {
             dir: dir.to_path_buf(),
             _lock: lock,
@@ -457,6 +468,7 @@ impl ResultWriter {
                 .transpose()?,
             supported,
             tables,
+            values: vec![0.0; longest],
             pvd: Vec::new(),
             log: Vec::new(),
         })
@@ -516,16 +528,16 @@ impl ResultWriter {
             );
         }
         let ctx = model.context(t, false);
-        let mut values = Vec::new();
         for table in &mut self.tables {
-            values.resize(table.width, 0.0);
             for &k in &table.elements {
                 let e = &model.elements[k];
                 debug_assert_eq!(e.kind(), table.kind);
-                e.results(&ctx, state, &mut values);
+                let values = &mut self.values[..e.result_names().len()];
+                values.fill(0.0);
+                e.results(&ctx, state, values);
                 let w = &mut table.file.pending;
                 let _ = write!(w, "{step},{t:.12e},{}", e.id());
-                for v in &values {
+                for v in values.iter() {
                     // absent quantities (a joint with fewer coordinates) are empty
                     if v.is_nan() {
                         w.push(',');

@@ -19,14 +19,16 @@
 //!   the reference), `rotation` (rotation vector of `R R₀ᵀ`, global frame;
 //!   at a joint point that of its node) and `axis_1`, `axis_2`, `axis_3`
 //!   (unit vectors: a node's material axes, a joint point's joint axes);
-//! - cells: beams and two-node springs as lines, rigid bodies, point masses
-//!   and springs to ground as vertices; for each joint, a line from each
-//!   of its nodes to its joint point on that node (a rigid link) and a
-//!   vertex at its point on body B (the joint marker). Cell data `kind`
-//!   (1 beam, 2 rigid body, 3 point mass, 4 spring, 7 joint, 10 rigid
-//!   link), `element_id`, the beam section forces `N`, `V2`, `V3`, `T`,
-//!   `M2`, `M3` (zero on other cells) and the spring force and deformation
-//!   `spring_F`, `spring_D` (zero on other cells).
+//! - cells: each element as its [`CellShape`] says (beams and two-node
+//!   springs as lines, rigid bodies, point masses and springs to ground as
+//!   vertices, four-node elements as quadrilaterals); for each joint, a
+//!   line from each of its nodes to its joint point on that node (a rigid
+//!   link) and a vertex at its point on body B (the joint marker). Cell
+//!   data `kind` ([`ElementKind::code`]; 10 for a rigid link),
+//!   `element_id`, and the arrays each kind fills from its results
+//!   ([`ElementKind::cell_fields`]: the beam section forces `N`, `V2`,
+//!   `V3`, `T`, `M2`, `M3`, the spring force and deformation `spring_F`,
+//!   `spring_D`), zero on the cells of other kinds.
 
 use std::fmt::Write as _;
 use std::io::{self, Write as _};
@@ -36,14 +38,13 @@ use flate2::write::ZlibEncoder;
 use flate2::Compression;
 
 use super::results::file_error;
-use crate::elements::{Attachment, CellShape, ElementKind, EvalContext};
+use crate::elements::{Attachment, CellField, CellShape, ElementKind, EvalContext};
 use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
 
-/// VTK cell type codes.
+/// VTK cell type code of a vertex.
 const VTK_VERTEX: u8 = 1;
-const VTK_LINE: u8 = 3;
 
 /// Cell `kind` of a rigid link from a node to a joint point.
 pub const KIND_LINK: i32 = 10;
@@ -268,28 +269,44 @@ pub fn write_vtu(
         joint_id.push(model.elements[*k].id() as i64);
     }
 
-    // cells
+    // cells: the shape of each element, its results in the cell arrays of
+    // its kind (ElementKind::cell_fields), zeros in the others
+    let fields: Vec<(ElementKind, &CellField)> = ElementKind::ALL
+        .into_iter()
+        .flat_map(|k| k.cell_fields().iter().map(move |f| (k, f)))
+        .collect();
+    let mut field_values: Vec<Vec<f64>> = vec![Vec::new(); fields.len()];
     let mut connectivity: Vec<i64> = Vec::new();
     let mut offsets: Vec<i64> = Vec::new();
     let mut types: Vec<u8> = Vec::new();
     let mut kinds: Vec<i32> = Vec::new();
     let mut ids: Vec<i64> = Vec::new();
-    let mut beam: Vec<[f64; 6]> = Vec::new();
-    let mut spring: Vec<[f64; 6]> = Vec::new();
-    let mut cell = |points: &[usize], kind: i32, id: i64, b: [f64; 6], s: [f64; 6]| {
+    let longest = model
+        .elements
+        .iter()
+        .map(|e| e.result_names().len())
+        .max()
+        .unwrap_or(0);
+    let mut results = vec![0.0; longest];
+    let mut cell = |points: &[usize], kind: i32, id: i64, values: Option<(ElementKind, &[f64])>| {
         connectivity.extend(points.iter().map(|&p| p as i64));
         offsets.push(connectivity.len() as i64);
-        types.push(if points.len() == 2 {
-            VTK_LINE
-        } else {
-            VTK_VERTEX
-        });
+        types.push(
+            CellShape::with_nodes(points.len())
+                .vtk_type()
+                .unwrap_or(VTK_VERTEX),
+        );
         kinds.push(kind);
         ids.push(id);
-        beam.push(b);
-        spring.push(s);
+        for ((k, f), column) in fields.iter().zip(&mut field_values) {
+            match values {
+                Some((of, v)) if of == *k && f.first + f.components <= v.len() => {
+                    column.extend_from_slice(&v[f.first..f.first + f.components])
+                }
+                _ => column.extend(std::iter::repeat_n(0.0, f.components)),
+            }
+        }
     };
-    let mut results = [0.0; 6];
     let mut next_joint_point = n_nodes;
     for (k, e) in model.elements.iter().enumerate() {
         let id = e.id() as i64;
@@ -299,35 +316,29 @@ pub fn write_vtu(
         while next_joint_point < n_points && joints[next_joint_point - n_nodes].0 == k {
             let a = &joints[next_joint_point - n_nodes].1;
             if let Some(node) = a.node {
-                cell(&[node, next_joint_point], KIND_LINK, id, [0.0; 6], [0.0; 6]);
+                cell(&[node, next_joint_point], KIND_LINK, id, None);
             }
             next_joint_point += 1;
         }
         if next_joint_point > first {
-            cell(
-                &[next_joint_point - 1],
-                e.kind().code(),
-                id,
-                [0.0; 6],
-                [0.0; 6],
-            );
+            cell(&[next_joint_point - 1], e.kind().code(), id, None);
             continue;
         }
-        let points = match e.cell_shape() {
-            CellShape::Line => &nodes[..2],
-            CellShape::Vertex => &nodes[..1],
-            CellShape::None => continue,
-        };
-        results.fill(0.0);
-        if matches!(e.kind(), ElementKind::Beam | ElementKind::Spring) {
-            e.results(ctx, state, &mut results);
+        let shape = e.cell_shape();
+        if shape == CellShape::None {
+            continue;
         }
-        let (b, s) = match e.kind() {
-            ElementKind::Beam => (results, [0.0; 6]),
-            ElementKind::Spring => ([0.0; 6], results),
-            _ => ([0.0; 6], [0.0; 6]),
+        let points = &nodes[..shape.nodes()];
+        let kind = e.kind();
+        let values = if kind.cell_fields().is_empty() {
+            None
+        } else {
+            let r = &mut results[..e.result_names().len()];
+            r.fill(0.0);
+            e.results(ctx, state, r);
+            Some((kind, &*r))
         };
-        cell(points, e.kind().code(), id, b, s);
+        cell(points, kind.code(), id, values);
     }
     let n_cells = types.len();
 
@@ -361,16 +372,8 @@ pub fn write_vtu(
     doc.xml.push_str("      <CellData Scalars=\"kind\">\n");
     doc.array("kind", 1, &kinds);
     doc.array("element_id", 1, &ids);
-    let mut column = Vec::with_capacity(3 * n_cells);
-    for (c, name) in ["N", "V2", "V3", "T", "M2", "M3"].iter().enumerate() {
-        column.clear();
-        column.extend(beam.iter().map(|b| b[c]));
-        doc.array(name, 1, &column);
-    }
-    for (name, range) in [("spring_F", 0..3), ("spring_D", 3..6)] {
-        column.clear();
-        column.extend(spring.iter().flat_map(|s| s[range.clone()].iter().copied()));
-        doc.array(name, 3, &column);
+    for ((_, f), column) in fields.iter().zip(&field_values) {
+        doc.array(f.name, f.components, column);
     }
     doc.xml.push_str("      </CellData>\n");
 
@@ -420,4 +423,88 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
         let _ = std::fs::remove_file(&tmp);
         file_error(path, e)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::elements::{Element, ElementOutput};
+    use crate::model::input::ModelInput;
+    use crate::model::Id;
+
+    /// A four-node element drawn as a quadrilateral (as a shell is), with
+    /// no stiffness.
+    struct Panel {
+        nodes: [usize; 4],
+    }
+
+    impl Element for Panel {
+        fn kind(&self) -> ElementKind {
+            ElementKind::Constraint
+        }
+        fn id(&self) -> Id {
+            99
+        }
+        fn nodes(&self) -> &[usize] {
+            &self.nodes
+        }
+        fn evaluate(&self, _: &EvalContext, _: &State, _: &mut ElementOutput) {}
+        fn cell_shape(&self) -> CellShape {
+            CellShape::Quad
+        }
+    }
+
+    /// A square frame of four beams with a panel on its corners: the
+    /// panel is a VTK_QUAD cell (type 9) through the four corner points in
+    /// order, after the four beam lines.
+    #[test]
+    fn a_four_node_element_is_written_as_a_quad_cell() {
+        let mut m = ModelInput::new("panel");
+        let corners = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        for (i, x) in corners.into_iter().enumerate() {
+            m.add_node(i as Id + 1, x);
+        }
+        m.add_section("s", [1e6, 4e5, 4e5, 80.0, 100.0, 100.0]);
+        for i in 0..4 {
+            m.add_beam(i + 1, [i + 1, (i + 1) % 4 + 1], "s", None);
+        }
+        m.fix(1, &["all"]);
+        let mut model = crate::model::Model::from_input(&m).unwrap();
+        let nodes = [0, 1, 2, 3].map(|id| model.node_index(id + 1).unwrap());
+        model.push_element(Box::new(Panel { nodes }));
+        let state = model.initial_state();
+        let path = std::env::temp_dir().join(format!("unfold-quad-{}.vtu", std::process::id()));
+        write_vtu(
+            &path,
+            &model,
+            &model.context(0.0, false),
+            &state,
+            Encoding::Ascii,
+        )
+        .unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        let array = |name: &str| -> Vec<f64> {
+            let start = text.find(&format!("Name=\"{name}\"")).unwrap();
+            let body = &text[start..];
+            let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+            body.split_whitespace()
+                .map(|v| v.parse().unwrap())
+                .collect()
+        };
+        assert_eq!(array("types"), vec![3.0, 3.0, 3.0, 3.0, 9.0]);
+        assert_eq!(array("offsets"), vec![2.0, 4.0, 6.0, 8.0, 12.0]);
+        assert_eq!(&array("connectivity")[8..], &nodes.map(|n| n as f64));
+        assert_eq!(array("kind")[4], ElementKind::Constraint.code() as f64);
+        assert_eq!(array("element_id"), vec![1.0, 2.0, 3.0, 4.0, 99.0]);
+        // the beam resultants and spring values are zero on the panel
+        assert_eq!(array("M3").len(), 5);
+        assert_eq!(array("M3")[4], 0.0);
+        assert_eq!(array("spring_F"), vec![0.0; 15]);
+    }
 }

@@ -19,7 +19,7 @@ use super::kinematics::{with_scratch, Conf};
 use super::types::Equation;
 use crate::curves::CurveIndex;
 use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext, ExtraKind};
-use crate::model::input::Id;
+use crate::model::Id;
 use crate::so3::{self, Vec3};
 use crate::state::State;
 

@@ -22,7 +22,7 @@ use crate::elements::{
     Attachment, CellShape, ConstraintScaling, Element, ElementKind, ElementOutput, EvalContext,
     ExtraKind,
 };
-use crate::model::input::Id;
+use crate::model::Id;
 use crate::so3::{self, Vec3};
 use crate::state::State;
 

@@ -8,7 +8,7 @@
 use super::coordinate::PairCoordinate;
 use super::kinematics::{with_scratch, Local};
 use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext};
-use crate::model::input::Id;
+use crate::model::Id;
 use crate::state::State;
 
 /// A force law `f(x)`: linear, or a table interpolated linearly between

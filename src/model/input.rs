@@ -7,8 +7,8 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Identifier of a node or an element, as written in the model file.
-pub type Id = u64;
+pub use super::Id;
+pub use crate::elements::spring::SpringKind;
 
 /// Largest id: TOML integers are 64-bit signed, so a model with a larger id
 /// (or generating one, see `beam_lines`) could not be written back.
@@ -362,6 +362,24 @@ pub struct SectionInput {
     pub inertia_per_length: Option<[f64; 3]>,
 }
 
+impl SectionInput {
+    /// A section of diagonal stiffnesses `[EA, GA2, GA3, GJ, EI2, EI3]`,
+    /// without mass.
+    pub fn diagonal(name: impl Into<String>, diagonal: [f64; 6]) -> Self {
+        let [ea, ga2, ga3, gj, ei2, ei3] = diagonal.map(Some);
+        Self {
+            name: name.into(),
+            ea,
+            ga2,
+            ga3,
+            gj,
+            ei2,
+            ei3,
+            ..Self::default()
+        }
+    }
+}
+
 /// A two-node beam element.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -462,19 +480,6 @@ pub struct PointMassInput {
     pub mass: f64,
 }
 
-/// What a spring resists.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub enum SpringKind {
-    /// Relative displacement along the global axes: `f = diag(k) Δu`.
-    Translational,
-    /// Relative rotation, measured in the first node's material frame (or
-    /// the global frame for a spring to ground): `m = diag(k) ψ`.
-    Rotational,
-    /// Change of the distance between the two nodes: `f = k (ℓ − ℓ₀)`.
-    Axial,
-}
-
 /// A linear spring between two nodes, or between a node and the ground.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -499,6 +504,18 @@ pub enum StiffnessInput {
     Isotropic(f64),
     /// One value per axis.
     PerAxis([f64; 3]),
+}
+
+impl From<f64> for StiffnessInput {
+    fn from(k: f64) -> Self {
+        Self::Isotropic(k)
+    }
+}
+
+impl From<[f64; 3]> for StiffnessInput {
+    fn from(k: [f64; 3]) -> Self {
+        Self::PerAxis(k)
+    }
 }
 
 /// Fixed degrees of freedom of a node.
@@ -618,7 +635,7 @@ pub struct CurveInput {
     pub to: Option<f64>,
 }
 
-// ---------- builder helpers for models written in Rust ----------
+// ---------- helpers for models written in Rust (see also crate::model::builder) ----------
 
 impl ModelInput {
     /// An empty model with a title.
@@ -643,17 +660,7 @@ impl ModelInput {
     /// Adds a section with the diagonal stiffnesses
     /// `[EA, GA2, GA3, GJ, EI2, EI3]`.
     pub fn add_section(&mut self, name: impl Into<String>, diagonal: [f64; 6]) -> &mut Self {
-        let [ea, ga2, ga3, gj, ei2, ei3] = diagonal;
-        self.sections.push(SectionInput {
-            name: name.into(),
-            ea: Some(ea),
-            ga2: Some(ga2),
-            ga3: Some(ga3),
-            gj: Some(gj),
-            ei2: Some(ei2),
-            ei3: Some(ei3),
-            ..SectionInput::default()
-        });
+        self.sections.push(SectionInput::diagonal(name, diagonal));
         self
     }
 

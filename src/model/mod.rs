@@ -8,19 +8,29 @@
 //! meant) in [`Model::warnings`] for the caller to show.
 
 mod build;
+pub mod builder;
+mod handles;
 pub mod input;
 
 use std::fmt;
 
 use crate::curves::{Curve, CurveIndex};
-use crate::elements::{ConstraintScaling, Element, EvalContext};
+use crate::elements::{ConstraintScaling, Element, ElementKind, EvalContext};
 use crate::so3::{Rotation, Vec3};
 use crate::state::State;
-use input::Id;
+
+/// Identifier of a node or an element, as written in the model file and in
+/// the result files.
+pub type Id = u64;
 
 pub use build::{
     LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MAX_LINE_ELEMENTS, MAX_MODEL_SIZE,
     MIN_RELATIVE_INCREMENT,
+};
+pub use builder::ModelBuilder;
+pub use handles::{
+    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, JointHandle,
+    JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle, SpringHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.
@@ -96,6 +106,8 @@ pub struct Model {
     pub reference_q: Vec<Rotation>,
     /// All elements (loads included).
     pub elements: Vec<Box<dyn Element>>,
+    /// Index of each element by kind and id.
+    element_lookup: std::collections::HashMap<(ElementKind, Id), usize>,
     /// Fixed components of each node (supports and prescribed motions).
     pub fixed: Vec<[bool; 6]>,
     /// Prescribed motions.
@@ -179,6 +191,8 @@ impl Model {
         let extra = self.elements.iter().map(|e| e.n_extra()).sum();
         let internal = self.elements.iter().map(|e| e.n_internal()).sum();
         e.set_offsets(extra, internal);
+        self.element_lookup
+            .insert((e.kind(), e.id()), self.elements.len());
         self.elements.push(e);
     }
 

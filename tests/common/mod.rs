@@ -2,7 +2,8 @@
 #![allow(dead_code)]
 
 use unfold::analysis::{IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
-use unfold::model::input::{BeamLineInput, ModelInput};
+use unfold::model::builder::{BeamLine, BeamLineHandle, ModelBuilder, SectionHandle};
+use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::state::State;
 
@@ -34,29 +35,18 @@ pub fn run(input: &ModelInput) -> (Model, StaticOutcome, Vec<IncrementInfo>) {
     (model, outcome, rec.increments)
 }
 
-/// A straight line of `n` beam elements from node 1 at `a` to node 2 at
-/// `b`; interior nodes get ids 3, 4, ... in order from `a`.
+/// A straight line of `n` beam elements of `section` between two new
+/// nodes at `a` and `b` (added in this order, before the interior nodes).
 pub fn line(
-    m: &mut ModelInput,
+    m: &mut ModelBuilder,
     a: [f64; 3],
     b: [f64; 3],
     n: usize,
-    section: &str,
+    section: SectionHandle,
     orientation: [f64; 3],
-) {
-    m.add_node(1, a);
-    m.add_node(2, b);
-    m.beam_lines.push(BeamLineInput {
-        nodes: [1, 2],
-        elements: n,
-        section: section.into(),
-        orientation: Some(orientation),
-        first_node: Some(3),
-        first_element: Some(1),
-        arc_center: None,
-        initial_strain: None,
-        initial_strain_curve: None,
-    });
+) -> BeamLineHandle {
+    let (a, b) = (m.node(a), m.node(b));
+    m.add(BeamLine::between(a, b, n, section).orientation(orientation))
 }
 
 /// Index of node `id` in the model.

@@ -1,26 +1,23 @@
-//! Validation and construction of joints, joint springs and drivers.
+//! `[[joints]]`: the kinematic pairs; and the table of the joints built,
+//! through which joint springs and drivers refer to a joint's coordinate.
 
 use std::collections::{HashMap, HashSet};
 
-use super::curves::RAMP;
 use super::Builder;
+use super::{drivers, joint_springs};
 use crate::elements::Element;
 use crate::joints::types::{Coordinate, JointParameters};
-use crate::joints::{Driver, Joint, JointSpring, JointType, Law, Pair, PairCoordinate};
-use crate::model::input::{AngleUnit, DriverInput, Id, JointInput, JointSpringInput};
+use crate::joints::{Joint, JointType, Pair, PairCoordinate};
+use crate::model::input::{AngleUnit, Id, JointInput};
 use crate::model::ModelErrorKind;
 use crate::so3::{self, Mat3, Vec3};
 
 /// Angle below which two axes count as parallel (rad).
 const PARALLEL: f64 = 1e-6;
 
-/// Largest change of a driven angle in one increment: the branch of an
-/// angle is followed only while an increment turns it by less than half a
-/// turn (docs/joints.md §3.3).
-const MAX_TURN_PER_INCREMENT: f64 = std::f64::consts::PI;
-
 impl Builder<'_> {
-    fn unit(&mut self, entity: &str, what: &str, v: [f64; 3]) -> Option<Vec3> {
+    /// `v` normalised; an error naming `what` if it is zero or not finite.
+    pub(super) fn unit(&mut self, entity: &str, what: &str, v: [f64; 3]) -> Option<Vec3> {
         let v = Vec3::from(v);
         let n = v.norm();
         if v.iter().all(|c| c.is_finite()) && n > 0.0 && n.is_finite() {
@@ -40,7 +37,7 @@ impl Builder<'_> {
 }
 
 /// The builder, as the joint functions know it.
-type Context<'b, 'i> = Builder<'i>;
+pub(super) type Context<'b, 'i> = Builder<'i>;
 
 /// A joint as built, for joint springs and drivers to refer to.
 struct Built {
@@ -51,7 +48,7 @@ struct Built {
 
 /// Joints as built, for joint springs and drivers to refer to.
 #[derive(Default)]
-struct Joints {
+pub(super) struct Joints {
     built: HashMap<Id, Built>,
     /// Ids of joints defined with errors (already reported).
     invalid: HashSet<Id>,
@@ -86,14 +83,14 @@ pub(super) fn build(cx: &mut Builder) {
     for s in &input.joint_springs {
         let entity = format!("joint spring {}", s.id);
         let id_ok = cx.claim_id(&entity, s.id);
-        if let (Some(e), true) = (joint_spring(cx, &entity, s, &joints), id_ok) {
+        if let (Some(e), true) = (joint_springs::joint_spring(cx, &entity, s, &joints), id_ok) {
             cx.elements.push(Box::new(e));
         }
     }
     for d in &input.drivers {
         let entity = format!("driver {}", d.id);
         let id_ok = cx.claim_id(&entity, d.id);
-        if let (Some(e), true) = (driver(cx, &entity, d, &joints), id_ok) {
+        if let (Some(e), true) = (drivers::driver(cx, &entity, d, &joints), id_ok) {
             cx.elements.push(Box::new(e));
         }
     }
@@ -101,7 +98,7 @@ pub(super) fn build(cx: &mut Builder) {
 
 /// A triad with `e₃ = axis` and `e₁` along the projection of `reference`
 /// (or any normal direction).
-fn triad(axis: &Vec3, reference: Option<&Vec3>) -> Option<Mat3> {
+pub(super) fn triad(axis: &Vec3, reference: Option<&Vec3>) -> Option<Mat3> {
     let guess = |a: &Vec3| {
         if a.x.abs() < 0.9 {
             Vec3::x()
@@ -427,7 +424,7 @@ fn project_on_polyline(pts: &[Vec3], p: &Vec3) -> f64 {
 }
 
 /// Resolves `coordinate` of joint `joint` into a pair coordinate.
-fn joint_coordinate(
+pub(super) fn joint_coordinate(
     cx: &mut Context,
     entity: &str,
     joint: Id,
@@ -483,7 +480,7 @@ fn joint_coordinate(
 
 /// Radians per unit of the angles of an entry acting on `source`; an error
 /// if a unit is given for a coordinate that is not an angle.
-fn angle_unit(
+pub(super) fn angle_unit(
     cx: &mut Context,
     entity: &str,
     unit: Option<AngleUnit>,
@@ -503,230 +500,5 @@ fn angle_unit(
             None
         }
         u => Some(u.unwrap_or_default().radians()),
-    }
-}
-
-/// A law from a linear coefficient or a table, the coordinate (table
-/// abscissae) scaled by `unit` and the coefficient divided by it.
-#[allow(clippy::too_many_arguments)]
-fn law(
-    cx: &mut Context,
-    entity: &str,
-    what: &str,
-    linear: Option<f64>,
-    x0: f64,
-    table: &[[f64; 2]],
-    unit: f64,
-) -> Result<Option<Law>, ()> {
-    match (linear, table.is_empty()) {
-        (Some(_), false) => {
-            cx.ck.push(
-                ModelErrorKind::Invalid,
-                entity,
-                format!("give either a linear {what} coefficient or a {what} table, not both"),
-            );
-            Err(())
-        }
-        (Some(k), true) => {
-            if !(k.is_finite() && k >= 0.0 && (k / unit).is_finite()) {
-                cx.ck.push(
-                    ModelErrorKind::NonPositive,
-                    entity,
-                    format!("{what} must be zero or positive and finite, got {k}"),
-                );
-                return Err(());
-            }
-            Ok(Some(Law::Linear { k: k / unit, x0 }))
-        }
-        (None, false) => {
-            let points: Vec<(f64, f64)> = table.iter().map(|p| (p[0] * unit, p[1])).collect();
-            if points.len() < 2
-                || points.iter().any(|p| !(p.0.is_finite() && p.1.is_finite()))
-                || points.windows(2).any(|w| {
-                    w[1].0 <= w[0].0
-                        || !(w[1].0 - w[0].0).is_finite()
-                        || !(w[1].1 - w[0].1).is_finite()
-                })
-            {
-                cx.ck.push(ModelErrorKind::Invalid, entity, format!("the {what} table needs at least two finite points with strictly increasing abscissae (and differences between them that do not overflow)"));
-                return Err(());
-            }
-            let l = Law::Table(points);
-            if what == "damping" && l.eval(0.0).0 != 0.0 {
-                cx.ck.push(
-                    ModelErrorKind::Invalid,
-                    entity,
-                    "the damping table must give zero force at zero rate",
-                );
-                return Err(());
-            }
-            Ok(Some(l))
-        }
-        (None, true) => Ok(None),
-    }
-}
-
-fn joint_spring(
-    cx: &mut Context,
-    entity: &str,
-    s: &JointSpringInput,
-    joints: &Joints,
-) -> Option<JointSpring> {
-    let source = joint_coordinate(cx, entity, s.joint, &s.coordinate, joints);
-    let unit = match &source {
-        Some(src) => angle_unit(cx, entity, s.unit, src)?,
-        None => 1.0,
-    };
-    let x0 = s.free_value.unwrap_or(0.0) * unit;
-    if !x0.is_finite() {
-        cx.ck
-            .push(ModelErrorKind::Invalid, entity, "free_value must be finite");
-        return None;
-    }
-    let spring = law(cx, entity, "stiffness", s.stiffness, x0, &s.table, unit);
-    let damper = law(
-        cx,
-        entity,
-        "damping",
-        s.damping,
-        0.0,
-        &s.damping_table,
-        unit,
-    );
-    let (spring, damper) = (spring.ok()?, damper.ok()?);
-    if spring.is_none() && damper.is_none() {
-        cx.ck.push(
-            ModelErrorKind::Missing,
-            entity,
-            "needs a stiffness, a table, a damping or a damping_table",
-        );
-        return None;
-    }
-    Some(JointSpring::new(s.id, source?, spring, damper))
-}
-
-fn driver(cx: &mut Context, entity: &str, d: &DriverInput, joints: &Joints) -> Option<Driver> {
-    let curve = cx.curve(entity, &d.curve, RAMP);
-    if !d.value.is_finite() {
-        cx.ck.push(
-            ModelErrorKind::Invalid,
-            entity,
-            format!("value must be finite, got {}", d.value),
-        );
-        return None;
-    }
-    let source = match (d.joint, d.node) {
-        (Some(j), None) => {
-            if d.direction.is_some() || d.motion.is_some() {
-                cx.ck.push(
-                    ModelErrorKind::Invalid,
-                    entity,
-                    "`direction` and `motion` apply to node drivers, not joint drivers",
-                );
-                return None;
-            }
-            joint_coordinate(cx, entity, j, &d.coordinate, joints)?
-        }
-        (None, Some(n)) => {
-            if d.coordinate.is_some() {
-                cx.ck.push(ModelErrorKind::Invalid, entity, "`coordinate` applies to joint drivers; a node driver takes `direction` and `motion`");
-                return None;
-            }
-            let node = cx.node(entity, n);
-            let Some(dir) = d.direction else {
-                cx.ck.push(
-                    ModelErrorKind::Missing,
-                    entity,
-                    "a node driver needs `direction`",
-                );
-                return None;
-            };
-            let dir = cx.unit(entity, "direction", dir)?;
-            let coordinate = match d.motion.as_deref() {
-                None | Some("translation") => Coordinate::Slide3,
-                Some("rotation") => Coordinate::Angle,
-                Some(m) => {
-                    cx.ck.push(
-                        ModelErrorKind::Invalid,
-                        entity,
-                        format!("motion must be \"translation\" or \"rotation\", got \"{m}\""),
-                    );
-                    return None;
-                }
-            };
-            let node = node?;
-            let (x, r) = (cx.nodes[node].x, so3::matrix(&cx.nodes[node].q));
-            let e = triad(&dir, None).expect("a unit vector has a normal");
-            let pair = Pair::node_to_ground(&x, &r, &e);
-            PairCoordinate {
-                nodes: vec![node],
-                pair,
-                coordinate,
-            }
-        }
-        _ => {
-            cx.ck.push(
-                ModelErrorKind::Invalid,
-                entity,
-                "give either `joint` (and `coordinate`) or `node` (with `direction` and `motion`)",
-            );
-            return None;
-        }
-    };
-    let value = d.value * angle_unit(cx, entity, d.unit, &source)?;
-    let curve = curve?;
-    if !cx
-        .curves
-        .check_range(&mut cx.ck, entity, "value", value.abs(), curve)
-    {
-        return None;
-    }
-    let window = match d.active {
-        None => None,
-        Some([start, end]) if !start.is_nan() && !end.is_nan() && start < end => Some((start, end)),
-        Some(w) => {
-            cx.ck.push(
-                ModelErrorKind::Invalid,
-                entity,
-                format!("active must be [start, end] with start < end, got {w:?}"),
-            );
-            return None;
-        }
-    };
-    if source.is_angle() {
-        warn_fast_angle(cx, entity, d, value, curve);
-    }
-    let driver = Driver::new(d.id, source, value, curve);
-    Some(match window {
-        Some((start, end)) => driver.with_window(start, end),
-        None => driver,
-    })
-}
-
-/// Warns when a driven angle would turn by more than half a turn in one
-/// of the largest increments: the increments are then cut back until they
-/// ask less; a value meant in degrees and read in radians does this.
-fn warn_fast_angle(cx: &mut Context, entity: &str, d: &DriverInput, value: f64, curve: usize) {
-    let s = &cx.settings;
-    if s.arc_length || !(s.max_increment.is_finite() && s.max_increment > 0.0) {
-        return;
-    }
-    let end = cx.curves.end_time;
-    let h = s.max_increment;
-    let change = value.abs() * cx.curves.curves[curve].largest_change(h, end);
-    if change > MAX_TURN_PER_INCREMENT {
-        let hint = if d.unit.is_none() {
-            " If the value is in degrees, write unit = \"deg\"."
-        } else {
-            ""
-        };
-        cx.ck.warn(
-            entity,
-            format!(
-                "asks for {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot follow (docs/joints.md §3.3); increments will be cut back. Lower max_increment to at most {:.3e}.{hint}",
-                change.to_degrees(),
-                h * MAX_TURN_PER_INCREMENT / change
-            ),
-        );
     }
 }

@@ -1,0 +1,146 @@
+//! `[[drivers]]`: prescribed histories of joint coordinates and of node
+//! translations and rotations.
+
+use super::curves::RAMP;
+use super::joints::{angle_unit, joint_coordinate, triad, Context, Joints};
+use crate::joints::types::Coordinate;
+use crate::joints::{Driver, Pair, PairCoordinate};
+use crate::model::input::DriverInput;
+use crate::model::ModelErrorKind;
+use crate::so3;
+
+/// Largest change of a driven angle in one increment: the branch of an
+/// angle is followed only while an increment turns it by less than half a
+/// turn (docs/joints.md §3.3).
+const MAX_TURN_PER_INCREMENT: f64 = std::f64::consts::PI;
+
+pub(super) fn driver(
+    cx: &mut Context,
+    entity: &str,
+    d: &DriverInput,
+    joints: &Joints,
+) -> Option<Driver> {
+    let curve = cx.curve(entity, &d.curve, RAMP);
+    if !d.value.is_finite() {
+        cx.ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!("value must be finite, got {}", d.value),
+        );
+        return None;
+    }
+    let source = match (d.joint, d.node) {
+        (Some(j), None) => {
+            if d.direction.is_some() || d.motion.is_some() {
+                cx.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    "`direction` and `motion` apply to node drivers, not joint drivers",
+                );
+                return None;
+            }
+            joint_coordinate(cx, entity, j, &d.coordinate, joints)?
+        }
+        (None, Some(n)) => {
+            if d.coordinate.is_some() {
+                cx.ck.push(ModelErrorKind::Invalid, entity, "`coordinate` applies to joint drivers; a node driver takes `direction` and `motion`");
+                return None;
+            }
+            let node = cx.node(entity, n);
+            let Some(dir) = d.direction else {
+                cx.ck.push(
+                    ModelErrorKind::Missing,
+                    entity,
+                    "a node driver needs `direction`",
+                );
+                return None;
+            };
+            let dir = cx.unit(entity, "direction", dir)?;
+            let coordinate = match d.motion.as_deref() {
+                None | Some("translation") => Coordinate::Slide3,
+                Some("rotation") => Coordinate::Angle,
+                Some(m) => {
+                    cx.ck.push(
+                        ModelErrorKind::Invalid,
+                        entity,
+                        format!("motion must be \"translation\" or \"rotation\", got \"{m}\""),
+                    );
+                    return None;
+                }
+            };
+            let node = node?;
+            let (x, r) = (cx.nodes[node].x, so3::matrix(&cx.nodes[node].q));
+            let e = triad(&dir, None).expect("a unit vector has a normal");
+            let pair = Pair::node_to_ground(&x, &r, &e);
+            PairCoordinate {
+                nodes: vec![node],
+                pair,
+                coordinate,
+            }
+        }
+        _ => {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                "give either `joint` (and `coordinate`) or `node` (with `direction` and `motion`)",
+            );
+            return None;
+        }
+    };
+    let value = d.value * angle_unit(cx, entity, d.unit, &source)?;
+    let curve = curve?;
+    if !cx
+        .curves
+        .check_range(&mut cx.ck, entity, "value", value.abs(), curve)
+    {
+        return None;
+    }
+    let window = match d.active {
+        None => None,
+        Some([start, end]) if !start.is_nan() && !end.is_nan() && start < end => Some((start, end)),
+        Some(w) => {
+            cx.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("active must be [start, end] with start < end, got {w:?}"),
+            );
+            return None;
+        }
+    };
+    if source.is_angle() {
+        warn_fast_angle(cx, entity, d, value, curve);
+    }
+    let driver = Driver::new(d.id, source, value, curve);
+    Some(match window {
+        Some((start, end)) => driver.with_window(start, end),
+        None => driver,
+    })
+}
+
+/// Warns when a driven angle would turn by more than half a turn in one
+/// of the largest increments: the increments are then cut back until they
+/// ask less; a value meant in degrees and read in radians does this.
+fn warn_fast_angle(cx: &mut Context, entity: &str, d: &DriverInput, value: f64, curve: usize) {
+    let s = &cx.settings;
+    if s.arc_length || !(s.max_increment.is_finite() && s.max_increment > 0.0) {
+        return;
+    }
+    let end = cx.curves.end_time;
+    let h = s.max_increment;
+    let change = value.abs() * cx.curves.curves[curve].largest_change(h, end);
+    if change > MAX_TURN_PER_INCREMENT {
+        let hint = if d.unit.is_none() {
+            " If the value is in degrees, write unit = \"deg\"."
+        } else {
+            ""
+        };
+        cx.ck.warn(
+            entity,
+            format!(
+                "asks for {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot follow (docs/joints.md §3.3); increments will be cut back. Lower max_increment to at most {:.3e}.{hint}",
+                change.to_degrees(),
+                h * MAX_TURN_PER_INCREMENT / change
+            ),
+        );
+    }
+}

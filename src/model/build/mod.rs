@@ -1,0 +1,365 @@
+//! Validation of a [`ModelInput`] and construction of the [`Model`].
+//!
+//! The input is checked in the order of the file's tables; every problem
+//! is collected (none stops the others from being found) and each is
+//! reported once, at the entity where it is written: an invalid curve,
+//! node, section or joint is not reported again by the entities referring
+//! to it. Sizes are checked before anything is allocated (the limits of
+//! docs/model-format.md, "Limits").
+
+use std::collections::{HashMap, HashSet};
+
+mod beams;
+mod checks;
+mod curves;
+mod drivers;
+mod joint_springs;
+mod joints;
+mod loads;
+mod masses;
+mod nodes;
+mod sections;
+mod settings;
+mod springs;
+mod supports;
+
+use super::input::*;
+use super::{
+    Model, ModelError, ModelErrorKind, ModelErrors, ModelWarning, Prescribed, StaticSettings,
+};
+use crate::curves::CurveIndex;
+use crate::elements::beam::BeamSection;
+use crate::elements::{Element, ElementKind};
+use crate::so3::{Rotation, Vec3};
+use beams::BeamSpec;
+use curves::{CurveTable, CONSTANT, RAMP};
+
+/// Most elements one `beam_lines` entry may generate.
+pub const MAX_LINE_ELEMENTS: usize = 100_000;
+
+/// Most nodes and elements of a model, together (given and generated). A
+/// model of this size needs about 2 GB to check (measured: 1.5 GB and 9 s
+/// for 200 000 beams); the largest structures of the field (a deployable
+/// truss of thousands of cells) are far below.
+pub const MAX_MODEL_SIZE: usize = 500_000;
+
+/// Most increments an analysis may need, `end_time / max_increment`.
+pub const MAX_INCREMENTS: f64 = 1e6;
+
+/// Most Newton iterations per increment (`max_iterations`) and
+/// arc-length increments (`max_increments`, as [`MAX_INCREMENTS`]).
+pub const MAX_ITERATIONS: usize = 1000;
+
+/// Smallest `min_increment`, relative to `end_time`: below it an increment
+/// is lost in the round-off of `t`, and cut-backs could go on ~1000 times.
+pub const MIN_RELATIVE_INCREMENT: f64 = 1e-12;
+
+/// Largest force or stiffness an element may give in the reference
+/// configuration: the analysis measures residuals by sums of squares,
+/// which overflow beyond 1.3e154.
+pub const LARGEST_ELEMENT_VALUE: f64 = 1e150;
+
+/// Collects problems and warnings while the model is built.
+#[derive(Default)]
+struct Checker {
+    errors: Vec<ModelError>,
+    warnings: Vec<ModelWarning>,
+}
+
+impl Checker {
+    fn push(
+        &mut self,
+        kind: ModelErrorKind,
+        entity: impl Into<String>,
+        message: impl Into<String>,
+    ) {
+        self.errors.push(ModelError {
+            kind,
+            entity: entity.into(),
+            message: message.into(),
+        });
+    }
+
+    fn warn(&mut self, entity: impl Into<String>, message: impl Into<String>) {
+        self.warnings.push(ModelWarning {
+            entity: entity.into(),
+            message: message.into(),
+        });
+    }
+
+    /// Checks that every value is finite.
+    fn finite(&mut self, entity: &str, what: &str, values: &[f64]) -> bool {
+        if values.iter().all(|v| v.is_finite()) {
+            true
+        } else {
+            self.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("{what} must be finite, got {values:?}"),
+            );
+            false
+        }
+    }
+
+    /// Checks that a value is finite and strictly positive.
+    fn positive(&mut self, entity: &str, what: &str, value: f64) -> bool {
+        if value.is_finite() && value > 0.0 {
+            true
+        } else {
+            self.push(
+                ModelErrorKind::NonPositive,
+                entity,
+                format!("{what} must be positive, got {}", num(value)),
+            );
+            false
+        }
+    }
+}
+
+/// A number for messages: as written for ordinary magnitudes, in
+/// exponent form for very large and very small ones (`1e-308`, not 308
+/// zeros).
+fn num(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// A node being built: reference position and orientation.
+struct NodeData {
+    x: Vec3,
+    q: Rotation,
+}
+
+/// The model being built: everything resolved so far.
+struct Builder<'i> {
+    input: &'i ModelInput,
+    ck: Checker,
+    settings: StaticSettings,
+    curves: CurveTable,
+    node_ids: Vec<Id>,
+    nodes: Vec<NodeData>,
+    node_index: HashMap<Id, usize>,
+    /// Ids of nodes defined with errors (already reported).
+    invalid_nodes: HashSet<Id>,
+    sections: HashMap<String, BeamSection>,
+    /// Names of sections defined with errors (already reported).
+    invalid_sections: HashSet<String>,
+    element_ids: HashSet<Id>,
+    elements: Vec<Box<dyn Element>>,
+    beam_specs: Vec<BeamSpec>,
+    fixed: Vec<[bool; 6]>,
+    prescribed: Vec<Prescribed>,
+}
+
+impl Builder<'_> {
+    /// Index of node `id`; an error naming `entity` if it does not exist
+    /// (unless its own definition was invalid and reported).
+    fn node(&mut self, entity: &str, id: Id) -> Option<usize> {
+        let found = self.node_index.get(&id).copied();
+        if found.is_none() && !self.invalid_nodes.contains(&id) {
+            self.ck.push(
+                ModelErrorKind::UnknownNode,
+                entity,
+                format!("node {id} does not exist"),
+            );
+        }
+        found
+    }
+
+    /// Claims an element id: false (and an error) if it is taken or too
+    /// large.
+    fn claim_id(&mut self, entity: &str, id: Id) -> bool {
+        if id > MAX_ID {
+            self.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("id {id} is larger than {MAX_ID}, the largest a model file can hold"),
+            );
+            false
+        } else if self.element_ids.insert(id) {
+            true
+        } else {
+            self.ck
+                .push(ModelErrorKind::DuplicateId, entity, "duplicate element id");
+            false
+        }
+    }
+
+    /// The curve followed by `entity`.
+    fn curve(
+        &mut self,
+        entity: &str,
+        name: &Option<String>,
+        default: CurveIndex,
+    ) -> Option<CurveIndex> {
+        self.curves.resolve(&mut self.ck, entity, name, default)
+    }
+
+    /// Default curve of loads and gravity: the ramp in statics (the load
+    /// factor), the constant in a kinematic analysis, whose motion the
+    /// drivers set and whose loads are those of the real, fully loaded
+    /// mechanism at every instant.
+    fn load_default(&self) -> CurveIndex {
+        if self.settings.kinematic {
+            CONSTANT
+        } else {
+            RAMP
+        }
+    }
+}
+
+/// The size of the model the input describes, nodes and elements given and
+/// generated (by the lines within [`MAX_LINE_ELEMENTS`]: the others are
+/// reported and not generated).
+fn model_size(input: &ModelInput) -> usize {
+    let generated: usize = input
+        .beam_lines
+        .iter()
+        .filter(|l| l.elements <= MAX_LINE_ELEMENTS)
+        .map(|l| 2 * l.elements)
+        .sum();
+    [
+        input.nodes.len(),
+        input.beams.len(),
+        input.rigid_bodies.len(),
+        input.point_masses.len(),
+        input.springs.len(),
+        input.loads.len(),
+        input.joints.len(),
+        input.joint_springs.len(),
+        input.drivers.len(),
+        generated,
+    ]
+    .into_iter()
+    .fold(0usize, usize::saturating_add)
+}
+
+impl Model {
+    /// Validates `input` and builds the model. On failure returns every
+    /// problem found.
+    pub fn from_input(input: &ModelInput) -> Result<Model, ModelErrors> {
+        let mut ck = Checker::default();
+        let settings = settings::settings(&mut ck, &input.analysis);
+        let curves = CurveTable::build(&mut ck, &input.curves, settings.end_time);
+        let mut b = Builder {
+            input,
+            ck,
+            settings,
+            curves,
+            node_ids: Vec::new(),
+            nodes: Vec::new(),
+            node_index: HashMap::new(),
+            invalid_nodes: HashSet::new(),
+            sections: HashMap::new(),
+            invalid_sections: HashSet::new(),
+            element_ids: HashSet::new(),
+            elements: Vec::new(),
+            beam_specs: Vec::new(),
+            fixed: Vec::new(),
+            prescribed: Vec::new(),
+        };
+        let size = model_size(input);
+        let mesh = size <= MAX_MODEL_SIZE;
+        if !mesh {
+            b.ck.push(
+                ModelErrorKind::Invalid,
+                "model",
+                format!(
+                    "has {size} nodes and elements (given and generated by beam_lines), more than the limit of {MAX_MODEL_SIZE}"
+                ),
+            );
+        }
+        b.nodes();
+        b.sections();
+        b.beams();
+        b.beam_lines(mesh);
+        b.build_beams();
+        b.masses();
+        b.springs();
+        b.loads();
+        joints::build(&mut b);
+        let gravity = b.gravity();
+        b.supports();
+        b.prescribed();
+
+        // ---------- global checks ----------
+        let Builder {
+            mut ck,
+            settings,
+            curves,
+            node_ids,
+            nodes,
+            node_index,
+            mut elements,
+            fixed,
+            prescribed,
+            ..
+        } = b;
+        if ck.errors.is_empty() {
+            if elements.iter().all(|e| e.kind() == ElementKind::NodalLoad) {
+                ck.push(ModelErrorKind::Missing, "model", "has no elements");
+            } else {
+                checks::check_restraint(&mut ck, &node_ids, &elements, &fixed);
+            }
+        }
+        if !ck.errors.is_empty() {
+            return Err(ModelErrors(ck.errors));
+        }
+
+        let length_scale = {
+            let mut lo = Vec3::repeat(f64::INFINITY);
+            let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+            for n in &nodes {
+                lo = lo.inf(&n.x);
+                hi = hi.sup(&n.x);
+            }
+            let d = (hi - lo).norm();
+            if d > 0.0 && d.is_finite() {
+                d
+            } else {
+                1.0
+            }
+        };
+        let (mut extra, mut internal) = (0, 0);
+        for e in &mut elements {
+            e.set_offsets(extra, internal);
+            extra += e.n_extra();
+            internal += e.n_internal();
+        }
+        let model = Model {
+            title: input.title.clone().unwrap_or_default(),
+            node_ids,
+            node_lookup: node_index,
+            element_lookup: elements
+                .iter()
+                .enumerate()
+                .map(|(i, e)| ((e.kind(), e.id()), i))
+                .collect(),
+            reference_x: nodes.iter().map(|n| n.x).collect(),
+            reference_q: nodes.iter().map(|n| n.q).collect(),
+            elements,
+            fixed,
+            prescribed,
+            curves: curves.curves,
+            curve_uses: curves.uses,
+            warnings: ck.warnings,
+            gravity,
+            settings,
+            length_scale,
+            scaling: Default::default(),
+        }
+        .with_default_scaling(
+            input.analysis.constraint_scale,
+            input.analysis.constraint_penalty,
+        );
+        let errors = checks::non_finite_elements(&model);
+        if !errors.is_empty() {
+            return Err(ModelErrors(errors));
+        }
+        Ok(model)
+    }
+}

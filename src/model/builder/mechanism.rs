@@ -1,0 +1,329 @@
+//! Joints, joint springs and dampers, drivers (docs/joints.md).
+
+use super::{Body, CurveHandle, Entity, ModelBuilder};
+use crate::joints::{Coordinate, JointType};
+use crate::model::handles::{DriverHandle, JointHandle, JointSpringHandle, NodeHandle};
+use crate::model::input::{AngleUnit, DriverInput, JointInput, JointSpringInput};
+use crate::model::Id;
+
+/// A kinematic pair between node A and node B, or between node A and the
+/// [`super::Ground`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    input: JointInput,
+    id: Option<Id>,
+}
+
+impl Joint {
+    /// A joint of type `kind` between `a` and `b` (a node or the ground).
+    pub fn new(kind: JointType, a: NodeHandle, b: impl Into<Body>) -> Self {
+        Self {
+            input: JointInput {
+                kind,
+                nodes: b.into().with_first(a),
+                ..JointInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// A hinge: rotation about [`Joint::axis`] only.
+    pub fn revolute(a: NodeHandle, b: impl Into<Body>) -> Self {
+        Self::new(JointType::Revolute, a, b)
+    }
+
+    /// Sliding along [`Joint::axis`] only.
+    pub fn prismatic(a: NodeHandle, b: impl Into<Body>) -> Self {
+        Self::new(JointType::Prismatic, a, b)
+    }
+
+    /// Rotation about and sliding along [`Joint::axis`].
+    pub fn cylindrical(a: NodeHandle, b: impl Into<Body>) -> Self {
+        Self::new(JointType::Cylindrical, a, b)
+    }
+
+    /// A ball joint: the joint point is common, rotations are free.
+    pub fn spherical(a: NodeHandle, b: impl Into<Body>) -> Self {
+        Self::new(JointType::Spherical, a, b)
+    }
+
+    /// Motion in the plane normal to [`Joint::axis`].
+    pub fn planar(a: NodeHandle, b: impl Into<Body>) -> Self {
+        Self::new(JointType::Planar, a, b)
+    }
+
+    /// A Cardan joint of cross arms `arm_a` (carried by A) and `arm_b`
+    /// (carried by B), perpendicular.
+    pub fn universal(
+        a: NodeHandle,
+        b: impl Into<Body>,
+        arm_a: impl Into<[f64; 3]>,
+        arm_b: impl Into<[f64; 3]>,
+    ) -> Self {
+        Self::new(JointType::Universal, a, b)
+            .axis(arm_a)
+            .axis_b(arm_b)
+    }
+
+    /// A screw about [`Joint::axis`] advancing `pitch` per turn (signed).
+    pub fn helical(a: NodeHandle, b: impl Into<Body>, pitch: f64) -> Self {
+        let mut j = Self::new(JointType::Helical, a, b);
+        j.input.pitch = Some(pitch);
+        j
+    }
+
+    /// A rigid connection of two nodes at the joint point.
+    pub fn rigid(a: NodeHandle, b: NodeHandle) -> Self {
+        Self::new(JointType::Rigid, a, b)
+    }
+
+    /// Node B held where it is in A's material frame (see
+    /// [`Joint::offset`], [`Joint::lock_rotations`]).
+    pub fn glue(a: NodeHandle, b: NodeHandle) -> Self {
+        Self::new(JointType::Glue, a, b)
+    }
+
+    /// `node` sliding on the C¹ spline through the nodes of `curve` (see
+    /// [`Joint::polyline`]).
+    pub fn slider(node: NodeHandle, curve: &[NodeHandle]) -> Self {
+        let mut j = Self::new(JointType::Slider, node, super::Ground);
+        j.input.curve = curve.iter().map(|n| n.0).collect();
+        j
+    }
+
+    /// The joint axis `e₃` (hinge, sliding or screw axis; normal of a
+    /// planar joint), reference configuration.
+    pub fn axis(mut self, axis: impl Into<[f64; 3]>) -> Self {
+        self.input.axis = Some(axis.into());
+        self
+    }
+
+    /// The same axis as carried by body B, which must coincide with
+    /// [`Joint::axis`] (a universal joint: B's cross arm).
+    pub fn axis_b(mut self, axis: impl Into<[f64; 3]>) -> Self {
+        self.input.axis_b = Some(axis.into());
+        self
+    }
+
+    /// The direction from which its angles are measured (`e₁`).
+    pub fn reference_direction(mut self, direction: impl Into<[f64; 3]>) -> Self {
+        self.input.reference_direction = Some(direction.into());
+        self
+    }
+
+    /// The joint point (default: node A's position).
+    pub fn at(mut self, point: impl Into<[f64; 3]>) -> Self {
+        self.input.position = Some(point.into());
+        self
+    }
+
+    /// Glue: where B is held, in A's material frame (default: where B is).
+    pub fn offset(mut self, offset: impl Into<[f64; 3]>) -> Self {
+        self.input.offset = Some(offset.into());
+        self
+    }
+
+    /// Glue: whether B's rotations are locked to A's too (default true).
+    pub fn lock_rotations(mut self, lock: bool) -> Self {
+        self.input.lock_rotations = Some(lock);
+        self
+    }
+
+    /// Slider: a polyline through the curve nodes instead of a spline.
+    pub fn polyline(mut self) -> Self {
+        self.input.spline = Some(false);
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for Joint {
+    type Handle = JointHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> JointHandle {
+        self.input.id = m.element_id(self.id, 1);
+        let handle = JointHandle(self.input.id);
+        m.input.joints.push(self.input);
+        handle
+    }
+}
+
+/// A spring and/or a damper on a joint coordinate: linear (a stiffness,
+/// a damping coefficient) or tabulated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointSpring {
+    input: JointSpringInput,
+    id: Option<Id>,
+}
+
+impl JointSpring {
+    /// On the first coordinate of `joint` (see [`JointSpring::coordinate`]).
+    pub fn on(joint: JointHandle) -> Self {
+        Self {
+            input: JointSpringInput {
+                joint: joint.0,
+                ..JointSpringInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// The joint coordinate it acts on.
+    pub fn coordinate(mut self, coordinate: Coordinate) -> Self {
+        self.input.coordinate = Some(coordinate.name().into());
+        self
+    }
+
+    /// The unit of the angles (free value, table abscissae, stiffness and
+    /// damping per unit) when the coordinate is an angle.
+    pub fn unit(mut self, unit: AngleUnit) -> Self {
+        self.input.unit = Some(unit);
+        self
+    }
+
+    /// A linear spring of stiffness `k` (N/m, or N·m per angle unit).
+    pub fn stiffness(mut self, k: f64) -> Self {
+        self.input.stiffness = Some(k);
+        self
+    }
+
+    /// The coordinate at which the linear spring is unloaded (default 0).
+    pub fn free_value(mut self, value: f64) -> Self {
+        self.input.free_value = Some(value);
+        self
+    }
+
+    /// A nonlinear spring: points `[coordinate, force]`.
+    pub fn table(mut self, points: impl Into<Vec<[f64; 2]>>) -> Self {
+        self.input.table = points.into();
+        self
+    }
+
+    /// A linear damper of coefficient `c`.
+    pub fn damping(mut self, c: f64) -> Self {
+        self.input.damping = Some(c);
+        self
+    }
+
+    /// A nonlinear damper: points `[rate, force]`.
+    pub fn damping_table(mut self, points: impl Into<Vec<[f64; 2]>>) -> Self {
+        self.input.damping_table = points.into();
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for JointSpring {
+    type Handle = JointSpringHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> JointSpringHandle {
+        self.input.id = m.element_id(self.id, 1);
+        let handle = JointSpringHandle(self.input.id);
+        m.input.joint_springs.push(self.input);
+        handle
+    }
+}
+
+/// A prescribed history `value · f(t)` of a joint coordinate, or of a
+/// node's translation along or rotation about a direction, relative to
+/// the reference configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Driver {
+    input: DriverInput,
+    curve: Option<CurveHandle>,
+    id: Option<Id>,
+}
+
+impl Driver {
+    fn new(input: DriverInput) -> Self {
+        Self {
+            input,
+            curve: None,
+            id: None,
+        }
+    }
+
+    /// Drives the first coordinate of `joint` (see [`Driver::coordinate`]).
+    pub fn on(joint: JointHandle) -> Self {
+        Self::new(DriverInput {
+            joint: Some(joint.0),
+            ..DriverInput::default()
+        })
+    }
+
+    /// Drives the translation of `node` along `direction` (global).
+    pub fn translation(node: NodeHandle, direction: impl Into<[f64; 3]>) -> Self {
+        Self::new(DriverInput {
+            node: Some(node.0),
+            direction: Some(direction.into()),
+            ..DriverInput::default()
+        })
+    }
+
+    /// Drives the rotation of `node` about `axis` (global).
+    pub fn rotation(node: NodeHandle, axis: impl Into<[f64; 3]>) -> Self {
+        Self::new(DriverInput {
+            node: Some(node.0),
+            direction: Some(axis.into()),
+            motion: Some("rotation".into()),
+            ..DriverInput::default()
+        })
+    }
+
+    /// The joint coordinate driven.
+    pub fn coordinate(mut self, coordinate: Coordinate) -> Self {
+        self.input.coordinate = Some(coordinate.name().into());
+        self
+    }
+
+    /// The coordinate's value when the curve equals 1 (m, or rad).
+    pub fn value(mut self, value: f64) -> Self {
+        self.input.value = value;
+        self
+    }
+
+    /// An angle's value when the curve equals 1, in `unit`.
+    pub fn angle(mut self, value: f64, unit: AngleUnit) -> Self {
+        self.input.value = value;
+        self.input.unit = Some(unit);
+        self
+    }
+
+    /// The curve `f(t)` (default the ramp).
+    pub fn curve(mut self, curve: CurveHandle) -> Self {
+        self.curve = Some(curve);
+        self
+    }
+
+    /// Acts only while `start ≤ t ≤ end` (`end` may be infinite), released
+    /// outside.
+    pub fn active(mut self, start: f64, end: f64) -> Self {
+        self.input.active = Some([start, end]);
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for Driver {
+    type Handle = DriverHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> DriverHandle {
+        self.input.id = m.element_id(self.id, 1);
+        self.input.curve = self.curve.map(|c| m.curve_name(c));
+        let handle = DriverHandle(self.input.id);
+        m.input.drivers.push(self.input);
+        handle
+    }
+}

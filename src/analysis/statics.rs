@@ -91,6 +91,9 @@ pub struct StaticOutcome {
     pub wasted_iterations: usize,
     /// Number of cut-backs.
     pub cutbacks: usize,
+    /// Translation corrections (docs/theory.md §7.2): one more assembly and
+    /// factorisation each, besides the iterations.
+    pub translation_corrections: usize,
     /// Constraint equations removed as redundant (docs/joints.md §5).
     pub redundant_constraints: usize,
     /// Load parameter reached.
@@ -128,6 +131,13 @@ impl<'m> StaticAnalysis<'m> {
 
     /// Runs from the reference configuration to `end_time`.
     pub fn run(&mut self, observer: &mut dyn Observer) -> StaticOutcome {
+        let mut outcome = self.run_increments(observer);
+        outcome.translation_corrections = self.solver.translation_corrections();
+        outcome
+    }
+
+    /// The analysis proper (see [`StaticAnalysis::run`]).
+    fn run_increments(&mut self, observer: &mut dyn Observer) -> StaticOutcome {
         let start = Instant::now();
         let model = self.model;
         let s = &model.settings;
@@ -139,6 +149,7 @@ impl<'m> StaticAnalysis<'m> {
             iterations: 0,
             wasted_iterations: 0,
             cutbacks: 0,
+            translation_corrections: 0,
             redundant_constraints: 0,
             time: 0.0,
             wall_time: 0.0,
@@ -203,6 +214,9 @@ impl<'m> StaticAnalysis<'m> {
         let mut t = 0.0;
         let mut dt = s.initial_increment;
         let mut backup = state.clone();
+        // the converged state before the last one, and the step between
+        // them, for the predictor
+        let mut previous: Option<(State, f64)> = None;
 
         let mut increment = 1;
         while t < s.end_time {
@@ -215,6 +229,11 @@ impl<'m> StaticAnalysis<'m> {
             backup.clone_from(&state);
             state.time = t_new;
             model.apply_prescribed(&mut state, t_new);
+            // predictor: each node continues its last increment
+            if let Some((p, last_step)) = &previous {
+                self.solver
+                    .predict(model, &mut state, p, step / last_step, t_new);
+            }
             match self
                 .solver
                 .solve(model, s, &mut state, t_new, increment, observer)
@@ -254,6 +273,13 @@ impl<'m> StaticAnalysis<'m> {
                     }
                     if r.iterations <= EASY_ITERATIONS {
                         dt = (dt * GROWTH).min(s.max_increment);
+                    }
+                    match &mut previous {
+                        Some((p, last_step)) => {
+                            p.clone_from(&backup);
+                            *last_step = step;
+                        }
+                        None => previous = Some((backup.clone(), step)),
                     }
                     increment += 1;
                 }

@@ -111,6 +111,13 @@ const FLOOR_FACTOR: f64 = 4.0;
 /// nodes by less than ~1e-12 of their positions and element lengths.
 const PLATEAU_FACTOR: f64 = 1024.0;
 
+/// Arc-length iterations of one increment whose constraint may have no
+/// real root (each then takes the increment of closest approach) before the
+/// increment is cut back. On the deep arch and Lee's frame the increments
+/// that converge need at most 2; those that need more go on doing so until
+/// the iteration limit.
+const MAX_CLOSEST_APPROACHES: usize = 3;
+
 /// The work `|r·Δq|` of an iteration grown by this factor over that of the
 /// first iteration is divergence: a residual grown 1e8 times, with a
 /// correction grown as much. (The first corrections of a stiff beam may
@@ -176,6 +183,13 @@ pub enum NewtonFailure {
         /// "c" (NaN at t = 0.5)`, `in the solution of the linear system`.
         origin: String,
     },
+    /// Arc-length control: the increment turned back along the path it
+    /// came from (it would retrace it).
+    #[error("arc-length increment turning back along the path at iteration {iteration}")]
+    PathReversed {
+        /// Iteration.
+        iteration: usize,
+    },
     /// Arc-length control: the constraint on the arc length has no real
     /// root (the arc is too long for the curvature of the path).
     #[error("arc-length constraint without a real root at iteration {iteration}")]
@@ -200,7 +214,8 @@ impl NewtonFailure {
             Self::MaxIterations { iterations, .. } => *iterations,
             Self::Diverging { iteration, .. }
             | Self::NonFinite { iteration, .. }
-            | Self::NoArcRoot { iteration } => *iteration,
+            | Self::NoArcRoot { iteration }
+            | Self::PathReversed { iteration } => *iteration,
             Self::Singular { .. } => 0,
         }
     }
@@ -248,6 +263,8 @@ pub struct NewtonSolver {
     /// Whether the last assembly is at the current state and time (and may
     /// be used by the next assessment instead of assembling again).
     fresh: bool,
+    /// Weight of translations in the arc-length norm (rotations: 1).
+    translation_weight: f64,
     /// Whether `step` holds a predictor's motion for the next solve.
     predicted: bool,
     /// Work space of the size of `rhs`.
@@ -257,6 +274,8 @@ pub struct NewtonSolver {
     translation_corrections: bool,
     /// Translation corrections made so far.
     translation_count: usize,
+    /// Arc-length iterations without a real root so far.
+    closest_approach_count: usize,
     /// Whether a tangent has been factored and solved once: until then a
     /// solve always makes one correction, even from equilibrium, so that a
     /// singular model (a mechanism) is caught at the start.
@@ -297,9 +316,11 @@ impl NewtonSolver {
             held_entries: None,
             predicted: false,
             fresh: false,
+            translation_weight: 1.0,
             work: vec![0.0; n],
             translation_corrections: true,
             translation_count: 0,
+            closest_approach_count: 0,
             tangent_checked: false,
             extra_kinds,
             redundant: Vec::new(),
@@ -367,6 +388,12 @@ impl NewtonSolver {
     /// more assembly and factorisation.
     pub fn translation_corrections(&self) -> usize {
         self.translation_count
+    }
+
+    /// Arc-length iterations so far whose constraint had no real root
+    /// (docs/theory.md §9).
+    pub fn closest_approaches(&self) -> usize {
+        self.closest_approach_count
     }
 
     /// Number of stored entries of the system matrix.
@@ -929,12 +956,17 @@ impl NewtonSolver {
         }
     }
 
-    /// Weights of the arc-length norm, by equation: `1/L` for
-    /// translations, 1 for rotations, 0 for extra unknowns.
-    fn arc_weights(&self, length: f64) -> Vec<f64> {
+    /// Weights of the arc-length norm, by equation (docs/theory.md §9):
+    /// `w_x` for translations, 1 for rotations, 0 for extra unknowns, with
+    /// `w_x = ‖q_t,θ‖/‖q_t,x‖` from the first tangent predictor (set by
+    /// [`NewtonSolver::tangent_arc`]; 1 before it or if either part is
+    /// zero), so that translations and rotations weigh alike in the first
+    /// increment, whatever the units, the extent of the model or the
+    /// stiffness of its parts.
+    fn arc_weights(&self) -> Vec<f64> {
         (0..self.dofs.n_equations())
             .map(|eq| match self.dofs.kind(self.dofs.dof(eq)) {
-                DofKind::Translation => 1.0 / length,
+                DofKind::Translation => self.translation_weight,
                 DofKind::Rotation => 1.0,
                 DofKind::Extra => 0.0,
             })
@@ -972,13 +1004,27 @@ impl NewtonSolver {
         let n = self.dofs.n_equations();
         let mut qt = vec![0.0; n];
         self.load_derivative(model, state, t, &mut Vec::new(), &mut qt);
-        let w = self.arc_weights(model.length_scale);
         self.rhs.iter_mut().zip(&qt).for_each(|(r, q)| *r = -q);
         let ok = self.analyze().is_ok()
             && self.lu.as_mut().is_some_and(|lu| {
                 lu.factor(&self.assembler.matrix).is_ok()
                     && lu.solve_in_place(&mut self.rhs).is_ok()
             });
+        // translations weighted to balance rotations in this predictor
+        let (mut nx, mut nth) = (0.0f64, 0.0f64);
+        for (eq, v) in self.rhs.iter().enumerate() {
+            match self.dofs.kind(self.dofs.dof(eq)) {
+                DofKind::Translation => nx += v * v,
+                DofKind::Rotation => nth += v * v,
+                DofKind::Extra => {}
+            }
+        }
+        self.translation_weight = if ok && nx > 0.0 && nth > 0.0 && (nth / nx).is_finite() {
+            (nth / nx).sqrt()
+        } else {
+            1.0
+        };
+        let w = self.arc_weights();
         let norm: f64 = self
             .rhs
             .iter()
@@ -997,8 +1043,8 @@ impl NewtonSolver {
     /// (docs/theory.md §9): the load parameter `t` is an unknown and the
     /// increment `Δq` from the last converged state keeps the weighted
     /// length `‖Δq‖ = arc`. `direction` is the previous increment (by
-    /// equation, weighted), used to choose the predictor's sign and the
-    /// root of the constraint; it is replaced by this increment.
+    /// equation), which sets the predictor's sign and the root of the
+    /// constraint; it is replaced by this increment.
     #[allow(clippy::too_many_arguments)]
     pub fn solve_arc(
         &mut self,
@@ -1012,7 +1058,7 @@ impl NewtonSolver {
         observer: &mut dyn Observer,
     ) -> Result<NewtonResult, NewtonFailure> {
         let n = self.dofs.n_equations();
-        let w = self.arc_weights(model.length_scale);
+        let w = self.arc_weights();
         let wdot = |a: &[f64], b: &[f64]| -> f64 {
             a.iter()
                 .zip(b)
@@ -1021,15 +1067,17 @@ impl NewtonSolver {
                 .sum()
         };
         self.step.fill(0.0);
+        self.fresh = false;
         let mut qt = vec![0.0; n];
         let mut qt_sol = vec![0.0; n];
         let mut r0 = Vec::new();
         let mut progress = Progress::default();
-        self.fresh = false;
         if direction.len() != n {
             direction.clear();
             direction.resize(n, 0.0);
         }
+        // the previous increment, if any, tells forward from backward
+        let has_direction = wdot(direction, direction) > 0.0;
         for iteration in 0..=settings.max_iterations {
             // the predictor (iteration 0) is never a converged state
             let may_converge = iteration > 0;
@@ -1044,6 +1092,10 @@ impl NewtonSolver {
                 may_converge,
                 observer,
             )? {
+                // an increment that turned back retraces the path
+                if has_direction && wdot(&self.step, direction) < 0.0 {
+                    return Err(NewtonFailure::PathReversed { iteration });
+                }
                 direction.copy_from_slice(&self.step);
                 return Ok(NewtonResult {
                     iterations: iteration,
@@ -1088,24 +1140,46 @@ impl NewtonSolver {
                     wdot(&self.step, &self.rhs),
                     wdot(&self.rhs, &self.rhs),
                 );
-                let (dt_, rt, bb) = (
+                let (dq_t, qr_t, bb) = (
                     wdot(&self.step, &qt_sol),
                     wdot(&self.rhs, &qt_sol),
                     wdot(&qt_sol, &qt_sol),
                 );
-                let (aa, ab) = (dd + 2.0 * dr + rr, dt_ + rt);
-                let disc = ab * ab - bb * (aa - arc * arc);
-                if disc < 0.0 || bb == 0.0 {
+                if !(bb > 0.0 && bb.is_finite()) {
                     return Err(NewtonFailure::NoArcRoot { iteration });
                 }
-                let roots = [(-ab + disc.sqrt()) / bb, (-ab - disc.sqrt()) / bb];
-                // the root whose increment stays closest to the current one:
-                // largest (a + δt q_t)·Δq
-                let score = |r: f64| dd + dr + r * dt_;
-                if score(roots[0]) >= score(roots[1]) {
-                    roots[0]
+                let (aa, ab) = (dd + 2.0 * dr + rr, dq_t + qr_t);
+                let disc = ab * ab - bb * (aa - arc * arc);
+                if disc < 0.0 {
+                    // no real root (the correction of the residual reaches
+                    // out of the cylinder, typically the stretching of
+                    // stiff members after a turn): the increment of closest
+                    // approach, minimising ‖a + δt q_t‖; later iterations
+                    // come back to the arc
+                    progress.closest_approaches += 1;
+                    self.closest_approach_count += 1;
+                    if progress.closest_approaches > MAX_CLOSEST_APPROACHES {
+                        return Err(NewtonFailure::NoArcRoot { iteration });
+                    }
+                    -ab / bb
                 } else {
-                    roots[1]
+                    let roots = [(-ab + disc.sqrt()) / bb, (-ab - disc.sqrt()) / bb];
+                    // the root whose increment goes on along the path:
+                    // largest (a + δt q_t)·d, with d the previous increment
+                    // (the current one in the first increment)
+                    let (along, along_t) = if has_direction {
+                        (
+                            wdot(&self.step, direction) + wdot(&self.rhs, direction),
+                            wdot(&qt_sol, direction),
+                        )
+                    } else {
+                        (dd + dr, dq_t)
+                    };
+                    if along + roots[0] * along_t >= along + roots[1] * along_t {
+                        roots[0]
+                    } else {
+                        roots[1]
+                    }
                 }
             };
             for (r, q) in self.rhs.iter_mut().zip(&qt_sol) {
@@ -1310,6 +1384,8 @@ struct Progress {
     residuals: Vec<f64>,
     /// `(max|Δx|, max|ΔΘ|)` of the last correction.
     last_correction: Option<(f64, f64)>,
+    /// Arc-length iterations whose constraint had no real root.
+    closest_approaches: usize,
     /// Work `|r·Δq|` of the first iteration (divergence reference).
     first_work: Option<f64>,
 }

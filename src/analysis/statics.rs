@@ -94,6 +94,9 @@ pub struct StaticOutcome {
     /// Translation corrections (docs/theory.md §7.2): one more assembly and
     /// factorisation each, besides the iterations.
     pub translation_corrections: usize,
+    /// Arc-length iterations whose constraint had no real root and took
+    /// the increment of closest approach (docs/theory.md §9).
+    pub closest_approaches: usize,
     /// Constraint equations removed as redundant (docs/joints.md §5).
     pub redundant_constraints: usize,
     /// Load parameter reached.
@@ -133,6 +136,7 @@ impl<'m> StaticAnalysis<'m> {
     pub fn run(&mut self, observer: &mut dyn Observer) -> StaticOutcome {
         let mut outcome = self.run_increments(observer);
         outcome.translation_corrections = self.solver.translation_corrections();
+        outcome.closest_approaches = self.solver.closest_approaches();
         outcome
     }
 
@@ -150,6 +154,7 @@ impl<'m> StaticAnalysis<'m> {
             wasted_iterations: 0,
             cutbacks: 0,
             translation_corrections: 0,
+            closest_approaches: 0,
             redundant_constraints: 0,
             time: 0.0,
             wall_time: 0.0,
@@ -343,7 +348,7 @@ impl<'m> StaticAnalysis<'m> {
         while increment <= s.max_increments {
             backup.clone_from(state);
             let (t_start, dir_backup) = (t, direction.clone());
-            match self.solver.solve_arc(
+            let mut result = self.solver.solve_arc(
                 model,
                 s,
                 state,
@@ -352,27 +357,35 @@ impl<'m> StaticAnalysis<'m> {
                 &mut direction,
                 increment,
                 observer,
-            ) {
-                Ok(mut r) => {
-                    let mut step = t - t_start;
-                    if t >= s.end_time {
-                        // land on end_time with a load-controlled increment
-                        let mut landed = backup.clone();
-                        landed.time = s.end_time;
-                        if let Ok(r2) = self.solver.solve(
-                            model,
-                            s,
-                            &mut landed,
-                            s.end_time,
-                            increment,
-                            observer,
-                        ) {
+            );
+            if result.is_ok() && t >= s.end_time {
+                // land on end_time with a load-controlled increment, from the
+                // start of the increment or else from the arc's end; if
+                // neither converges the arc is cut back like a failure
+                let arc_end = state.clone();
+                for start in [&backup, &arc_end] {
+                    let mut landed = start.clone();
+                    landed.time = s.end_time;
+                    let solved =
+                        self.solver
+                            .solve(model, s, &mut landed, s.end_time, increment, observer);
+                    match solved {
+                        Ok(r) => {
                             *state = landed;
                             t = s.end_time;
-                            step = t - t_start;
-                            r = r2;
+                            result = Ok(r);
+                            break;
+                        }
+                        Err(f) => {
+                            outcome.wasted_iterations += f.iterations_spent();
+                            result = Err(f);
                         }
                     }
+                }
+            }
+            match result {
+                Ok(r) => {
+                    let step = t - t_start;
                     model.update_internal(state);
                     outcome.increments += 1;
                     outcome.iterations += r.iterations;

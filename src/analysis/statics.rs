@@ -4,7 +4,9 @@
 //! 1. Equilibrium at `t = 0` (pretension, loads whose curves start at a
 //!    non-zero value): increment 0.
 //! 2. Each increment moves `t` by `Δt`, sets prescribed motions to their
-//!    values at the new `t`, and iterates to equilibrium.
+//!    values at the new `t`, moves the free unknowns by the predictor (each
+//!    node continues the motion of the last increment, docs/theory.md
+//!    §7.3) and iterates to equilibrium.
 //! 3. A failed increment (no convergence, divergence, singular tangent) is
 //!    restarted from the last converged state with `Δt/2`; the analysis
 //!    stops when `Δt` would fall below `min_increment`.

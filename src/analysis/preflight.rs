@@ -23,15 +23,8 @@ use crate::dofs::DofKind;
 use crate::linalg::{smallest_relative_pivot, SparseLu};
 use crate::model::Model;
 
-/// A relative pivot below this marks the tangent as singular: the value of
-/// the Newton solver (`analysis::newton`), which reports the same failure
-/// when the first correction of a run meets it.
-const SINGULAR_PIVOT: f64 = 1e-11;
-
-/// Corrections larger than this (times the model size for translations,
-/// in radians for rotations) mean the tangent is singular or nearly so:
-/// the value of the Newton solver.
-const RUNAWAY_CORRECTION: f64 = 1e6;
+// the Newton solver's thresholds: a check reports what a run would
+use super::newton::{non_finite_origin, RUNAWAY_CORRECTION, SINGULAR_PIVOT};
 
 /// What the checks found in a sound model.
 #[derive(Clone, Debug, PartialEq)]
@@ -75,6 +68,7 @@ pub fn check(model: &Model) -> Result<Preflight, StaticError> {
     if solver.residual().iter().any(|r| !r.is_finite()) {
         return Err(StaticError::Initial(NewtonFailure::NonFinite {
             iteration: 0,
+            origin: non_finite_origin(model, &state, 0.0),
         }));
     }
     if let Some(failure) = singular_direction(model, &solver) {

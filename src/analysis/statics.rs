@@ -4,7 +4,9 @@
 //! 1. Equilibrium at `t = 0` (pretension, loads whose curves start at a
 //!    non-zero value): increment 0.
 //! 2. Each increment moves `t` by `Δt`, sets prescribed motions to their
-//!    values at the new `t`, and iterates to equilibrium.
+//!    values at the new `t`, moves the free unknowns by the predictor (each
+//!    node continues the motion of the last increment, docs/theory.md
+//!    §7.3) and iterates to equilibrium.
 //! 3. A failed increment (no convergence, divergence, singular tangent) is
 //!    restarted from the last converged state with `Δt/2`; the analysis
 //!    stops when `Δt` would fall below `min_increment`.
@@ -91,6 +93,12 @@ pub struct StaticOutcome {
     pub wasted_iterations: usize,
     /// Number of cut-backs.
     pub cutbacks: usize,
+    /// Translation corrections (docs/theory.md §7.2): one more assembly and
+    /// factorisation each, besides the iterations.
+    pub translation_corrections: usize,
+    /// Arc-length iterations whose constraint had no real root and took
+    /// the increment of closest approach (docs/theory.md §9).
+    pub closest_approaches: usize,
     /// Constraint equations removed as redundant (docs/joints.md §5).
     pub redundant_constraints: usize,
     /// Load parameter reached.
@@ -128,6 +136,14 @@ impl<'m> StaticAnalysis<'m> {
 
     /// Runs from the reference configuration to `end_time`.
     pub fn run(&mut self, observer: &mut dyn Observer) -> StaticOutcome {
+        let mut outcome = self.run_increments(observer);
+        outcome.translation_corrections = self.solver.translation_corrections();
+        outcome.closest_approaches = self.solver.closest_approaches();
+        outcome
+    }
+
+    /// The analysis proper (see [`StaticAnalysis::run`]).
+    fn run_increments(&mut self, observer: &mut dyn Observer) -> StaticOutcome {
         let start = Instant::now();
         let model = self.model;
         let s = &model.settings;
@@ -139,6 +155,8 @@ impl<'m> StaticAnalysis<'m> {
             iterations: 0,
             wasted_iterations: 0,
             cutbacks: 0,
+            translation_corrections: 0,
+            closest_approaches: 0,
             redundant_constraints: 0,
             time: 0.0,
             wall_time: 0.0,
@@ -203,6 +221,9 @@ impl<'m> StaticAnalysis<'m> {
         let mut t = 0.0;
         let mut dt = s.initial_increment;
         let mut backup = state.clone();
+        // the converged state before the last one, and the step between
+        // them, for the predictor
+        let mut previous: Option<(State, f64)> = None;
 
         let mut increment = 1;
         while t < s.end_time {
@@ -215,6 +236,11 @@ impl<'m> StaticAnalysis<'m> {
             backup.clone_from(&state);
             state.time = t_new;
             model.apply_prescribed(&mut state, t_new);
+            // predictor: each node continues its last increment
+            if let Some((p, last_step)) = &previous {
+                self.solver
+                    .predict(model, &mut state, p, step / last_step, t_new);
+            }
             match self
                 .solver
                 .solve(model, s, &mut state, t_new, increment, observer)
@@ -254,6 +280,13 @@ impl<'m> StaticAnalysis<'m> {
                     }
                     if r.iterations <= EASY_ITERATIONS {
                         dt = (dt * GROWTH).min(s.max_increment);
+                    }
+                    match &mut previous {
+                        Some((p, last_step)) => {
+                            p.clone_from(&backup);
+                            *last_step = step;
+                        }
+                        None => previous = Some((backup.clone(), step)),
                     }
                     increment += 1;
                 }
@@ -317,7 +350,7 @@ impl<'m> StaticAnalysis<'m> {
         while increment <= s.max_increments {
             backup.clone_from(state);
             let (t_start, dir_backup) = (t, direction.clone());
-            match self.solver.solve_arc(
+            let mut result = self.solver.solve_arc(
                 model,
                 s,
                 state,
@@ -326,27 +359,35 @@ impl<'m> StaticAnalysis<'m> {
                 &mut direction,
                 increment,
                 observer,
-            ) {
-                Ok(mut r) => {
-                    let mut step = t - t_start;
-                    if t >= s.end_time {
-                        // land on end_time with a load-controlled increment
-                        let mut landed = backup.clone();
-                        landed.time = s.end_time;
-                        if let Ok(r2) = self.solver.solve(
-                            model,
-                            s,
-                            &mut landed,
-                            s.end_time,
-                            increment,
-                            observer,
-                        ) {
+            );
+            if result.is_ok() && t >= s.end_time {
+                // land on end_time with a load-controlled increment, from the
+                // start of the increment or else from the arc's end; if
+                // neither converges the arc is cut back like a failure
+                let arc_end = state.clone();
+                for start in [&backup, &arc_end] {
+                    let mut landed = start.clone();
+                    landed.time = s.end_time;
+                    let solved =
+                        self.solver
+                            .solve(model, s, &mut landed, s.end_time, increment, observer);
+                    match solved {
+                        Ok(r) => {
                             *state = landed;
                             t = s.end_time;
-                            step = t - t_start;
-                            r = r2;
+                            result = Ok(r);
+                            break;
+                        }
+                        Err(f) => {
+                            outcome.wasted_iterations += f.iterations_spent();
+                            result = Err(f);
                         }
                     }
+                }
+            }
+            match result {
+                Ok(r) => {
+                    let step = t - t_start;
                     model.update_internal(state);
                     outcome.increments += 1;
                     outcome.iterations += r.iterations;

@@ -77,7 +77,8 @@ pub struct StaticSettings {
     pub max_iterations: usize,
     /// Residual tolerance, relative to the force flux.
     pub residual_tolerance: f64,
-    /// Displacement increment tolerance, relative to the model size.
+    /// Displacement increment tolerance, relative to the largest
+    /// translation of the increment.
     pub displacement_tolerance: f64,
     /// Rotation increment tolerance (radians).
     pub rotation_tolerance: f64,

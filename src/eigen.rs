@@ -96,7 +96,7 @@ pub const SHIFT_FRACTION: f64 = 1e-10;
 /// the Rayleigh quotient `xᵀKx` produces, the terms `xᵢ Kᵢⱼ xⱼ` that cancel
 /// added with random signs. Measured (`tests/eigen.rs`, `benches/eigen.rs`:
 /// chains, beams of 200 to 3,333 elements with 1 to 3 rigid-body or
-/// mechanism modes, dense and Lanczos): zero modes at 0.02 to 0.32 of
+/// mechanism modes, dense and Lanczos): zero modes at 0.02 to 0.35 of
 /// this floor, the lowest flexible modes at 3.1e3 (a beam of slenderness
 /// 3e4 in 3,333 elements, `ω²₁ ≈ 6e-15 λ_ref`) and above 4e6 for all
 /// others. 30 lies between them with a margin of about 100 on each side.

@@ -18,6 +18,8 @@
 //! - [`dofs`], [`assembly`], [`linalg`]: numbering, sparse assembly, sparse
 //!   direct solver;
 //! - [`analysis`]: Newton–Raphson and the nonlinear static analysis;
+//! - [`eigen`]: eigen-solvers of modal analysis (dense null-space and
+//!   shift-invert Lanczos);
 //! - [`io`]: model files in, results (CSV, JSON, VTK) out.
 //!
 //! ```
@@ -52,6 +54,7 @@ pub mod analysis;
 pub mod assembly;
 pub mod curves;
 pub mod dofs;
+pub mod eigen;
 pub mod elements;
 pub mod io;
 pub mod joints;

@@ -78,10 +78,12 @@ fn the_written_model_file_reads_back_and_runs_the_same() {
     let text = m.to_toml().unwrap();
     let back = parse_model(&text, std::path::Path::new("arm.toml")).unwrap();
     assert_eq!(&back, m.input());
-    let built = m.build().unwrap();
-    let read = unfold::model::Model::from_input(&back).unwrap();
-    let a = StaticAnalysis::new(&built).run(&mut NoObserver);
-    let b = StaticAnalysis::new(&read).run(&mut NoObserver);
+    let built = std::sync::Arc::new(m.build().unwrap());
+    let read = std::sync::Arc::new(unfold::model::Model::from_input(&back).unwrap());
+    let settings = m.analyses().unwrap()[0].as_static().unwrap().clone();
+    let a = StaticAnalysis::new(built.clone(), settings.clone())
+        .run(built.initial_state(), &mut NoObserver);
+    let b = StaticAnalysis::new(read.clone(), settings).run(read.initial_state(), &mut NoObserver);
     assert!(a.error.is_none(), "{:?}", a.error);
     assert_eq!(a.state, b.state);
     assert_eq!(built.node(hand), read.node(hand));

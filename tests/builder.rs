@@ -158,3 +158,32 @@ fn one_diagonal_section() {
     assert_eq!(input.sections[0], section);
     assert_eq!(section.ei3, Some(6.0));
 }
+
+/// A sequence of analyses written by the builder is an array of
+/// `[[analysis]]` tables, read back to the same definition and the same
+/// settings, each starting where the one before ends (default increments
+/// a tenth of each span); a single analysis is still written as one
+/// `[analysis]` table.
+#[test]
+fn a_sequence_of_analyses_round_trips() {
+    let (mut m, ..) = arm();
+    m.analysis(Analysis::kinetostatic().end_time(1.0));
+    let one = m.to_toml().unwrap();
+    assert!(
+        one.contains("\n[analysis]\n") && !one.contains("[[analysis]]"),
+        "{one}"
+    );
+    m.then(Analysis::kinematic().end_time(3.0).output_times([1.5, 2.0]));
+    let text = m.to_toml().unwrap();
+    assert_eq!(text.matches("[[analysis]]").count(), 2, "{text}");
+    let back = parse_model(&text, std::path::Path::new("arm.toml")).unwrap();
+    assert_eq!(&back, m.input());
+    let settings = back.analyses().unwrap();
+    assert_eq!(settings.len(), 2);
+    let second = settings[1].as_static().unwrap();
+    assert!(second.kinematic);
+    assert_eq!(second.end_time, 3.0);
+    assert_eq!(second.initial_increment, 0.2);
+    assert_eq!(second.output_times, vec![1.5, 2.0]);
+    assert_eq!(settings, m.analyses().unwrap());
+}

@@ -476,12 +476,7 @@ mod tests {
 
     /// Moves local unknown `k` of variable `var` by `h`, configurations
     /// along the update rule of [`State::displace_node`].
-    fn moved<const K: usize>(
-        n: &[NodeMotion; K],
-        var: Var,
-        k: usize,
-        h: f64,
-    ) -> [NodeMotion; K] {
+    fn moved<const K: usize>(n: &[NodeMotion; K], var: Var, k: usize, h: f64) -> [NodeMotion; K] {
         let mut p = *n;
         let node = &mut p[k / 6];
         let c = k % 6;
@@ -519,8 +514,7 @@ mod tests {
         assert_eq!(N, 6 * K);
         let mut fd = SMatrix::<f64, N, N>::zeros();
         for k in 0..N {
-            let d = (residual(&moved(n, var, k, h)) - residual(&moved(n, var, k, -h)))
-                / (2.0 * h);
+            let d = (residual(&moved(n, var, k, h)) - residual(&moved(n, var, k, -h))) / (2.0 * h);
             fd.set_column(k, &d);
         }
         let scale = analytic.amax().max(fd.amax());

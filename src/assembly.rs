@@ -320,7 +320,7 @@ impl Assembler {
     /// As [`Assembler::assemble`], with the rotation columns of every local
     /// stiffness multiplied on the right by the 3×3 factor of their node,
     /// `K_{·Θᵢ} ← K_{·Θᵢ} Tᵢ` (the tangent operator of the generalised-α
-    /// update, docs/dynamics), before it is added to the inertia matrix.
+    /// update, docs/theory.md §12), before it is added to the inertia matrix.
     /// The inertia matrix is not factored. `factors` has one entry per
     /// node.
     pub fn assemble_factored(

@@ -234,15 +234,6 @@ impl DofMap {
         dof.checked_sub(self.first_multiplier())
     }
 
-    /// Where the coordinates, multipliers and internal variables of each
-    /// element start in the state; `internal` from the model.
-    pub fn offsets(&self, element: usize) -> (usize, usize) {
-        (
-            self.coordinate_offset[element],
-            self.multiplier_offset[element],
-        )
-    }
-
     /// Dofs of an element's local unknowns, in local order.
     pub fn element_dofs(&self, model: &Model, element: usize) -> Vec<usize> {
         let mut d: Vec<usize> = model.elements[element]

@@ -70,7 +70,7 @@ pub enum StaticError {
     },
     /// Constraints removed as redundant turned out violated: they
     /// contradict the others.
-    #[error("inconsistent constraints at t = {time:.6}: {constraint} was found redundant at the start but is now violated ({violation:.1e} × its tolerance); two joints or drivers impose incompatible motions")]
+    #[error("inconsistent constraints at t = {time:.6}: {constraint} was found redundant but is now violated ({violation:.1e} × its tolerance); two joints or drivers impose incompatible motions")]
     Inconsistent {
         /// Load parameter.
         time: f64,
@@ -111,8 +111,8 @@ pub struct StaticOutcome {
     /// Arc-length iterations whose constraint had no real root and took
     /// the increment of closest approach (docs/theory.md §9).
     pub closest_approaches: usize,
-    /// Constraint equations removed as redundant (docs/joints.md §5), at
-    /// the end.
+    /// Constraint equations removed as redundant (docs/joints.md §5): the
+    /// most at any time of the analysis.
     pub redundant_constraints: usize,
     /// Rank analyses of the constraints run again during the analysis,
     /// after a change of the active constraints.

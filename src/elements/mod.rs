@@ -43,7 +43,7 @@ pub use kind::{CellField, CellShape, ElementKind};
 
 /// Weights of the inertia matrix an element writes:
 /// `damping·∂r/∂v + mass·∂r/∂v̇`. The generalised-α integrator asks for
-/// `(γ′, β′)` (docs/dynamics), a modal analysis for `(0, 1)` (the mass
+/// `(γ′, β′)` (docs/theory.md §12), a modal analysis for `(0, 1)` (the mass
 /// matrix alone).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InertiaWeights {

@@ -520,13 +520,14 @@ impl Observer for Recorder {
     fn iteration(&mut self, info: &IterationInfo) {
         let n = &info.norms;
         self.log.line(&format!(
-            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
-            info.increment,
+            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+            info.increment + self.increment_offset,
             info.iteration,
             n.residual_force,
             n.flux_force,
             n.residual_moment,
             n.flux_moment,
+            n.residual_coordinate,
             n.relative_residual,
             n.residual_constraint,
             n.displacement_correction,

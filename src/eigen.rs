@@ -1,6 +1,6 @@
 //! Eigen-solvers of modal analysis: undamped natural frequencies and mode
 //! shapes of a constrained mechanism linearised about a configuration
-//! (docs/theory.md §12).
+//! (docs/theory.md §14).
 //!
 //! The problem, in the equation numbering of the analysis, is the
 //! generalized eigenproblem of the constrained pencil
@@ -127,7 +127,7 @@ const MASSLESS_FACTOR: f64 = 100.0;
 /// (`−d` below the lowest eigenvalue, `d` the smallest non-zero `|ω²|`) is
 /// repeated with the best shift, when that matters: modes far above a
 /// shift close to a zero eigenvalue, or far below a distant shift, lose
-/// accuracy in proportion (docs/theory.md §12.3).
+/// accuracy in proportion (docs/theory.md §14.3).
 const SHIFT_MISMATCH: f64 = 100.0;
 
 /// The Cholesky factorisation of `K_r − σM_r` failing (an eigenvalue below
@@ -610,7 +610,7 @@ fn count_zero(modes: &[Mode]) -> usize {
 //------ dense solver ------
 
 /// The lowest `settings.modes` modes by null-space reduction and a dense
-/// symmetric eigen-decomposition (docs/theory.md §12.2): every mode of the
+/// symmetric eigen-decomposition (docs/theory.md §14.2): every mode of the
 /// model is computed, so this is for models of up to a few thousand
 /// unknowns. `settings.shift` is only a starting value.
 pub fn solve_dense(pencil: &Pencil, settings: &EigenSettings) -> Result<ModalSolution, EigenError> {
@@ -867,7 +867,7 @@ fn shifted_inverse(
 /// of `L⁻¹M_rL⁻ᵀ`, ascending) was too far from the best one `σ* =
 /// min(ω²_min, 0) − d` (`d` the smallest `|ω²|` not at round-off of
 /// zero): modes far above a shift close to zero eigenvalues, or far below
-/// a distant shift, lose accuracy in proportion (docs/theory.md §12.3).
+/// a distant shift, lose accuracy in proportion (docs/theory.md §14.3).
 fn best_shift(mu: &[f64], sigma: f64, n: usize, lambda_ref: f64) -> Option<f64> {
     let mu_max = mu.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
     let massless = MASSLESS_FACTOR * n as f64 * f64::EPSILON * mu_max;
@@ -1017,7 +1017,7 @@ impl Basis {
 }
 
 /// The `settings.modes` modes nearest to the shift by shift-invert
-/// Lanczos with thick restarts (docs/theory.md §12.4).
+/// Lanczos with thick restarts (docs/theory.md §14.4).
 pub fn solve_lanczos(
     pencil: &Pencil,
     settings: &EigenSettings,

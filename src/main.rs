@@ -4,6 +4,9 @@
 //! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii]
 //! unfold check MODEL.toml
 //! ```
+//! A model file with a sequence of analyses (`[[analysis]]`) runs them in
+//! order, each from the final state of the one before, into one set of
+//! result files.
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
 //! written so far are kept) or results could not be written (each error
 //! names its file; the output directory in use by another run); 2 the
@@ -21,7 +24,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use unfold::analysis::preflight;
 use unfold::analysis::statics::StaticError;
-use unfold::analysis::{IncrementInfo, NewtonFailure, StaticAnalysis};
+use unfold::analysis::{
+    AnalysisSettings, IncrementInfo, NewtonFailure, StaticAnalysis, StaticSettings,
+};
 use unfold::io::model_file::read_model;
 use unfold::io::run::{signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest};
 use unfold::io::vtk::Encoding;
@@ -138,15 +143,18 @@ fn print_warnings(path: &Path, model: &Model) {
 /// (analysis::preflight): exit code 2, with the message a run would give,
 /// when one fails.
 fn check(path: &Path) -> ExitCode {
-    let model = match read_model(path) {
-        Ok((_, model)) => model,
+    let (model, analyses) = match read_model(path) {
+        Ok(file) => (file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
     print_warnings(path, &model);
-    match preflight::check(&model) {
+    let Some(settings) = static_settings(path, &analyses) else {
+        return ExitCode::from(EXIT_INPUT);
+    };
+    match preflight::check(&model, &settings[0]) {
         Ok(report) => {
             println!(
                 "{}: valid model: {}; {} unknowns",
@@ -170,6 +178,20 @@ fn check(path: &Path) -> ExitCode {
             ExitCode::from(EXIT_INPUT)
         }
     }
+}
+
+/// The settings of the analyses, all static ones (the analyses this tool
+/// runs); `None`, after an error message, if one is of another type.
+fn static_settings(path: &Path, plan: &[AnalysisSettings]) -> Option<Vec<StaticSettings>> {
+    let settings: Option<Vec<StaticSettings>> =
+        plan.iter().map(|a| a.as_static().cloned()).collect();
+    if settings.is_none() || plan.is_empty() {
+        eprintln!(
+            "error: {}: an analysis of this model is not one this version runs",
+            path.display()
+        );
+    }
+    settings.filter(|s| !s.is_empty())
 }
 
 /// Shows a run in the terminal: log lines (unless quiet) above a progress
@@ -225,15 +247,23 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         );
     }
 
-    let (_, model) = match read_model(path) {
-        Ok(m) => m,
+    let (model, plan) = match read_model(path) {
+        Ok(file) => (file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
     print_warnings(path, &model);
-    let mut analysis = StaticAnalysis::new(&model);
+    let Some(settings) = static_settings(path, &plan) else {
+        return ExitCode::from(EXIT_INPUT);
+    };
+    let mut analyses = settings
+        .into_iter()
+        .map(|s| StaticAnalysis::new(model.clone(), s));
+    let Some(mut analysis) = analyses.next() else {
+        return ExitCode::SUCCESS;
+    };
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] [{bar:40}] {msg}")
@@ -243,17 +273,27 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     let terminal = Terminal {
         bar,
         quiet,
-        end_time: model.settings.end_time,
+        end_time: plan.last().map_or(1.0, |a| a.end_time()),
     };
     let label = path.display().to_string();
-    let mut recorder = match Recorder::create(out, &label, &model, &analysis, terminal) {
+    let recorder = Recorder::create_sequence(out, &label, &analysis, &plan, terminal);
+    let mut recorder = match recorder {
         Ok(r) => r.with_stop(&stop).with_vtk_encoding(encoding),
         Err(e) => {
             eprintln!("error: cannot write results: {e}");
             return ExitCode::from(EXIT_FAILED);
         }
     };
-    let outcome = analysis.run(&mut recorder);
+    // the analyses in order, each from the final state of the one before
+    let mut outcome = analysis.run(model.initial_state(), &mut recorder);
+    for mut next in analyses {
+        if outcome.error.is_some() {
+            break;
+        }
+        recorder.next_analysis(&outcome, &next);
+        let start = std::mem::take(&mut outcome.state);
+        outcome = next.run(start, &mut recorder);
+    }
     let report = recorder.finish(&outcome);
 
     for e in &report.output_errors {
@@ -271,7 +311,10 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     if let Some(e) = &outcome.error {
         eprintln!("error: {}: {e}", path.display());
         // a model that is singular from the start is invalid input
-        if let StaticError::Initial(NewtonFailure::Singular { .. })
+        if let StaticError::Initial {
+            failure: NewtonFailure::Singular { .. },
+            ..
+        }
         | StaticError::Indeterminate { .. } = e
         {
             return ExitCode::from(EXIT_INPUT);

@@ -4,7 +4,7 @@
 
 mod common;
 
-use unfold::analysis::{CutbackInfo, IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
+use unfold::analysis::{CutbackInfo, IncrementInfo, Observer, StaticOutcome};
 use unfold::joints::JointType;
 use unfold::model::input::{JointInput, ModelInput};
 use unfold::model::Model;
@@ -75,13 +75,13 @@ fn von_mises_truss_is_followed_through_its_limit_point() {
     m.analysis.displacement_tolerance = Some(1e-10);
     m.analysis.rotation_tolerance = Some(1e-10);
 
-    let model = Model::from_input(&m).expect("valid model");
+    let model = std::sync::Arc::new(Model::from_input(&m).expect("valid model"));
     let mut path = Path {
         apex: model.node_index(3).unwrap(),
         height: h,
         ..Default::default()
     };
-    let outcome = StaticAnalysis::new(&model).run(&mut path);
+    let outcome = common::analysis(&model, &m).run(model.initial_state(), &mut path);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     assert_eq!(outcome.time, 1.0);
 
@@ -160,7 +160,7 @@ fn planar_frame(
     loaded: u64,
     load: f64,
     end_time: f64,
-) -> (Model, StaticOutcome, Trace) {
+) -> (std::sync::Arc<Model>, StaticOutcome, Trace) {
     let mut m = ModelInput::new("planar frame");
     m.add_section("s", section);
     for &(id, [x, y]) in nodes {
@@ -178,12 +178,12 @@ fn planar_frame(
     m.analysis.end_time = end_time;
     m.analysis.initial_increment = Some(0.5);
     m.analysis.max_increment = Some(2.0);
-    let model = Model::from_input(&m).expect("valid model");
+    let model = std::sync::Arc::new(Model::from_input(&m).expect("valid model"));
     let mut trace = Trace {
         node: model.node_index(loaded).unwrap(),
         ..Default::default()
     };
-    let outcome = StaticAnalysis::new(&model).run(&mut trace);
+    let outcome = common::analysis(&model, &m).run(model.initial_state(), &mut trace);
     (model, outcome, trace)
 }
 

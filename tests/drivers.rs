@@ -1,8 +1,10 @@
 //! Drivers with an acting window: released after it, taking over the
 //! coordinate where they find it when they start late.
 
+use std::sync::Arc;
+
 use unfold::analysis::{IncrementInfo, Observer, StaticAnalysis};
-use unfold::elements::ElementKind;
+use unfold::elements::{ElementKind, Need};
 use unfold::joints::JointType;
 use unfold::model::input::{DriverInput, JointInput, JointSpringInput, ModelInput};
 use unfold::model::Model;
@@ -20,7 +22,7 @@ impl Observer for History {
         s: &State,
         _: &[f64],
     ) -> std::io::Result<()> {
-        let ctx = model.context(info.time, false);
+        let ctx = model.context(info.time, Need::RESIDUAL);
         let mut row = (info.time, 0.0, 0.0, 0.0);
         let mut v = [0.0; 9];
         for e in &model.elements {
@@ -94,9 +96,10 @@ fn driver_acts_in_its_window_only() {
     // the link's node has no stiffness of its own besides the joints:
     // ground it in translation so that only the hinge turns
     m.fix(1, &["x", "y", "z"]);
-    let model = Model::from_input(&m).expect("valid model");
+    let model = Arc::new(Model::from_input(&m).expect("valid model"));
     let mut h = History::default();
-    let outcome = StaticAnalysis::new(&model).run(&mut h);
+    let settings = m.analyses().unwrap()[0].as_static().unwrap().clone();
+    let outcome = StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut h);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     assert_eq!(h.0.len(), 13, "12 increments and the initial state");
     for &(t, angle, load1, load2) in &h.0 {
@@ -160,7 +163,7 @@ curve = "stroke"
 "#;
     let input = unfold::io::model_file::parse_model(text, std::path::Path::new("smooth.toml"))
         .expect("valid model file");
-    let model = Model::from_input(&input).expect("valid model");
+    let model = Arc::new(Model::from_input(&input).expect("valid model"));
     #[derive(Default)]
     struct Angles(Vec<(f64, f64)>);
     impl Observer for Angles {
@@ -172,13 +175,14 @@ curve = "stroke"
             _: &[f64],
         ) -> std::io::Result<()> {
             let mut v = [0.0; 9];
-            model.elements[0].results(&model.context(info.time, false), s, &mut v);
+            model.elements[0].results(&model.context(info.time, Need::RESIDUAL), s, &mut v);
             self.0.push((info.time, v[0]));
             Ok(())
         }
     }
     let mut a = Angles::default();
-    let outcome = StaticAnalysis::new(&model).run(&mut a);
+    let settings = input.analyses().unwrap()[0].as_static().unwrap().clone();
+    let outcome = StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut a);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     for (t, angle) in a.0 {
         let tau = ((t - 0.5) / 1.0f64).clamp(0.0, 1.0);

@@ -121,12 +121,13 @@ pub(super) fn driver(
 /// of the largest increments: the increments are then cut back until they
 /// ask less; a value meant in degrees and read in radians does this.
 fn warn_fast_angle(cx: &mut Context, entity: &str, d: &DriverInput, value: f64, curve: usize) {
-    let s = &cx.settings;
-    if s.arc_length || !(s.max_increment.is_finite() && s.max_increment > 0.0) {
+    let Some(h) = cx.plan.max_increment else {
+        return;
+    };
+    if !(h.is_finite() && h > 0.0) {
         return;
     }
     let end = cx.curves.end_time;
-    let h = s.max_increment;
     let change = value.abs() * cx.curves.curves[curve].largest_change(h, end);
     if change > MAX_TURN_PER_INCREMENT {
         let hint = if d.unit.is_none() {

@@ -141,7 +141,7 @@ impl Builder<'_> {
                 ),
             }
         }
-        if self.settings.arc_length && !self.input.prescribed.is_empty() {
+        if self.plan.arc_length && !self.input.prescribed.is_empty() {
             self.ck.push(
                 ModelErrorKind::Invalid,
                 "analysis",

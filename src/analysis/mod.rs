@@ -16,14 +16,18 @@
 
 pub mod constraints;
 pub mod control;
+pub mod dynamics;
+pub mod energy;
 pub mod newton;
 pub mod preflight;
 pub mod settings;
 pub mod statics;
 
 pub use control::EventFunction;
+pub use dynamics::{DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
+pub use energy::{Energies, EnergyBalance};
 pub use newton::{ConvergenceNorms, NewtonFailure};
-pub use settings::{AnalysisSettings, StaticSettings};
+pub use settings::{AnalysisSettings, DynamicSettings, StaticSettings};
 pub use statics::{StaticAnalysis, StaticOutcome, Step};
 
 use crate::model::Model;

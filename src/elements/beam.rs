@@ -417,6 +417,32 @@ impl Element for Beam {
         0.5 * self.length * k.strain.dot(&(self.section.stiffness * k.strain))
     }
 
+    fn kinetic_energy(&self, state: &State) -> f64 {
+        if !self.has_inertia {
+            return 0.0;
+        }
+        self.inertia.kinetic_energy(&[
+            node_motion(state, self.nodes[0]),
+            node_motion(state, self.nodes[1]),
+        ])
+    }
+
+    fn momenta(&self, state: &State) -> super::inertia::Momenta {
+        if !self.has_inertia {
+            return Default::default();
+        }
+        self.inertia.momenta(&[
+            node_motion(state, self.nodes[0]),
+            node_motion(state, self.nodes[1]),
+        ])
+    }
+
+    /// `−ρA L₀ g·(x₁ + x₂)/2`: the weight of §3.4, half at each node.
+    fn weight_potential(&self, ctx: &EvalContext, state: &State) -> f64 {
+        let centre = 0.5 * (state.x[self.nodes[0]] + state.x[self.nodes[1]]);
+        -self.section.mass_per_length * self.length * ctx.gravity.dot(&centre)
+    }
+
     fn cell_shape(&self) -> CellShape {
         CellShape::Line
     }

@@ -96,7 +96,7 @@ impl<const N: usize> InertiaForces<N> {
 
 /// Linear momentum and angular momentum about the global origin, both in
 /// global components.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Momenta {
     /// Linear momentum `p`.
     pub linear: Vec3,

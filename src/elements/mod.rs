@@ -313,6 +313,30 @@ pub trait Element: Send + Sync {
         0.0
     }
 
+    /// Kinetic energy of the element's inertia (docs/theory.md I1, I7).
+    fn kinetic_energy(&self, _state: &State) -> f64 {
+        0.0
+    }
+
+    /// Linear momentum and angular momentum about the global origin of the
+    /// element's inertia (docs/theory.md I6), global frame; zero without
+    /// inertia.
+    fn momenta(&self, _state: &State) -> inertia::Momenta {
+        inertia::Momenta::default()
+    }
+
+    /// Potential of the weight, `−m g·x_c` with `x_c` the centre of mass
+    /// and `g` the gravity of `ctx`.
+    fn weight_potential(&self, _ctx: &EvalContext, _state: &State) -> f64 {
+        0.0
+    }
+
+    /// Power dissipated by the element's dampers (non-negative), in
+    /// dynamics.
+    fn dissipated_power(&self, _ctx: &EvalContext, _state: &State) -> f64 {
+        0.0
+    }
+
     /// Points of the element carried by its nodes (joint points), for
     /// drawing: each is drawn joined to its node, so that a rigid link is
     /// seen from its node to its joints. Appended to `out`.

@@ -99,6 +99,9 @@ pub struct ModelInput {
     /// Prescribed histories of joint coordinates or node components.
     #[serde(default)]
     pub drivers: Vec<DriverInput>,
+    /// Rigid motions of sets of nodes at the start (dynamic analyses).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub initial_motion: Vec<InitialMotionInput>,
 }
 
 /// A kinematic pair between node A and node B (or the ground).
@@ -374,6 +377,28 @@ pub struct AnalysisInput {
     /// Arc-length control: largest number of increments, default 1000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_increments: Option<usize>,
+    /// Dynamics: first time step, default a hundredth of the span.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_step: Option<f64>,
+    /// Dynamics: smallest time step, default `time_step · 1e-6`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_step: Option<f64>,
+    /// Dynamics: largest time step, default a tenth of the span (adaptive)
+    /// or `time_step` (fixed steps).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_step: Option<f64>,
+    /// Dynamics: spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`,
+    /// default 0.9.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_infinity: Option<f64>,
+    /// Dynamics: relative tolerance of the local error estimate, default
+    /// 1e-4.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error_tolerance: Option<f64>,
+    /// Dynamics: whether the step follows the error estimate (default
+    /// true); `false` for fixed steps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<bool>,
 }
 
 fn default_analysis_type() -> String {
@@ -401,6 +426,12 @@ impl Default for AnalysisInput {
             constraint_penalty: None,
             control: None,
             max_increments: None,
+            time_step: None,
+            min_step: None,
+            max_step: None,
+            rho_infinity: None,
+            error_tolerance: None,
+            adaptive: None,
         }
     }
 }
@@ -419,6 +450,30 @@ pub struct NodeInput {
     /// Unit of `rotation` (its length is the angle).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unit: Option<AngleUnit>,
+    /// Initial velocity (global frame), default zero; dynamic analyses.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<[f64; 3]>,
+    /// Initial angular velocity (global frame, rad/s), default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_velocity: Option<[f64; 3]>,
+}
+
+/// `[[initial_motion]]`: a rigid motion given to a set of nodes at the
+/// start, `v(x) = v + ω × (x − about)`, `ω` to every node (global frame).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct InitialMotionInput {
+    /// The nodes that move together.
+    pub nodes: Vec<Id>,
+    /// Velocity of the point `about`, default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<[f64; 3]>,
+    /// Angular velocity (rad/s), default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_velocity: Option<[f64; 3]>,
+    /// The point whose velocity is `velocity`, default the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub about: Option<[f64; 3]>,
 }
 
 /// Cross-section properties of a beam.
@@ -752,6 +807,8 @@ impl ModelInput {
             x,
             rotation: None,
             unit: None,
+            velocity: None,
+            angular_velocity: None,
         });
         self
     }

@@ -13,6 +13,7 @@ mod beams;
 mod checks;
 mod curves;
 mod drivers;
+mod initial;
 mod joint_springs;
 mod joints;
 mod loads;
@@ -201,9 +202,11 @@ impl Builder<'_> {
     /// Default curve of loads and gravity: the ramp in statics (the load
     /// factor), the constant in a kinematic analysis, whose motion the
     /// drivers set and whose loads are those of the real, fully loaded
-    /// mechanism at every instant.
+    /// mechanism at every instant, and in a first dynamic analysis, whose
+    /// loads act from the start (a ramp in time is a loading history of
+    /// its own, to be given as such).
     fn load_default(&self) -> CurveIndex {
-        if self.plan.kinematic {
+        if self.plan.kinematic || self.plan.first_dynamic {
             CONSTANT
         } else {
             RAMP
@@ -284,6 +287,7 @@ impl Model {
         let gravity = b.gravity();
         b.supports();
         b.prescribed();
+        let initial_velocity = b.initial_velocities();
 
         // ---------- global checks ----------
         let Builder {
@@ -301,7 +305,8 @@ impl Model {
         if ck.errors.is_empty() {
             if elements.iter().all(|e| e.kind() == ElementKind::NodalLoad) {
                 ck.push(ModelErrorKind::Missing, "model", "has no elements");
-            } else {
+            } else if !plan.dynamic_only {
+                // in dynamics inertia holds a free part
                 checks::check_restraint(&mut ck, &node_ids, &elements, &fixed);
             }
         }
@@ -343,6 +348,7 @@ impl Model {
             gravity,
             length_scale,
             scaling: Default::default(),
+            initial_velocity,
             offsets: Vec::new(),
             sizes: Default::default(),
         };

@@ -508,13 +508,28 @@ impl Analysis {
     /// The settings of this analysis alone (from `t = 0`), validated as in
     /// a model file.
     pub fn settings(self) -> Result<crate::analysis::StaticSettings, crate::model::ModelErrors> {
+        match self.analysis_settings()? {
+            crate::analysis::AnalysisSettings::Dynamic(_) => {
+                Err(crate::model::ModelErrors(vec![crate::model::ModelError {
+                    kind: crate::model::ModelErrorKind::Invalid,
+                    entity: "analysis".into(),
+                    message: "a dynamic analysis has dynamic settings: use analysis_settings or dynamic_settings".into(),
+                }]))
+            }
+            crate::analysis::AnalysisSettings::Static(s) => Ok(s),
+        }
+    }
+
+    /// The settings of this analysis alone (from `t = 0`), of whatever
+    /// type, validated as in a model file.
+    pub fn analysis_settings(
+        self,
+    ) -> Result<crate::analysis::AnalysisSettings, crate::model::ModelErrors> {
         let input = crate::model::input::ModelInput {
             analysis: self.0.into(),
             ..crate::model::input::ModelInput::default()
         };
         let mut all = input.analyses()?;
-        Ok(match all.remove(0) {
-            crate::analysis::AnalysisSettings::Static(s) => s,
-        })
+        Ok(all.remove(0))
     }
 }

@@ -136,6 +136,40 @@ impl ModelBuilder {
         self.add(Node::at(x).id(id))
     }
 
+    /// Gives node `node` the initial velocity `v` and angular velocity
+    /// `w` (global frame), for dynamic analyses.
+    pub fn initial_velocity(
+        &mut self,
+        node: NodeHandle,
+        v: impl Into<[f64; 3]>,
+        w: impl Into<[f64; 3]>,
+    ) {
+        if let Some(n) = self.input.nodes.iter_mut().find(|n| n.id == node.0) {
+            n.velocity = Some(v.into());
+            n.angular_velocity = Some(w.into());
+        }
+    }
+
+    /// Gives `nodes` the rigid motion in which the point `about` moves
+    /// with `velocity` and everything turns with `angular_velocity`
+    /// (global frame): `v(x) = velocity + angular_velocity × (x − about)`.
+    pub fn initial_motion(
+        &mut self,
+        nodes: impl IntoIterator<Item = NodeHandle>,
+        velocity: impl Into<[f64; 3]>,
+        angular_velocity: impl Into<[f64; 3]>,
+        about: impl Into<[f64; 3]>,
+    ) {
+        self.input
+            .initial_motion
+            .push(crate::model::input::InitialMotionInput {
+                nodes: nodes.into_iter().map(|n| n.0).collect(),
+                velocity: Some(velocity.into()),
+                angular_velocity: Some(angular_velocity.into()),
+                about: Some(about.into()),
+            });
+    }
+
     /// Adds a beam cross-section.
     pub fn section(&mut self, section: Section) -> SectionHandle {
         self.add(section)

@@ -1,12 +1,14 @@
 //! `unfold`: command-line front end.
 //!
 //! ```text
-//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii]
+//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii] [--restart FILE]
 //! unfold check MODEL.toml
 //! ```
 //! A model file with a sequence of analyses (`[[analysis]]`) runs them in
 //! order, each from the final state of the one before, into one set of
-//! result files.
+//! result files. Every run writes `restart.json` (the state at its last
+//! converged step) into its output directory; `--restart FILE` continues a
+//! run from such a file (docs/results.md, "Restart files").
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
 //! written so far are kept) or results could not be written (each error
 //! names its file; the output directory in use by another run); 2 the
@@ -28,8 +30,10 @@ use unfold::analysis::{
     AnalysisSettings, IncrementInfo, NewtonFailure, StaticAnalysis, StaticSettings,
 };
 use unfold::io::model_file::read_model;
+use unfold::io::restart::{fingerprint, Restart, RestartError, RestartWriter, Resume};
 use unfold::io::run::{signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest};
 use unfold::io::vtk::Encoding;
+use unfold::model::input::ModelInput;
 use unfold::model::Model;
 
 // `println!` and `eprintln!` that ignore a failed write instead of
@@ -78,6 +82,10 @@ enum Command {
         /// Write the VTK grids as text instead of compressed binary.
         #[arg(long)]
         vtk_ascii: bool,
+        /// Continue from a restart file of an earlier run of this model
+        /// (its `restart.json`, or a `restart-<t>.json`).
+        #[arg(long, value_name = "FILE")]
+        restart: Option<PathBuf>,
     },
     /// Check a model file and print its size, without running it.
     Check {
@@ -102,6 +110,7 @@ fn main() -> ExitCode {
             quiet,
             threads,
             vtk_ascii,
+            restart,
         } => {
             if let Some(n) = threads {
                 if let Err(e) = rayon::ThreadPoolBuilder::new()
@@ -123,7 +132,7 @@ fn main() -> ExitCode {
             } else {
                 Encoding::Binary
             };
-            run(&model, &out, quiet, encoding)
+            run(&model, &out, quiet, encoding, restart.as_deref())
         }
     }
 }
@@ -227,7 +236,13 @@ impl Console for Terminal {
     }
 }
 
-fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
+fn run(
+    path: &Path,
+    out: &Path,
+    quiet: bool,
+    encoding: Encoding,
+    restart: Option<&Path>,
+) -> ExitCode {
     // from now on SIGINT, SIGTERM and SIGHUP stop the run after the
     // current increment, with consistent result files
     let stop = StopRequest::new();
@@ -247,8 +262,8 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         );
     }
 
-    let (model, plan) = match read_model(path) {
-        Ok(file) => (file.model, file.analyses),
+    let (input, model, plan) = match read_model(path) {
+        Ok(file) => (file.input, file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
@@ -258,8 +273,29 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     let Some(settings) = static_settings(path, &plan) else {
         return ExitCode::from(EXIT_INPUT);
     };
+    // a restart: the analysis it continues and its start state
+    let (first, start) = match restart.map(|r| resume(r, &input, &model, &plan)) {
+        None => (0, model.initial_state()),
+        Some(Ok(resume)) => (resume.analysis, resume.state),
+        Some(Err(e)) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
+    let restarts = RestartWriter::new(out, &input).starting_at(start.time);
+    let restart_note = restart.map(|r| {
+        format!(
+            "restarted from {} at t = {} in analysis {} of {}",
+            r.display(),
+            start.time,
+            first + 1,
+            plan.len()
+        )
+    });
+    let plan = &plan[first..];
     let mut analyses = settings
         .into_iter()
+        .skip(first)
         .map(|s| StaticAnalysis::new(model.clone(), s));
     let Some(mut analysis) = analyses.next() else {
         return ExitCode::SUCCESS;
@@ -276,16 +312,22 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         end_time: plan.last().map_or(1.0, |a| a.end_time()),
     };
     let label = path.display().to_string();
-    let recorder = Recorder::create_sequence(out, &label, &analysis, &plan, terminal);
+    let recorder = Recorder::create_sequence(out, &label, &analysis, plan, terminal);
     let mut recorder = match recorder {
-        Ok(r) => r.with_stop(&stop).with_vtk_encoding(encoding),
+        Ok(r) => r
+            .with_stop(&stop)
+            .with_vtk_encoding(encoding)
+            .with_restart(restarts, first),
         Err(e) => {
             eprintln!("error: cannot write results: {e}");
             return ExitCode::from(EXIT_FAILED);
         }
     };
+    if let Some(note) = restart_note {
+        recorder.line(&note);
+    }
     // the analyses in order, each from the final state of the one before
-    let mut outcome = analysis.run(model.initial_state(), &mut recorder);
+    let mut outcome = analysis.run(start, &mut recorder);
     for mut next in analyses {
         if outcome.error.is_some() {
             break;
@@ -330,4 +372,15 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         return ExitCode::from(EXIT_FAILED);
     }
     ExitCode::SUCCESS
+}
+
+/// Reads the restart file `path` and finds where the run of `model`
+/// continues from it.
+fn resume(
+    path: &Path,
+    input: &ModelInput,
+    model: &Model,
+    plan: &[AnalysisSettings],
+) -> Result<Resume, RestartError> {
+    Restart::read(path)?.resume(path, &fingerprint(input), model, plan)
 }

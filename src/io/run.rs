@@ -27,6 +27,10 @@
 //! looked at between increments, and a second signal, which ends the
 //! process at once, waits for the step being written.
 //!
+//! Restart files ([`super::restart`]): with [`Recorder::with_restart`]
+//! the recorder writes them at the requested times and, when the run ends,
+//! `restart.json` with its last converged state.
+//!
 //! The library never prints: what a person should see goes to a
 //! [`Console`], which the caller provides.
 
@@ -36,6 +40,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicI32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
+use super::restart::RestartWriter;
 use super::results::{file_error, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
@@ -309,6 +314,9 @@ pub struct Recorder {
     current: Running,
     /// Increments of the analyses before the running one.
     increment_offset: usize,
+    /// Restart files, and the index in the model's sequence of the first
+    /// analysis recorded.
+    restart: Option<(RestartWriter, usize)>,
 }
 
 /// The analysis being recorded.
@@ -372,6 +380,7 @@ impl Recorder {
             analyses: plan.len().max(1),
             current: Running::of(0, first),
             increment_offset: 0,
+            restart: None,
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -444,6 +453,14 @@ impl Recorder {
         self
     }
 
+    /// Writes restart files with `writer` (io::restart); the first analysis
+    /// recorded is analysis `first_analysis` (from 0) of the model's
+    /// sequence, as in a restarted run.
+    pub fn with_restart(mut self, writer: RestartWriter, first_analysis: usize) -> Self {
+        self.restart = Some((writer, first_analysis));
+        self
+    }
+
     /// Writes the grids in `encoding` (binary by default).
     pub fn with_vtk_encoding(mut self, encoding: Encoding) -> Self {
         self.writer = self.writer.with_vtk_encoding(encoding);
@@ -481,6 +498,14 @@ impl Recorder {
             ),
             (Some(e), None) => (RunStatus::Failed, Some(e.to_string())),
         };
+        let mut output_errors = Vec::new();
+        if let Some((restart, first)) = &self.restart {
+            let _writing = self.stop.output();
+            let index = first + self.current.index;
+            if let Err(e) = restart.finish(index, self.current.kind, &outcome.state) {
+                output_errors.push(e);
+            }
+        }
         self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
         let last_line = format!(
@@ -496,7 +521,6 @@ impl Recorder {
         );
         self.log.line(&last_line);
         self.console.finish(&last_line);
-        let mut output_errors = Vec::new();
         if let Err(e) = self.log.flush() {
             output_errors.push(e);
         }
@@ -577,6 +601,9 @@ impl Observer for Recorder {
                 self.writer.increment(&last, model, state, residual)?;
             } else {
                 self.writer.increment(info, model, state, residual)?;
+            }
+            if let Some((restart, first)) = &mut self.restart {
+                restart.increment(*first + self.current.index, self.current.kind, state)?;
             }
         }
         self.log.flush()?;

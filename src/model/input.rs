@@ -99,6 +99,20 @@ pub struct ModelInput {
     /// Prescribed histories of joint coordinates or node components.
     #[serde(default)]
     pub drivers: Vec<DriverInput>,
+    /// What a run writes besides the result files (`[output]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<OutputInput>,
+}
+
+/// `[output]`: files a run writes besides the results.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OutputInput {
+    /// Times at which a restart file `restart-<t>.json` is written
+    /// (besides `restart.json` at the end of every run), in increasing
+    /// order, within the analyses; the analyses land on them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub restart_times: Vec<f64>,
 }
 
 /// A kinematic pair between node A and node B (or the ground).

@@ -17,6 +17,7 @@
 pub mod constraints;
 pub mod control;
 pub mod newton;
+pub mod observers;
 pub mod preflight;
 pub mod settings;
 pub mod statics;

@@ -165,8 +165,10 @@ fn run(bays: usize, out: &std::path::Path) -> Result<(), Box<dyn std::error::Err
     std::fs::write(&file, mast.to_toml()?)?;
     println!("model written to {}", file.display());
 
-    let model = mast.build()?;
-    let mut analysis = StaticAnalysis::new(&model);
+    let model = std::sync::Arc::new(mast.build()?);
+    let settings = mast.analyses()?.remove(0);
+    let settings = settings.as_static().ok_or("a static analysis")?.clone();
+    let mut analysis = StaticAnalysis::new(model.clone(), settings);
     // loads are elements of the model too: count them apart
     let loads = model
         .elements
@@ -191,8 +193,8 @@ fn run(bays: usize, out: &std::path::Path) -> Result<(), Box<dyn std::error::Err
         SignalEvent::Ending(s) => eprintln!("{}: stopping at once", signal_name(s)),
     })?;
     let label = file.display().to_string();
-    let mut recorder = Recorder::create(out, &label, &model, &analysis, Silent)?.with_stop(&stop);
-    let outcome = analysis.run(&mut recorder);
+    let mut recorder = Recorder::create(out, &label, &analysis, Silent)?.with_stop(&stop);
+    let outcome = analysis.run(model.initial_state(), &mut recorder);
     let report = recorder.finish(&outcome);
     println!("{}", report.last_line);
     if let Some(e) = report.output_errors.into_iter().next() {

@@ -10,7 +10,8 @@
 //! analysis (ordering, column elimination tree, predicted fill, supernodes)
 //! is computed once per sparsity pattern and reused; the numeric factor and
 //! its workspace are kept between factorisations, so a Newton iteration
-//! allocates little. Only this file knows faer's API.
+//! allocates little. Only this file and the eigen-solvers (`src/eigen.rs`)
+//! know faer's API.
 //!
 //! # Column ordering
 //!
@@ -199,6 +200,26 @@ impl SparseMatrix {
                 y[rows[k]] += self.values[k] * xj;
             }
         }
+    }
+
+    /// Computes `y = |A| x`, with `|A|` the entrywise absolute values: the
+    /// size of the terms that cancel in `A x`, from which its round-off is
+    /// estimated.
+    pub fn mul_abs_vec(&self, x: &[f64], y: &mut [f64]) {
+        y.fill(0.0);
+        let ptr = self.symbolic.col_ptr();
+        let rows = self.symbolic.row_idx();
+        for (j, &xj) in x.iter().enumerate() {
+            for k in ptr[j]..ptr[j + 1] {
+                y[rows[k]] += self.values[k].abs() * xj;
+            }
+        }
+    }
+
+    /// Row indices of the stored entries, in pattern order (column by
+    /// column; the entries of column `j` start at [`Self::column_start`]).
+    pub fn row_indices(&self) -> &[usize] {
+        self.symbolic.row_idx()
     }
 
     /// Every stored entry as `(row, col, value)`.

@@ -4,6 +4,9 @@
 //! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii]
 //! unfold check MODEL.toml
 //! ```
+//! A model file with a sequence of analyses (`[[analysis]]`) runs them in
+//! order, each from the final state of the one before, into one set of
+//! result files.
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
 //! written so far are kept) or results could not be written (each error
 //! names its file; the output directory in use by another run); 2 the
@@ -15,13 +18,16 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use unfold::analysis::preflight;
 use unfold::analysis::statics::StaticError;
-use unfold::analysis::{IncrementInfo, NewtonFailure, StaticAnalysis};
+use unfold::analysis::{
+    AnalysisSettings, IncrementInfo, NewtonFailure, StaticAnalysis, StaticSettings,
+};
 use unfold::io::model_file::read_model;
 use unfold::io::run::{
     format_time, signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest,
@@ -157,15 +163,18 @@ fn print_warnings(path: &Path, model: &Model) {
 /// (analysis::preflight): exit code 2, with the message a run would give,
 /// when one fails.
 fn check(path: &Path) -> ExitCode {
-    let model = match read_model(path) {
-        Ok((_, model)) => model,
+    let (model, analyses) = match read_model(path) {
+        Ok(file) => (file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
     print_warnings(path, &model);
-    match preflight::check(&model) {
+    let Some(settings) = static_settings(path, &analyses) else {
+        return ExitCode::from(EXIT_INPUT);
+    };
+    match preflight::check(&model, &settings[0]) {
         Ok(report) => {
             for w in &report.warnings {
                 eprintln!("warning: {}: {w}", path.display());
@@ -192,6 +201,20 @@ fn check(path: &Path) -> ExitCode {
             ExitCode::from(EXIT_INPUT)
         }
     }
+}
+
+/// The settings of the analyses, all static ones (the analyses this tool
+/// runs); `None`, after an error message, if one is of another type.
+fn static_settings(path: &Path, plan: &[AnalysisSettings]) -> Option<Vec<StaticSettings>> {
+    let settings: Option<Vec<StaticSettings>> =
+        plan.iter().map(|a| a.as_static().cloned()).collect();
+    if settings.is_none() || plan.is_empty() {
+        eprintln!(
+            "error: {}: an analysis of this model is not one this version runs",
+            path.display()
+        );
+    }
+    settings.filter(|s| !s.is_empty())
 }
 
 /// Shows a run in the terminal: log lines (unless quiet) above a progress
@@ -247,26 +270,44 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         );
     }
 
-    let (_, mut model) = match read_model(path) {
-        Ok(m) => m,
+    let (mut model, plan) = match read_model(path) {
+        Ok(file) => (file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
-    // the start-of-run checks (those of `check`), before any result file
-    let checked = preflight::check(&model);
-    if let Ok(report) = &checked {
-        model.warnings.extend(report.warnings.iter().cloned());
+    // the start-of-run checks (those of `check`) for the first analysis,
+    // before any result file
+    let checked = match plan.first().and_then(|a| a.as_static()) {
+        Some(first) => preflight::check(&model, first).map(Some),
+        None => Ok(None),
+    };
+    if let (Ok(Some(report)), Some(m)) = (&checked, Arc::get_mut(&mut model)) {
+        m.warnings.extend(report.warnings.iter().cloned());
     }
     print_warnings(path, &model);
-    let mut analysis = StaticAnalysis::new(&model);
+    let Some(settings) = static_settings(path, &plan) else {
+        return ExitCode::from(EXIT_INPUT);
+    };
+    let mut analyses = settings
+        .into_iter()
+        .map(|s| StaticAnalysis::new(model.clone(), s));
+    let Some(mut analysis) = analyses.next() else {
+        return ExitCode::SUCCESS;
+    };
     let label = path.display().to_string();
     if let Err(e) = checked {
         // invalid input: summary.json alone says why
         eprintln!("error: {}: {e}", path.display());
-        let rejected =
-            unfold::io::results::write_rejected(out, &label, &model, &analysis, &e.to_string());
+        let rejected = unfold::io::results::write_rejected(
+            out,
+            &label,
+            &model,
+            &analysis,
+            &plan,
+            &e.to_string(),
+        );
         if let Err(w) = rejected {
             eprintln!("error: cannot write results: {w}");
         }
@@ -281,16 +322,26 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     let terminal = Terminal {
         bar,
         quiet,
-        end_time: model.settings.end_time,
+        end_time: plan.last().map_or(1.0, |a| a.end_time()),
     };
-    let mut recorder = match Recorder::create(out, &label, &model, &analysis, terminal) {
+    let recorder = Recorder::create_sequence(out, &label, &analysis, &plan, terminal);
+    let mut recorder = match recorder {
         Ok(r) => r.with_stop(&stop).with_vtk_encoding(encoding),
         Err(e) => {
             eprintln!("error: cannot write results: {e}");
             return ExitCode::from(EXIT_FAILED);
         }
     };
-    let outcome = analysis.run(&mut recorder);
+    // the analyses in order, each from the final state of the one before
+    let mut outcome = analysis.run(model.initial_state(), &mut recorder);
+    for mut next in analyses {
+        if outcome.error.is_some() {
+            break;
+        }
+        recorder.next_analysis(&outcome, &next);
+        let start = std::mem::take(&mut outcome.state);
+        outcome = next.run(start, &mut recorder);
+    }
     let report = recorder.finish(&outcome);
 
     for e in &report.output_errors {
@@ -316,7 +367,10 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     if let Some(e) = &outcome.error {
         eprintln!("error: {}: {e}", path.display());
         // a model that is singular from the start is invalid input
-        if let StaticError::Initial(NewtonFailure::Singular { .. })
+        if let StaticError::Initial {
+            failure: NewtonFailure::Singular { .. },
+            ..
+        }
         | StaticError::Indeterminate { .. } = e
         {
             return ExitCode::from(EXIT_INPUT);

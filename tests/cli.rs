@@ -1416,3 +1416,97 @@ fn an_over_driven_mechanism_is_warned_about() {
         "{err}"
     );
 }
+
+/// A sequence of analyses (`[[analysis]]`): the cantilever loaded to
+/// t = 1, then (from that state) to t = 2, runs both in order into one set
+/// of result files: steps numbered 0, 1, 2, ... across both analyses
+/// (the second analysis's equilibrium at its start, the state already
+/// written as the first one's last step, is not written again), increments
+/// numbered on, time going on from 1 to 2, and `summary.json` listing each
+/// analysis. Its end state is that of one analysis from 0 to 2 in the same
+/// increments: the same nodes.csv row of the tip at the last step, to
+/// 1e-12 of the tip's displacement (the same equilibrium to round-off; the
+/// written zeros differ at 1e-20).
+#[test]
+fn a_sequence_of_analyses_runs_into_one_set_of_results() {
+    let dir = scratch("sequence");
+    let text = format!(
+        "{CANTILEVER}\n[[analysis]]\nend_time = 1.0\ninitial_increment = 0.25\n\n[[analysis]]\nend_time = 2.0\ninitial_increment = 0.25\n"
+    );
+    let (code, out, err) = run_model(&dir, "sequence.toml", &text);
+    assert_eq!(code, 0, "stdout {out}\nstderr {err}");
+    assert!(
+        out.contains("analysis 2 of 2: static from t = 1 to t = 2"),
+        "{out}"
+    );
+    let steps = std::fs::read_to_string(dir.join("out/steps.csv")).unwrap();
+    let rows: Vec<Vec<String>> = steps
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    // steps 0..=8, increments 0..=8, t from 0 to 2 by 0.25
+    assert_eq!(rows.len(), 9, "{steps}");
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row[0], k.to_string(), "{steps}");
+        assert_eq!(row[1], k.to_string(), "{steps}");
+        let t: f64 = row[2].parse().unwrap();
+        assert!((t - 0.25 * k as f64).abs() < 1e-12, "{steps}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["status"], "completed");
+    assert_eq!(summary["increments"], 8);
+    assert_eq!(summary["final_time"], 2.0);
+    assert_eq!(summary["end_time"], 2.0);
+    assert_eq!(summary["output_steps"], 9);
+    let analyses = summary["analyses"].as_array().unwrap();
+    assert_eq!(analyses.len(), 2);
+    assert_eq!(analyses[1]["start_time"], 1.0);
+    assert_eq!(analyses[1]["end_time"], 2.0);
+    assert_eq!(analyses[1]["increments"], 4);
+    let last_rows = |nodes: &str| -> Vec<f64> {
+        let row = nodes
+            .lines()
+            .find(|l| l.starts_with("8,") && l.split(',').nth(2) == Some("3"))
+            .expect("the tip at step 8");
+        row.split(',').skip(3).map(|v| v.parse().unwrap()).collect()
+    };
+    let sequence_tip = last_rows(&std::fs::read_to_string(dir.join("out/nodes.csv")).unwrap());
+
+    // one analysis from 0 to 2
+    let one = scratch("sequence-one");
+    let text = format!("{CANTILEVER}\n[analysis]\nend_time = 2.0\ninitial_increment = 0.25\n");
+    let (code, _, err) = run_model(&one, "one.toml", &text);
+    assert_eq!(code, 0, "{err}");
+    let one_tip = last_rows(&std::fs::read_to_string(one.join("out/nodes.csv")).unwrap());
+    let u = (sequence_tip[3].powi(2) + sequence_tip[5].powi(2)).sqrt();
+    let worst = sequence_tip
+        .iter()
+        .zip(&one_tip)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(worst <= 1e-12 * u, "{sequence_tip:?} vs {one_tip:?}");
+}
+
+/// A sequence whose analyses do not go forward in time, or that gives the
+/// model's constraint scaling again, is rejected naming the analysis.
+#[test]
+fn a_sequence_must_go_forward() {
+    let text = format!(
+        "{CANTILEVER}\n[[analysis]]\nend_time = 1.0\n\n[[analysis]]\nend_time = 0.5\nconstraint_scale = 3.0\n"
+    );
+    assert_rejected(
+        "backwards",
+        &text,
+        &[
+            "analysis[2]: end_time must be after the end of the analysis before it (t = 1), got 0.5",
+            "analysis[2]: constraint_scale belongs to the model",
+        ],
+    );
+    let text = CANTILEVER.replace(
+        "title = \"two-element cantilever\"",
+        "title = \"two-element cantilever\"\nanalysis = []",
+    );
+    assert_rejected("no_analysis", &text, &["at least one [[analysis]] table"]);
+}

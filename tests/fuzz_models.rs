@@ -309,7 +309,16 @@ fn check(text: &str, path: &Path) -> Result<Model, String> {
         }
         .to_string()
     })?;
-    preflight::check(&model).map_err(|e| format!("{}: {e}", path.display()))?;
+    let invalid = |e| {
+        unfold::io::model_file::ModelFileError::Invalid {
+            path: path.to_path_buf(),
+            errors: e,
+        }
+        .to_string()
+    };
+    let analyses = input.analyses().map_err(invalid)?;
+    let settings = analyses[0].as_static().ok_or("not a static analysis")?;
+    preflight::check(&model, settings).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(model)
 }
 

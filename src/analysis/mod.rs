@@ -1,18 +1,31 @@
-//! Analyses: algorithms that turn a [`crate::model::Model`] and an initial
-//! [`crate::state::State`] into a sequence of converged states.
+//! Analyses: algorithms that take a [`crate::model::Model`] (shared,
+//! `Arc<Model>`), their settings ([`AnalysisSettings`], beside the model)
+//! and a start [`crate::state::State`], and return a sequence of converged
+//! states and the final one. A first analysis starts from
+//! [`crate::model::Model::initial_state`], a later one from the final state
+//! of the one before (a preload, then a deployment, then ...).
+//!
+//! Every incremental analysis is driven by the one step controller of
+//! [`control`]: step sizes, landing on output times and on `end_time`,
+//! cut-backs, events, changes of the active constraints.
 //!
 //! An analysis reports its progress to an [`Observer`]: every Newton
-//! iteration, every converged increment (with the state, for output) and
-//! every cut-back. The library never prints; the command-line tool turns
-//! these events into log lines, a progress bar and result files.
+//! iteration, every converged increment (with the state, for output), every
+//! cut-back and every event. The library never prints; the command-line
+//! tool turns these events into log lines, a progress bar and result files.
 
 pub mod constraints;
+pub mod control;
 pub mod newton;
+pub mod observers;
 pub mod preflight;
+pub mod settings;
 pub mod statics;
 
+pub use control::EventFunction;
 pub use newton::{ConvergenceNorms, NewtonFailure};
-pub use statics::{StaticAnalysis, StaticOutcome};
+pub use settings::{AnalysisSettings, StaticSettings};
+pub use statics::{StaticAnalysis, StaticOutcome, Step};
 
 use crate::model::Model;
 use crate::state::State;
@@ -63,6 +76,19 @@ pub struct CutbackInfo {
     pub reason: NewtonFailure,
 }
 
+/// A step that landed on an event ([`EventFunction`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EventInfo {
+    /// Increment that landed on it.
+    pub increment: usize,
+    /// Load parameter (time) of the event.
+    pub time: f64,
+    /// The event's name.
+    pub name: String,
+    /// The event function there (within its tolerance of zero).
+    pub value: f64,
+}
+
 /// Receives the events of an analysis. Every method has an empty default.
 pub trait Observer {
     /// After each residual evaluation of a Newton iteration.
@@ -84,6 +110,10 @@ pub trait Observer {
 
     /// When an increment is cut back.
     fn cutback(&mut self, _info: &CutbackInfo) {}
+
+    /// After the increment that landed on an event (reported to
+    /// [`Observer::increment`] first).
+    fn event(&mut self, _info: &EventInfo) {}
 
     /// A remark worth showing the user (redundant constraints removed).
     fn note(&mut self, _text: &str) {}

@@ -474,22 +474,25 @@ mod tests {
         A,
     }
 
-    /// Perturbs local unknown `k` of variable `var` by `h`.
-    fn perturbed<const K: usize>(
-        n: &[NodeMotion; K],
-        var: Var,
-        k: usize,
-        h: f64,
-    ) -> [NodeMotion; K] {
+    /// Moves local unknown `k` of variable `var` by `h`, configurations
+    /// along the update rule of [`State::displace_node`].
+    fn moved<const K: usize>(n: &[NodeMotion; K], var: Var, k: usize, h: f64) -> [NodeMotion; K] {
         let mut p = *n;
         let node = &mut p[k / 6];
         let c = k % 6;
         let mut e = Vec3::zeros();
         e[c % 3] = h;
         match (var, c < 3) {
-            (Var::Q, true) => node.position += e,
-            // along the update rule, as `crate::elements::testing::perturb`
-            (Var::Q, false) => node.rotation *= so3::exp(&e),
+            (Var::Q, translation) => {
+                let mut s = State::at_rest(0.0, vec![node.position], vec![node.rotation]);
+                let (dx, dth) = if translation {
+                    (e, Vec3::zeros())
+                } else {
+                    (Vec3::zeros(), e)
+                };
+                s.displace_node(0, &dx, &dth);
+                (node.position, node.rotation) = (s.x[0], s.q[0]);
+            }
             (Var::V, true) => node.velocity += e,
             (Var::V, false) => node.angular_velocity += e,
             (Var::A, true) => node.acceleration += e,
@@ -511,8 +514,7 @@ mod tests {
         assert_eq!(N, 6 * K);
         let mut fd = SMatrix::<f64, N, N>::zeros();
         for k in 0..N {
-            let d = (residual(&perturbed(n, var, k, h)) - residual(&perturbed(n, var, k, -h)))
-                / (2.0 * h);
+            let d = (residual(&moved(n, var, k, h)) - residual(&moved(n, var, k, -h))) / (2.0 * h);
             fd.set_column(k, &d);
         }
         let scale = analytic.amax().max(fd.amax());
@@ -871,15 +873,11 @@ mod tests {
             time: 1.0,
             curves: &[],
             gravity: Vec3::zeros(),
-            need_tangent: true,
-            dynamics: None,
+            need: crate::elements::Need::STIFFNESS,
+            dynamics: false,
             scaling: Default::default(),
         };
-        let state = State {
-            x: x.to_vec(),
-            q: r.to_vec(),
-            ..State::default()
-        };
+        let state = State::at_rest(0.0, x.to_vec(), r.to_vec());
         let omega = Vec3::new(0.3, -1.2, 0.7);
         let mut v = SVector::<f64, 12>::zeros();
         for i in 0..2 {

@@ -15,9 +15,12 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
+use std::sync::Arc;
+
 use serde::Deserialize;
 use toml::de::{DeTable, DeValue};
 
+use crate::analysis::AnalysisSettings;
 use crate::model::input::{ModelInput, TOP_LEVEL_KEYS};
 use crate::model::{Model, ModelErrors};
 
@@ -250,18 +253,35 @@ fn remove_table<'i>(table: &mut DeTable<'i>, span: &Range<usize>) -> bool {
     })
 }
 
+/// A model file read and validated: the model and, beside it, the
+/// analyses the file asks for, in order.
+pub struct ModelFile {
+    /// The file as written.
+    pub input: ModelInput,
+    /// The model.
+    pub model: Arc<Model>,
+    /// The analyses (`[analysis]`, or each `[[analysis]]` of a sequence).
+    pub analyses: Vec<AnalysisSettings>,
+}
+
 /// Reads and validates a model file.
-pub fn read_model(path: &Path) -> Result<(ModelInput, Model), ModelFileError> {
+pub fn read_model(path: &Path) -> Result<ModelFile, ModelFileError> {
     let text = std::fs::read_to_string(path).map_err(|source| ModelFileError::Read {
         path: path.to_path_buf(),
         source,
     })?;
     let input = parse_model(&text, path)?;
-    let model = Model::from_input(&input).map_err(|errors| ModelFileError::Invalid {
+    let invalid = |errors| ModelFileError::Invalid {
         path: path.to_path_buf(),
         errors,
-    })?;
-    Ok((input, model))
+    };
+    let model = Model::from_input(&input).map_err(invalid)?;
+    let analyses = input.analyses().map_err(invalid)?;
+    Ok(ModelFile {
+        input,
+        model: Arc::new(model),
+        analyses,
+    })
 }
 
 #[cfg(test)]

@@ -35,8 +35,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::vtk;
-use crate::analysis::{IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
-use crate::elements::ElementKind;
+use crate::analysis::{AnalysisSettings, IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
+use crate::elements::{ElementKind, Need};
 use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -86,6 +86,28 @@ pub struct IncrementRecord {
     pub iterations: usize,
     /// Relative residual at each iteration.
     pub residuals: Vec<f64>,
+}
+
+/// What one analysis of a run did, for `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct AnalysisRecord {
+    /// Analysis type (`static`, `kinematic`).
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// `t` it started from.
+    pub start_time: f64,
+    /// Its requested end.
+    pub end_time: f64,
+    /// `t` it reached.
+    pub final_time: f64,
+    /// Converged increments after its initial equilibrium.
+    pub increments: usize,
+    /// Newton iterations of its converged increments.
+    pub iterations: usize,
+    /// Its cut-backs.
+    pub cutbacks: usize,
+    /// Whether it stopped early (the analyses after it were not run).
+    pub failed: bool,
 }
 
 /// Where a run stands, as written in `summary.json`.
@@ -165,17 +187,29 @@ pub struct Summary {
     pub wall_time_s: f64,
     /// Output steps written.
     pub output_steps: usize,
+    /// Each analysis of the run, in order (one unless the model file asks
+    /// for a sequence).
+    pub analyses: Vec<AnalysisRecord>,
     /// Every converged increment.
     pub increment_log: Vec<IncrementRecord>,
+    /// Iterations of the initial equilibria, left out of the average.
+    #[serde(skip)]
+    initial_iterations: usize,
     /// Free unknowns before redundant constraint equations are removed.
     #[serde(skip)]
     unknowns: usize,
 }
 
 impl Summary {
-    /// The summary of a run of `model` (read from `model_file`) that has
-    /// not started: status `running`, counts of the model, no increment.
-    pub fn start(model_file: &str, model: &Model, analysis: &StaticAnalysis) -> Self {
+    /// The summary of a run of the analyses `plan` on `model` (read from
+    /// `model_file`), the first of which is `first`, that has not started:
+    /// status `running`, counts of the model, no increment.
+    pub fn start(
+        model_file: &str,
+        model: &Model,
+        first: &StaticAnalysis,
+        plan: &[AnalysisSettings],
+    ) -> Self {
         let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
         Self {
             model: model_file.to_string(),
@@ -188,48 +222,77 @@ impl Summary {
             joints: count(ElementKind::Joint),
             drivers: count(ElementKind::Driver),
             redundant_constraints: 0,
-            dofs: analysis.n_equations(),
-            nonzeros: analysis.solver().nnz(),
+            dofs: first.n_equations(),
+            nonzeros: first.solver().nnz(),
             increments: 0,
             iterations: 0,
             average_iterations: 0.0,
             wasted_iterations: 0,
             cutbacks: 0,
             final_time: 0.0,
-            end_time: model.settings.end_time,
+            end_time: plan
+                .last()
+                .map_or(first.settings().end_time, |a| a.end_time()),
             wall_time_s: 0.0,
             output_steps: 0,
+            analyses: Vec::new(),
             increment_log: Vec::new(),
-            unknowns: analysis.n_equations(),
+            initial_iterations: 0,
+            unknowns: first.n_equations(),
         }
     }
 
-    /// Fills in what the analysis did (`outcome`), the increments recorded
-    /// by `writer`, and the final status.
-    pub fn finish(
+    /// Adds what analysis `kind` (from `start_time` to `end_time`) did,
+    /// `outcome`, to the counts; `initial_iterations` are those of its
+    /// initial equilibrium (left out of the average).
+    pub fn add(
         &mut self,
+        kind: &str,
+        start_time: f64,
+        end_time: f64,
         outcome: &StaticOutcome,
-        writer: &ResultWriter,
-        status: RunStatus,
-        message: Option<String>,
+        initial_iterations: usize,
     ) {
-        self.status = status;
-        self.message = message;
-        self.redundant_constraints = outcome.redundant_constraints;
-        self.dofs = self.unknowns.saturating_sub(outcome.redundant_constraints);
-        self.increments = outcome.increments;
-        self.iterations = outcome.iterations;
-        // the initial equilibrium is not an increment
-        self.average_iterations = if outcome.increments > 0 {
-            (outcome.iterations - writer.log.first().map_or(0, |r| r.iterations)) as f64
-                / outcome.increments as f64
+        self.analyses.push(AnalysisRecord {
+            kind: kind.to_string(),
+            start_time,
+            end_time,
+            final_time: outcome.time,
+            increments: outcome.increments,
+            iterations: outcome.iterations,
+            cutbacks: outcome.cutbacks,
+            failed: outcome.error.is_some(),
+        });
+        self.redundant_constraints = self
+            .redundant_constraints
+            .max(outcome.redundant_constraints);
+        // the equations solved: without the redundant ones
+        self.dofs = self.unknowns.saturating_sub(self.redundant_constraints);
+        self.increments += outcome.increments;
+        self.iterations += outcome.iterations;
+        self.wasted_iterations += outcome.wasted_iterations;
+        self.cutbacks += outcome.cutbacks;
+        self.final_time = outcome.time;
+        self.wall_time_s += outcome.wall_time;
+        // the initial equilibria are not increments
+        self.initial_iterations += initial_iterations;
+        self.average_iterations = if self.increments > 0 {
+            self.iterations.saturating_sub(self.initial_iterations) as f64 / self.increments as f64
         } else {
             0.0
         };
-        self.wasted_iterations = outcome.wasted_iterations;
-        self.cutbacks = outcome.cutbacks;
-        self.final_time = outcome.time;
-        self.wall_time_s = outcome.wall_time;
+    }
+
+    /// Newton iterations of the initial equilibria of the analyses added
+    /// (counted in `iterations`, not in `average_iterations`).
+    pub fn initial_iterations(&self) -> usize {
+        self.initial_iterations
+    }
+
+    /// The final status, the increments recorded by `writer`.
+    pub fn finish(&mut self, writer: &ResultWriter, status: RunStatus, message: Option<String>) {
+        self.status = status;
+        self.message = message;
         self.output_steps = writer.output_steps();
         self.increment_log = writer.log.clone();
     }
@@ -451,8 +514,9 @@ fn remove_leftovers(dir: &Path, writes: impl Fn(&str) -> bool) -> io::Result<()>
     Ok(())
 }
 
-/// Records in `dir` a run of `model` (read from `model_file`) rejected
-/// before its analysis started, by the checks of
+/// Records in `dir` a run of `model` (read from `model_file`, analyses
+/// `plan`, the first of which is `first`) rejected before its first
+/// analysis started, by the checks of
 /// [`crate::analysis::preflight`]: `summary.json` alone, status `failed`
 /// with `message`. The directory is locked as for a run, and the files of
 /// an earlier run are removed (none would belong to this model); no other
@@ -461,7 +525,8 @@ pub fn write_rejected(
     dir: &Path,
     model_file: &str,
     model: &Model,
-    analysis: &StaticAnalysis,
+    first: &StaticAnalysis,
+    plan: &[AnalysisSettings],
     message: &str,
 ) -> io::Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| file_error(dir, e))?;
@@ -469,7 +534,7 @@ pub fn write_rejected(
     remove_leftovers(dir, |_| false)?;
     // an empty grid folder of an earlier run goes too
     let _ = std::fs::remove_dir(dir.join("vtk"));
-    let mut summary = Summary::start(model_file, model, analysis);
+    let mut summary = Summary::start(model_file, model, first, plan);
     summary.status = RunStatus::Failed;
     summary.message = Some(message.to_string());
     let text = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;
@@ -628,7 +693,7 @@ impl ResultWriter {
                 model.node_ids[i], x.x, x.y, x.z, u.x, u.y, u.z, q.w, q.i, q.j, q.k
             );
         }
-        let ctx = model.context(t, false);
+        let ctx = model.context(t, Need::RESIDUAL);
         for table in &mut self.tables {
             for &k in &table.elements {
                 let e = &model.elements[k];
@@ -689,7 +754,7 @@ impl ResultWriter {
         self.format_step(step, info, model, state, residual);
         let name = format!("step_{step:05}.vtu");
         let grid = self.dir.join("vtk").join(&name);
-        let ctx = model.context(info.time, false);
+        let ctx = model.context(info.time, Need::RESIDUAL);
         if let Err(e) = vtk::write_vtu(&grid, model, &ctx, state, self.encoding) {
             self.csv_files().for_each(CsvFile::rollback);
             return Err(e);

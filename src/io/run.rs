@@ -3,15 +3,21 @@
 //! and for programs that build their model with the library.
 //!
 //! ```no_run
-//! # use unfold::analysis::StaticAnalysis;
+//! # use std::sync::Arc;
+//! # use unfold::analysis::{StaticAnalysis, StaticSettings};
 //! # use unfold::io::run::{Recorder, Silent};
-//! # fn run(model: &unfold::model::Model) -> std::io::Result<()> {
-//! let mut analysis = StaticAnalysis::new(model);
-//! let mut recorder = Recorder::create("results/x".as_ref(), "x.toml", model, &analysis, Silent)?;
-//! let outcome = analysis.run(&mut recorder);
+//! # fn run(model: Arc<unfold::model::Model>, settings: StaticSettings) -> std::io::Result<()> {
+//! let mut analysis = StaticAnalysis::new(model.clone(), settings);
+//! let mut recorder = Recorder::create("results/x".as_ref(), "x.toml", &analysis, Silent)?;
+//! let outcome = analysis.run(model.initial_state(), &mut recorder);
 //! let report = recorder.finish(&outcome);
 //! # Ok(()) }
 //! ```
+//!
+//! A sequence of analyses ([`Recorder::create_sequence`]) is recorded in
+//! one set of files: each analysis starts from the final state of the one
+//! before ([`Recorder::next_analysis`]), the output steps and increments
+//! are numbered on across them, and `summary.json` lists each analysis.
 //!
 //! Stopping: a [`StopRequest`] shared with the recorder (set by
 //! [`stop_on_signals`] on SIGINT, SIGTERM or SIGHUP) makes it write the
@@ -34,7 +40,8 @@ use super::results::{file_error, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
-    CutbackInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome,
+    AnalysisSettings, CutbackInfo, EventInfo, IncrementInfo, IterationInfo, Observer,
+    StaticAnalysis, StaticOutcome,
 };
 use crate::elements::ElementKind;
 use crate::model::Model;
@@ -314,43 +321,95 @@ pub struct Recorder {
     console: Box<dyn Console>,
     stop: StopRequest,
     summary: Summary,
+    /// End of the last analysis of the run.
     end_time: f64,
+    /// Number of analyses of the run.
+    analyses: usize,
+    /// The analysis running: its index, type, start and end.
+    current: Running,
+    /// Increments of the analyses before the running one.
+    increment_offset: usize,
+}
+
+/// The analysis being recorded.
+struct Running {
+    index: usize,
+    kind: &'static str,
+    start_time: f64,
+    end_time: f64,
+    initial_iterations: usize,
+}
+
+impl Running {
+    fn of(index: usize, analysis: &StaticAnalysis) -> Self {
+        let s = analysis.settings();
+        Self {
+            index,
+            kind: if s.kinematic { "kinematic" } else { "static" },
+            start_time: 0.0,
+            end_time: s.end_time,
+            initial_iterations: 0,
+        }
+    }
 }
 
 impl Recorder {
-    /// Locks and prepares `dir` for a run of `model` (read from
-    /// `model_file`, as named in the summary): result files with their
+    /// Locks and prepares `dir` for a run of `analysis` (of a model read
+    /// from `model_file`, as named in the summary): result files with their
     /// headers, `log.txt` with a first line describing the model, and a
     /// `summary.json` saying `running`; the run is shown on `console`.
     /// Every error names its file.
     pub fn create(
         dir: &Path,
         model_file: &str,
-        model: &Model,
         analysis: &StaticAnalysis,
         console: impl Console + 'static,
     ) -> io::Result<Self> {
+        let plan = [AnalysisSettings::Static(analysis.settings().clone())];
+        Self::create_sequence(dir, model_file, analysis, &plan, console)
+    }
+
+    /// As [`Recorder::create`], for a run of the analyses `plan` in order,
+    /// the first of which is `first`.
+    pub fn create_sequence(
+        dir: &Path,
+        model_file: &str,
+        first: &StaticAnalysis,
+        plan: &[AnalysisSettings],
+        console: impl Console + 'static,
+    ) -> io::Result<Self> {
+        let model = &**first.model();
         let writer = ResultWriter::create(dir, model)?;
         let log = LogFile::create(dir.join("log.txt"))?;
-        let summary = Summary::start(model_file, model, analysis);
+        let summary = Summary::start(model_file, model, first, plan);
         let mut recorder = Self {
             writer,
             log,
             console: Box::new(console),
             stop: StopRequest::new(),
+            end_time: summary.end_time,
             summary,
-            end_time: model.settings.end_time,
+            analyses: plan.len().max(1),
+            current: Running::of(0, first),
+            increment_offset: 0,
+        };
+        let analyses = if plan.len() > 1 {
+            let each: Vec<String> = plan
+                .iter()
+                .map(|a| format!("{} to t = {}", a.name(), format_time(a.end_time())))
+                .collect();
+            format!("{} analyses: {}", plan.len(), each.join(", "))
+        } else {
+            format!(
+                "{} analysis to t = {}",
+                recorder.current.kind,
+                format_time(recorder.current.end_time)
+            )
         };
         recorder.line(&format!(
-            "{model_file}: {}; {} unknowns; {} analysis to t = {}",
+            "{model_file}: {}; {} unknowns; {analyses}",
             describe(model),
-            analysis.n_equations(),
-            if model.settings.kinematic {
-                "kinematic"
-            } else {
-                "static"
-            },
-            format_time(model.settings.end_time)
+            first.n_equations(),
         ));
         // warnings are shown by the caller; the log keeps them with the run
         for w in &model.warnings {
@@ -362,6 +421,42 @@ impl Recorder {
         recorder.log.flush()?;
         recorder.writer.write_summary(&recorder.summary)?;
         Ok(recorder)
+    }
+
+    /// Closes the record of the analysis that returned `outcome` and opens
+    /// that of `next`, which starts from `outcome`'s final state.
+    pub fn next_analysis(&mut self, outcome: &StaticOutcome, next: &StaticAnalysis) {
+        self.close(outcome);
+        self.current = Running::of(self.current.index + 1, next);
+        self.line(&format!(
+            "analysis {} of {}: {} from t = {} to t = {}",
+            self.current.index + 1,
+            self.analyses,
+            self.current.kind,
+            format_time(outcome.time),
+            format_time(self.current.end_time)
+        ));
+    }
+
+    /// Adds the running analysis's `outcome` to the summary.
+    fn close(&mut self, outcome: &StaticOutcome) {
+        let c = &self.current;
+        self.summary.add(
+            c.kind,
+            c.start_time,
+            c.end_time,
+            outcome,
+            c.initial_iterations,
+        );
+        self.increment_offset += outcome.increments;
+    }
+
+    /// `info` numbered on across the analyses of the run.
+    fn renumbered(&self, info: &IncrementInfo) -> IncrementInfo {
+        IncrementInfo {
+            increment: info.increment + self.increment_offset,
+            ..info.clone()
+        }
     }
 
     /// Stops the run when `stop` is requested.
@@ -392,11 +487,12 @@ impl Recorder {
         self.console.line(text);
     }
 
-    /// Ends the record of a run whose analysis returned `outcome`: the
-    /// status (completed, failed or interrupted), the last line of
+    /// Ends the record of a run whose (last) analysis returned `outcome`:
+    /// the status (completed, failed or interrupted), the last line of
     /// `log.txt`, and `summary.json`. Write errors are returned in the
     /// report, not lost.
     pub fn finish(mut self, outcome: &StaticOutcome) -> RunReport {
+        self.close(outcome);
         let interrupted = outcome.error.as_ref().and_then(Interrupted::of);
         let (status, message) = match (&outcome.error, interrupted) {
             (None, _) => (RunStatus::Completed, None),
@@ -406,17 +502,21 @@ impl Recorder {
             ),
             (Some(e), None) => (RunStatus::Failed, Some(e.to_string())),
         };
-        self.summary.finish(outcome, &self.writer, status, message);
+        self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
-        // the initial equilibrium's iterations are counted in the total,
+        // the initial equilibria's iterations are counted in the total,
         // not in the average
-        let initial = self.writer.log.first().map_or(0, |r| r.iterations);
+        let initial = if self.analyses > 1 {
+            "the initial equilibria"
+        } else {
+            "the initial equilibrium"
+        };
         let last_line = format!(
-            "{}: {} increments, {} iterations ({} for the initial equilibrium; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
+            "{}: {} increments, {} iterations ({} for {initial}; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
             s.status.name(),
             s.increments,
             s.iterations,
-            initial,
+            s.initial_iterations(),
             s.average_iterations,
             s.cutbacks,
             format_time(s.final_time),
@@ -450,13 +550,14 @@ impl Observer for Recorder {
     fn iteration(&mut self, info: &IterationInfo) {
         let n = &info.norms;
         self.log.line(&format!(
-            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
-            info.increment,
+            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+            info.increment + self.increment_offset,
             info.iteration,
             n.residual_force,
             n.flux_force,
             n.residual_moment,
             n.flux_moment,
+            n.residual_coordinate,
             n.relative_residual,
             n.residual_constraint,
             n.displacement_correction,
@@ -471,6 +572,14 @@ impl Observer for Recorder {
         state: &State,
         residual: &[f64],
     ) -> io::Result<()> {
+        if info.increment == 0 {
+            self.current.start_time = info.time;
+            self.current.initial_iterations = info.iterations;
+        }
+        // a later analysis starts at the final state of the one before,
+        // written already: its equilibrium there is logged, not written
+        let restart = info.increment == 0 && self.current.index > 0;
+        let info = &self.renumbered(info);
         let residuals: Vec<String> = info.residuals.iter().map(|r| format!("{r:.1e}")).collect();
         self.line(&format!(
             "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  relative residuals: {}",
@@ -481,6 +590,9 @@ impl Observer for Recorder {
             residuals.join(" ")
         ));
         self.console.progress(info);
+        if restart {
+            return self.log.flush();
+        }
 
         // a stop request before the end: this increment is the last
         // output step
@@ -511,7 +623,21 @@ impl Observer for Recorder {
     fn cutback(&mut self, info: &CutbackInfo) {
         self.line(&format!(
             "increment {:4}  from t = {:.6}: step {:.3e} failed ({}); retrying with {:.3e}",
-            info.increment, info.time, info.failed_step, info.reason, info.next_step
+            info.increment + self.increment_offset,
+            info.time,
+            info.failed_step,
+            info.reason,
+            info.next_step
+        ));
+    }
+
+    fn event(&mut self, info: &EventInfo) {
+        self.line(&format!(
+            "increment {:4}  t = {:.6}: event \"{}\" (value {:.3e})",
+            info.increment + self.increment_offset,
+            info.time,
+            info.name,
+            info.value
         ));
     }
 }

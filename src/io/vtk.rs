@@ -482,7 +482,7 @@ mod tests {
         write_vtu(
             &path,
             &model,
-            &model.context(0.0, false),
+            &model.context(0.0, crate::elements::Need::RESIDUAL),
             &state,
             Encoding::Ascii,
         )

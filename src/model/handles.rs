@@ -214,7 +214,11 @@ impl Model {
         let e = self.element(handle);
         let names = e.result_names();
         let mut values = vec![0.0; names.len()];
-        e.results(&self.context(state.time, false), state, &mut values);
+        e.results(
+            &self.context(state.time, crate::elements::Need::RESIDUAL),
+            state,
+            &mut values,
+        );
         ElementResults { names, values }
     }
 

@@ -71,9 +71,10 @@ pub struct ModelInput {
     /// Free text describing the model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub title: Option<String>,
-    /// The analysis to run and its parameters.
+    /// The analysis to run and its parameters: one `[analysis]` table, or
+    /// a sequence of `[[analysis]]` tables run one after the other.
     #[serde(default)]
-    pub analysis: AnalysisInput,
+    pub analysis: Analyses,
     /// Nodes: positions and orientations of the reference configuration.
     #[serde(default)]
     pub nodes: Vec<NodeInput>,
@@ -244,7 +245,97 @@ pub struct DriverInput {
     pub active: Option<[f64; 2]>,
 }
 
-/// Kind and parameters of the analysis.
+/// The analyses of a model: one (`[analysis]`, the default static analysis
+/// when the table is absent) or a sequence run in order (`[[analysis]]`),
+/// each starting from the final state of the one before. Never empty.
+///
+/// It dereferences to the first analysis, so that a model with one
+/// analysis reads and sets it as `input.analysis.end_time`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Analyses(Vec<AnalysisInput>);
+
+impl Analyses {
+    /// A sequence of analyses; `None` if it is empty.
+    pub fn sequence(analyses: Vec<AnalysisInput>) -> Option<Self> {
+        (!analyses.is_empty()).then_some(Self(analyses))
+    }
+
+    /// The analyses, in order.
+    pub fn all(&self) -> &[AnalysisInput] {
+        &self.0
+    }
+
+    /// Appends an analysis to the sequence.
+    pub fn push(&mut self, analysis: AnalysisInput) {
+        self.0.push(analysis);
+    }
+}
+
+impl Default for Analyses {
+    fn default() -> Self {
+        Self(vec![AnalysisInput::default()])
+    }
+}
+
+impl From<AnalysisInput> for Analyses {
+    fn from(a: AnalysisInput) -> Self {
+        Self(vec![a])
+    }
+}
+
+impl std::ops::Deref for Analyses {
+    type Target = AnalysisInput;
+    fn deref(&self) -> &AnalysisInput {
+        &self.0[0]
+    }
+}
+
+impl std::ops::DerefMut for Analyses {
+    fn deref_mut(&mut self) -> &mut AnalysisInput {
+        &mut self.0[0]
+    }
+}
+
+impl Serialize for Analyses {
+    /// One analysis as a table (`[analysis]`), a sequence as an array of
+    /// tables (`[[analysis]]`).
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match &self.0[..] {
+            [one] => one.serialize(s),
+            all => all.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Analyses {
+    /// A table or a non-empty array of tables; the messages of a table's
+    /// fields are those of [`AnalysisInput`], with their place in the file.
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = Analyses;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an [analysis] table or a sequence of [[analysis]] tables")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Analyses, A::Error> {
+                let one =
+                    AnalysisInput::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(Analyses(vec![one]))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Analyses, A::Error> {
+                let all = Vec::<AnalysisInput>::deserialize(
+                    serde::de::value::SeqAccessDeserializer::new(seq),
+                )?;
+                Analyses::sequence(all).ok_or_else(|| {
+                    serde::de::Error::invalid_length(0, &"at least one [[analysis]] table")
+                })
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+/// Kind and parameters of an analysis.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AnalysisInput {
@@ -253,13 +344,16 @@ pub struct AnalysisInput {
     /// joints and drivers must determine every unknown).
     #[serde(rename = "type", default = "default_analysis_type")]
     pub kind: String,
-    /// Final value of the load parameter `t` (pseudo-time), default 1.
+    /// Final value of the load parameter `t` (pseudo-time), default 1 (each
+    /// analysis of a sequence ends later than the one before).
     #[serde(default = "default_end_time")]
     pub end_time: f64,
-    /// First increment of `t`, default `end_time / 10`.
+    /// First increment of `t`, default a tenth of the analysis's span
+    /// (`end_time / 10` for the first).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_increment: Option<f64>,
-    /// Smallest increment before the analysis gives up, default `end_time · 1e-6`.
+    /// Smallest increment before the analysis gives up, default 1e-6 of the
+    /// span (`end_time · 1e-6` for the first).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_increment: Option<f64>,
     /// Largest increment, default the initial increment.
@@ -281,6 +375,10 @@ pub struct AnalysisInput {
     /// last increment is always written.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output_every: Option<usize>,
+    /// Values of `t` the analysis lands on exactly and writes results at
+    /// (increasing, within the analysis's span).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_times: Option<Vec<f64>>,
     /// Scaling factor `k` of constraint equations (eq. 17), default the
     /// largest diagonal stiffness of the model (docs/joints.md §1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -319,6 +417,7 @@ impl Default for AnalysisInput {
             displacement_tolerance: None,
             rotation_tolerance: None,
             output_every: None,
+            output_times: None,
             constraint_scale: None,
             constraint_penalty: None,
             control: None,

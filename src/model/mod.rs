@@ -1,11 +1,14 @@
 //! The validated, immutable model: nodes, elements, supports, prescribed
-//! motions, curves and analysis settings, with ids resolved to indices.
+//! motions and curves, with ids resolved to indices.
 //!
 //! A [`Model`] is built from a [`input::ModelInput`] (read from a model file
 //! or written in Rust) by [`Model::from_input`], which checks everything and
 //! reports every problem it finds, each naming the entity concerned, and
 //! keeps the warnings (input that is valid but probably not what was
-//! meant) in [`Model::warnings`] for the caller to show.
+//! meant) in [`Model::warnings`] for the caller to show. The analyses the
+//! input asks for are not part of the model: [`input::ModelInput::analyses`]
+//! gives their settings ([`crate::analysis::AnalysisSettings`]), and an
+//! analysis takes the model (shared, `Arc<Model>`) and a start state.
 
 mod build;
 pub mod builder;
@@ -15,7 +18,7 @@ pub mod input;
 use std::fmt;
 
 use crate::curves::{Curve, CurveIndex};
-use crate::elements::{ConstraintScaling, Element, ElementKind, EvalContext};
+use crate::elements::{ConstraintScaling, Element, ElementKind, EvalContext, Need, Offsets};
 use crate::so3::{Rotation, Vec3};
 use crate::state::State;
 
@@ -61,38 +64,6 @@ pub enum Prescribed {
     },
 }
 
-/// Parameters of the nonlinear static analysis (see docs/model-format.md,
-/// `[analysis]`, for the meaning and default of each).
-#[derive(Clone, Debug, PartialEq)]
-pub struct StaticSettings {
-    /// Final value of the load parameter.
-    pub end_time: f64,
-    /// First increment.
-    pub initial_increment: f64,
-    /// Smallest increment allowed after cut-backs.
-    pub min_increment: f64,
-    /// Largest increment allowed when increments grow again.
-    pub max_increment: f64,
-    /// Newton iterations per increment before a cut-back.
-    pub max_iterations: usize,
-    /// Residual tolerance, relative to the force flux.
-    pub residual_tolerance: f64,
-    /// Displacement increment tolerance, relative to the largest
-    /// translation of the increment.
-    pub displacement_tolerance: f64,
-    /// Rotation increment tolerance (radians).
-    pub rotation_tolerance: f64,
-    /// Results are written every this many increments.
-    pub output_every: usize,
-    /// Kinematic analysis: the joints and drivers must determine every
-    /// unknown (docs/joints.md §6).
-    pub kinematic: bool,
-    /// Arc-length path control instead of load increments.
-    pub arc_length: bool,
-    /// Arc-length control: largest number of increments.
-    pub max_increments: usize,
-}
-
 /// A validated model.
 pub struct Model {
     /// Title from the model file.
@@ -122,13 +93,17 @@ pub struct Model {
     pub warnings: Vec<ModelWarning>,
     /// Gravity acceleration and its curve.
     pub gravity: Option<(Vec3, CurveIndex)>,
-    /// Analysis settings.
-    pub settings: StaticSettings,
     /// Diagonal of the bounding box of the nodes (1 if zero): the length
     /// against which displacement tolerances are measured.
     pub length_scale: f64,
     /// Scaling and penalty of the constraint equations.
     pub scaling: ConstraintScaling,
+    /// Where each element's coordinates, multipliers and internal
+    /// variables start in the state.
+    offsets: Vec<Offsets>,
+    /// Sizes of the state's coordinates, multipliers and internal
+    /// variables.
+    sizes: Offsets,
 }
 
 /// A quantity that follows a curve.
@@ -168,43 +143,67 @@ impl Model {
         self.node_ids.len()
     }
 
-    /// The reference (initial) state.
+    /// The reference (initial) state, at rest at `t = 0`: what a first
+    /// analysis starts from.
     pub fn initial_state(&self) -> State {
-        let mut extra = vec![0.0; self.elements.iter().map(|e| e.n_extra()).sum()];
-        let mut offset = 0;
-        for e in &self.elements {
-            e.initial_extra(&mut extra[offset..offset + e.n_extra()]);
-            offset += e.n_extra();
+        let mut coordinates = vec![0.0; self.sizes.coordinates];
+        for (e, o) in self.elements.iter().zip(&self.offsets) {
+            e.initial_coordinates(
+                &mut coordinates[o.coordinates..o.coordinates + e.n_coordinates()],
+            );
         }
-        State {
-            time: 0.0,
-            x: self.reference_x.clone(),
-            q: self.reference_q.clone(),
-            extra,
-            internal: vec![0.0; self.elements.iter().map(|e| e.n_internal()).sum()],
-            velocity: Vec::new(),
-        }
+        State::at_rest(0.0, self.reference_x.clone(), self.reference_q.clone()).with_unknowns(
+            coordinates,
+            self.sizes.multipliers,
+            self.sizes.internal,
+        )
     }
 
-    /// Adds an element, telling it where its extra unknowns and internal
-    /// variables are stored in the state.
-    pub fn push_element(&mut self, mut e: Box<dyn Element>) {
-        let extra = self.elements.iter().map(|e| e.n_extra()).sum();
-        let internal = self.elements.iter().map(|e| e.n_internal()).sum();
-        e.set_offsets(extra, internal);
+    /// Where the coordinates, multipliers and internal variables of
+    /// element `e` start in the state.
+    pub fn offsets(&self, e: usize) -> Offsets {
+        self.offsets[e]
+    }
+
+    /// Numbers of coordinates, multipliers and internal variables of the
+    /// state.
+    pub fn state_sizes(&self) -> Offsets {
+        self.sizes
+    }
+
+    /// Tells every element where its unknowns and internal variables are
+    /// in the state (after the element list changed).
+    fn place_elements(&mut self) {
+        self.offsets.clear();
+        let mut o = Offsets::default();
+        for e in &mut self.elements {
+            e.set_offsets(o);
+            self.offsets.push(o);
+            o.coordinates += e.n_coordinates();
+            o.multipliers += e.n_multipliers();
+            o.internal += e.n_internal();
+        }
+        self.sizes = o;
+    }
+
+    /// Adds an element, telling it where its coordinates, multipliers and
+    /// internal variables are stored in the state.
+    pub fn push_element(&mut self, e: Box<dyn Element>) {
         self.element_lookup
             .insert((e.kind(), e.id()), self.elements.len());
         self.elements.push(e);
+        self.place_elements();
     }
 
-    /// The evaluation context at load parameter `time`.
-    pub fn context(&self, time: f64, need_tangent: bool) -> EvalContext<'_> {
+    /// The evaluation context at load parameter `time` (statics: no
+    /// inertia forces) asking for `need`.
+    pub fn context(&self, time: f64, need: Need) -> EvalContext<'_> {
         EvalContext {
             time,
             curves: &self.curves,
             gravity: self.gravity_at(time),
-            need_tangent,
-            dynamics: None,
+            need,
+            dynamics: false,
             scaling: self.scaling,
         }
     }
@@ -212,18 +211,16 @@ impl Model {
     /// Updates the internal variables of every element after `state` has
     /// converged (unwrapped joint angles).
     pub fn update_internal(&self, state: &mut State) {
-        let ctx = self.context(state.time, false);
-        let mut offset = 0;
+        let ctx = self.context(state.time, Need::RESIDUAL);
         let mut buf = Vec::new();
-        for e in &self.elements {
-            let n = e.n_internal();
+        for (e, o) in self.elements.iter().zip(&self.offsets) {
+            let (n, offset) = (e.n_internal(), o.internal);
             if n > 0 {
                 buf.clear();
                 buf.extend_from_slice(&state.internal[offset..offset + n]);
                 e.update_internal(&ctx, state, &mut buf);
                 state.internal[offset..offset + n].copy_from_slice(&buf);
             }
-            offset += n;
         }
     }
 
@@ -246,11 +243,11 @@ impl Model {
                 force: (0.0, 0.0),
                 moment: (0.0, 0.0),
             },
-            ..self.context(0.0, true)
+            ..self.context(0.0, Need::STIFFNESS)
         };
         let (mut kf, mut km) = (0.0f64, 0.0f64);
         for e in &self.elements {
-            if e.n_extra() > 0 {
+            if e.n_coordinates() + e.n_multipliers() > 0 {
                 continue;
             }
             let n = e.n_local();
@@ -259,10 +256,7 @@ impl Model {
             e.evaluate(
                 &ctx,
                 &state,
-                &mut crate::elements::ElementOutput {
-                    residual: &mut r,
-                    tangent: &mut t,
-                },
+                &mut crate::elements::ElementOutput::with_stiffness(&mut r, &mut t),
             );
             for i in 0..6 * e.nodes().len() {
                 let d = t[i * n + i].abs();

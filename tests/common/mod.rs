@@ -1,38 +1,32 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use unfold::analysis::{IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
+use std::sync::Arc;
+
+use unfold::analysis::observers::History;
+use unfold::analysis::{IncrementInfo, StaticAnalysis, StaticOutcome, StaticSettings};
 use unfold::model::builder::{BeamLine, BeamLineHandle, ModelBuilder, SectionHandle};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
-use unfold::state::State;
 
-/// Keeps every converged increment.
-#[derive(Default)]
-pub struct Recorder {
-    pub increments: Vec<IncrementInfo>,
-}
-
-impl Observer for Recorder {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        _: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.increments.push(info.clone());
-        Ok(())
-    }
-}
-
-/// Builds and runs a model, returning it with the outcome and the
-/// converged increments.
-pub fn run(input: &ModelInput) -> (Model, StaticOutcome, Vec<IncrementInfo>) {
-    let model = Model::from_input(input).expect("valid model");
-    let mut rec = Recorder::default();
-    let outcome = StaticAnalysis::new(&model).run(&mut rec);
+/// Builds and runs a model (its first analysis, from the initial state),
+/// returning it with the outcome and the converged increments.
+pub fn run(input: &ModelInput) -> (Arc<Model>, StaticOutcome, Vec<IncrementInfo>) {
+    let model = Arc::new(Model::from_input(input).expect("valid model"));
+    let mut rec = History::new();
+    let outcome = analysis(&model, input).run(model.initial_state(), &mut rec);
     (model, outcome, rec.increments)
+}
+
+/// The settings of the first analysis of `input`.
+pub fn settings(input: &ModelInput) -> StaticSettings {
+    let all = input.analyses().expect("valid analyses");
+    all[0].as_static().expect("a static analysis").clone()
+}
+
+/// The first analysis of `input` on `model`.
+pub fn analysis(model: &Arc<Model>, input: &ModelInput) -> StaticAnalysis {
+    StaticAnalysis::new(model.clone(), settings(input))
 }
 
 /// A straight line of `n` beam elements of `section` between two new

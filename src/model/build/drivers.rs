@@ -137,12 +137,13 @@ fn warn_fast_angle(
     value: f64,
     curve: usize,
 ) -> bool {
-    let s = &cx.settings;
-    if s.arc_length || !(s.max_increment.is_finite() && s.max_increment > 0.0) {
+    let Some(h) = cx.plan.max_increment else {
+        return false;
+    };
+    if !(h.is_finite() && h > 0.0) {
         return false;
     }
     let end = cx.curves.end_time;
-    let h = s.max_increment;
     let change = value.abs() * cx.curves.curves[curve].largest_change(h, end);
     if change > MAX_TURN_PER_INCREMENT {
         let hint = if d.unit.is_none() {

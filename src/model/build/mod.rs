@@ -24,9 +24,7 @@ mod springs;
 mod supports;
 
 use super::input::*;
-use super::{
-    Model, ModelError, ModelErrorKind, ModelErrors, ModelWarning, Prescribed, StaticSettings,
-};
+use super::{Model, ModelError, ModelErrorKind, ModelErrors, ModelWarning, Prescribed};
 use crate::curves::CurveIndex;
 use crate::elements::beam::BeamSection;
 use crate::elements::{Element, ElementKind};
@@ -173,7 +171,8 @@ struct NodeData {
 struct Builder<'i> {
     input: &'i ModelInput,
     ck: Checker,
-    settings: StaticSettings,
+    /// What the checks and defaults take from the analyses.
+    plan: settings::Plan,
     curves: CurveTable,
     node_ids: Vec<Id>,
     nodes: Vec<NodeData>,
@@ -239,7 +238,7 @@ impl Builder<'_> {
     /// drivers set and whose loads are those of the real, fully loaded
     /// mechanism at every instant.
     fn load_default(&self) -> CurveIndex {
-        if self.settings.kinematic {
+        if self.plan.kinematic {
             CONSTANT
         } else {
             RAMP
@@ -278,12 +277,12 @@ impl Model {
     /// problem found.
     pub fn from_input(input: &ModelInput) -> Result<Model, ModelErrors> {
         let mut ck = Checker::default();
-        let settings = settings::settings(&mut ck, &input.analysis);
-        let curves = CurveTable::build(&mut ck, &input.curves, settings.end_time);
+        let plan = settings::Plan::of(&settings::analyses(&mut ck, &input.analysis));
+        let curves = CurveTable::build(&mut ck, &input.curves, plan.end_time);
         let mut b = Builder {
             input,
             ck,
-            settings,
+            plan,
             curves,
             node_ids: Vec::new(),
             nodes: Vec::new(),
@@ -324,12 +323,12 @@ impl Model {
         // ---------- global checks ----------
         let Builder {
             mut ck,
-            settings,
+            plan,
             curves,
             node_ids,
             nodes,
             node_index,
-            mut elements,
+            elements,
             fixed,
             prescribed,
             ..
@@ -359,13 +358,7 @@ impl Model {
                 1.0
             }
         };
-        let (mut extra, mut internal) = (0, 0);
-        for e in &mut elements {
-            e.set_offsets(extra, internal);
-            extra += e.n_extra();
-            internal += e.n_internal();
-        }
-        let model = Model {
+        let mut model = Model {
             title: input.title.clone().unwrap_or_default(),
             node_ids,
             node_lookup: node_index,
@@ -383,15 +376,17 @@ impl Model {
             curve_uses: curves.uses,
             warnings: ck.warnings,
             gravity,
-            settings,
             length_scale,
             scaling: Default::default(),
-        }
-        .with_default_scaling(
+            offsets: Vec::new(),
+            sizes: Default::default(),
+        };
+        model.place_elements();
+        let model = model.with_default_scaling(
             input.analysis.constraint_scale,
             input.analysis.constraint_penalty,
         );
-        let errors = checks::non_finite_elements(&model);
+        let errors = checks::non_finite_elements(&model, plan.end_time);
         if !errors.is_empty() {
             return Err(ModelErrors(errors));
         }

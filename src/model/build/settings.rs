@@ -1,17 +1,107 @@
-//! `[analysis]`: the analysis settings, with their defaults and limits.
+//! `[analysis]` or `[[analysis]]`: the settings of the analysis, or of
+//! each analysis of a sequence, with their defaults and limits.
 
 use super::{
     num, Checker, LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MIN_RELATIVE_INCREMENT,
 };
-use crate::model::input::AnalysisInput;
-use crate::model::{ModelErrorKind, StaticSettings};
+use crate::analysis::{AnalysisSettings, StaticSettings};
+use crate::model::input::{Analyses, AnalysisInput, ModelInput};
+use crate::model::{ModelErrorKind, ModelErrors};
 
-/// Analysis settings with defaults (docs/model-format.md).
-pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
+impl ModelInput {
+    /// The settings of the analyses the model asks for, in order, validated
+    /// (the same checks and messages as [`crate::model::Model::from_input`],
+    /// which reports them with the rest of the model).
+    pub fn analyses(&self) -> Result<Vec<AnalysisSettings>, ModelErrors> {
+        let mut ck = Checker::default();
+        let all = analyses(&mut ck, &self.analysis);
+        if ck.errors.is_empty() {
+            Ok(all.into_iter().map(AnalysisSettings::Static).collect())
+        } else {
+            Err(ModelErrors(ck.errors))
+        }
+    }
+}
+
+/// What the model's own checks and defaults take from its analyses: the
+/// type of the first (the default curve of loads), whether any uses arc
+/// length, the end of the last and the largest load increment.
+#[derive(Clone, Debug)]
+pub(super) struct Plan {
+    /// The first analysis is kinematic.
+    pub kinematic: bool,
+    /// Some analysis uses arc-length control.
+    pub arc_length: bool,
+    /// End of the last analysis.
+    pub end_time: f64,
+    /// Largest `max_increment` of the load-controlled analyses.
+    pub max_increment: Option<f64>,
+}
+
+impl Plan {
+    pub(super) fn of(settings: &[StaticSettings]) -> Self {
+        let load = settings.iter().filter(|s| !s.arc_length);
+        Self {
+            kinematic: settings.first().is_some_and(|s| s.kinematic),
+            arc_length: settings.iter().any(|s| s.arc_length),
+            end_time: settings.last().map_or(1.0, |s| s.end_time),
+            max_increment: load.map(|s| s.max_increment).reduce(f64::max),
+        }
+    }
+}
+
+/// Settings of every analysis of `analyses`, with defaults
+/// (docs/model-format.md). Each analysis of a sequence starts where the one
+/// before ends; the entities of messages are `analysis`, or
+/// `analysis[k]` (from 1) in a sequence.
+pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<StaticSettings> {
+    let all = analyses.all();
+    let mut start = 0.0;
+    let mut out = Vec::with_capacity(all.len());
+    for (k, a) in all.iter().enumerate() {
+        let entity = if all.len() == 1 {
+            "analysis".to_string()
+        } else {
+            format!("analysis[{}]", k + 1)
+        };
+        if k > 0 {
+            if a.end_time.is_finite() && a.end_time <= start {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    &entity,
+                    format!(
+                        "end_time must be after the end of the analysis before it (t = {}), got {}",
+                        num(start),
+                        num(a.end_time)
+                    ),
+                );
+            }
+            for (name, v) in [
+                ("constraint_scale", a.constraint_scale),
+                ("constraint_penalty", a.constraint_penalty),
+            ] {
+                if v.is_some() {
+                    ck.push(
+                        ModelErrorKind::Invalid,
+                        &entity,
+                        format!("{name} belongs to the model and applies to every analysis: give it in the first one"),
+                    );
+                }
+            }
+        }
+        let s = settings(ck, &entity, a, start);
+        start = s.end_time;
+        out.push(s);
+    }
+    out
+}
+
+/// Settings of one analysis from `start` to its end, with defaults.
+fn settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> StaticSettings {
     if !matches!(a.kind.as_str(), "static" | "kinetostatic" | "kinematic") {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic)",
                 a.kind
@@ -19,12 +109,13 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         );
     }
     let end = a.end_time;
-    ck.positive("analysis", "end_time", end);
-    let initial = a.initial_increment.unwrap_or(end / 10.0);
+    ck.positive(entity, "end_time", end);
+    let span = end - start;
+    let initial = a.initial_increment.unwrap_or(span / 10.0);
     let s = StaticSettings {
         end_time: end,
         initial_increment: initial,
-        min_increment: a.min_increment.unwrap_or(end * 1e-6),
+        min_increment: a.min_increment.unwrap_or(span * 1e-6),
         max_increment: a.max_increment.unwrap_or(initial),
         max_iterations: a.max_iterations.unwrap_or(25),
         // quadratic convergence makes 1e-8 cheap: one iteration more than 1e-4
@@ -32,6 +123,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
         rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
         output_every: a.output_every.unwrap_or(1),
+        output_times: a.output_times.clone().unwrap_or_default(),
         kinematic: a.kind == "kinematic",
         arc_length: a.control.as_deref() == Some("arc_length"),
         max_increments: a.max_increments.unwrap_or(1000),
@@ -42,7 +134,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     ) {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "unknown control \"{}\" (available: load, arc_length)",
                 a.control.as_deref().unwrap_or("")
@@ -52,7 +144,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.arc_length && s.kinematic {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             "a kinematic analysis follows its drivers: arc-length control does not apply",
         );
     }
@@ -64,19 +156,19 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         if v.is_some_and(|v| v > LARGEST_ELEMENT_VALUE) {
             ck.push(
                 ModelErrorKind::Invalid,
-                "analysis",
+                entity,
                 format!("{name} must be at most {LARGEST_ELEMENT_VALUE:e}"),
             );
         }
     }
     if let Some(k) = a.constraint_scale {
-        ck.positive("analysis", "constraint_scale", k);
+        ck.positive(entity, "constraint_scale", k);
     }
     if let Some(p) = a.constraint_penalty {
         if !(p.is_finite() && p >= 0.0) {
             ck.push(
                 ModelErrorKind::NonPositive,
-                "analysis",
+                entity,
                 format!(
                     "constraint_penalty must be zero or positive, got {}",
                     num(p)
@@ -87,20 +179,16 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.max_increments == 0 {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             "max_increments must be at least 1",
         );
     }
-    ck.positive("analysis", "initial_increment", s.initial_increment);
-    ck.positive("analysis", "min_increment", s.min_increment);
-    ck.positive("analysis", "max_increment", s.max_increment);
-    ck.positive("analysis", "residual_tolerance", s.residual_tolerance);
-    ck.positive(
-        "analysis",
-        "displacement_tolerance",
-        s.displacement_tolerance,
-    );
-    ck.positive("analysis", "rotation_tolerance", s.rotation_tolerance);
+    ck.positive(entity, "initial_increment", s.initial_increment);
+    ck.positive(entity, "min_increment", s.min_increment);
+    ck.positive(entity, "max_increment", s.max_increment);
+    ck.positive(entity, "residual_tolerance", s.residual_tolerance);
+    ck.positive(entity, "displacement_tolerance", s.displacement_tolerance);
+    ck.positive(entity, "rotation_tolerance", s.rotation_tolerance);
     // relative tolerances of 1 or more accept any iterate
     for (name, v) in [
         ("residual_tolerance", s.residual_tolerance),
@@ -110,7 +198,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         if v >= 1.0 {
             ck.push(
                 ModelErrorKind::Invalid,
-                "analysis",
+                entity,
                 format!(
                     "{name} must be below 1 (a relative tolerance, or radians), got {}",
                     num(v)
@@ -121,7 +209,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.max_iterations == 0 || s.max_iterations > MAX_ITERATIONS {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "max_iterations must be from 1 to {MAX_ITERATIONS}, got {}",
                 s.max_iterations
@@ -131,7 +219,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.max_increments as f64 > MAX_INCREMENTS {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "max_increments must be at most {MAX_INCREMENTS:e}, got {}",
                 s.max_increments
@@ -139,20 +227,21 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         );
     }
     // a run of more than MAX_INCREMENTS increments is a hang, not an analysis
-    let increments = s.end_time / s.max_increment;
+    let increments = span / s.max_increment;
     if increments > MAX_INCREMENTS {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
-                "end_time / max_increment = {increments:.3e}: the analysis would need more than {MAX_INCREMENTS:e} increments"
+                "{} / max_increment = {increments:.3e}: the analysis would need more than {MAX_INCREMENTS:e} increments",
+                if start == 0.0 { "end_time" } else { "(end_time − start)" }
             ),
         );
     }
     if s.min_increment < MIN_RELATIVE_INCREMENT * s.end_time {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "min_increment must be at least end_time·{MIN_RELATIVE_INCREMENT:e} = {:e} (smaller steps are lost in the round-off of t), got {}",
                 MIN_RELATIVE_INCREMENT * s.end_time,
@@ -163,20 +252,41 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.output_every == 0 {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             "output_every must be at least 1",
         );
     }
     if s.min_increment > s.initial_increment || s.initial_increment > s.max_increment {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "increments must satisfy min_increment ≤ initial_increment ≤ max_increment, got {} ≤ {} ≤ {}",
                 num(s.min_increment),
                 num(s.initial_increment),
                 num(s.max_increment)
             ),
+        );
+    }
+    for &t in &s.output_times {
+        if !(t.is_finite() && t > start && t <= end) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "output_times must lie after the start of the analysis (t = {}) and not after its end_time ({}), got {}",
+                    num(start),
+                    num(end),
+                    num(t)
+                ),
+            );
+        }
+    }
+    if s.output_times.windows(2).any(|w| w[1] <= w[0]) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            "output_times must be in increasing order",
         );
     }
     s

@@ -222,7 +222,7 @@ impl Builder<'_> {
                 ),
             }
         }
-        if self.settings.arc_length && !self.input.prescribed.is_empty() {
+        if self.plan.arc_length && !self.input.prescribed.is_empty() {
             self.ck.push(
                 ModelErrorKind::Invalid,
                 "analysis",
@@ -246,11 +246,12 @@ impl Builder<'_> {
         curve: CurveIndex,
         unitless: bool,
     ) -> bool {
-        let s = &self.settings;
-        if !(s.max_increment.is_finite() && s.max_increment > 0.0) {
+        let Some(h) = self.plan.max_increment else {
+            return false;
+        };
+        if !(h.is_finite() && h > 0.0) {
             return false;
         }
-        let h = s.max_increment;
         let change = angle * self.curves.curves[curve].largest_change(h, self.curves.end_time);
         if change > std::f64::consts::PI {
             let hint = if unitless {

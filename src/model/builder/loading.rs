@@ -473,6 +473,12 @@ impl Analysis {
         self
     }
 
+    /// Values of `t` the analysis lands on exactly and writes results at.
+    pub fn output_times(mut self, times: impl Into<Vec<f64>>) -> Self {
+        self.0.output_times = Some(times.into());
+        self
+    }
+
     /// Scaling factor `k` of the constraint equations (default from the
     /// model's stiffness).
     pub fn constraint_scale(mut self, k: f64) -> Self {
@@ -497,5 +503,18 @@ impl Analysis {
     /// The `[analysis]` table of the model file.
     pub fn into_input(self) -> AnalysisInput {
         self.0
+    }
+
+    /// The settings of this analysis alone (from `t = 0`), validated as in
+    /// a model file.
+    pub fn settings(self) -> Result<crate::analysis::StaticSettings, crate::model::ModelErrors> {
+        let input = crate::model::input::ModelInput {
+            analysis: self.0.into(),
+            ..crate::model::input::ModelInput::default()
+        };
+        let mut all = input.analyses()?;
+        Ok(match all.remove(0) {
+            crate::analysis::AnalysisSettings::Static(s) => s,
+        })
     }
 }

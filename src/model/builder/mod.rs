@@ -181,15 +181,27 @@ impl ModelBuilder {
         self.add(Gravity::of(g));
     }
 
-    /// Sets the analysis and its parameters.
+    /// Sets the analysis and its parameters (the only one, replacing any
+    /// sequence).
     pub fn analysis(&mut self, analysis: Analysis) {
-        self.input.analysis = analysis.into_input();
+        self.input.analysis = analysis.into_input().into();
+    }
+
+    /// Adds an analysis after the last one: a sequence of analyses, each
+    /// starting from the final state of the one before (`[[analysis]]`).
+    pub fn then(&mut self, analysis: Analysis) {
+        self.input.analysis.push(analysis.into_input());
     }
 
     /// Validates the model and builds it: every problem found, as for a
     /// model file.
     pub fn build(&self) -> Result<Model, ModelErrors> {
         Model::from_input(&self.input)
+    }
+
+    /// The settings of the analyses, validated, in order.
+    pub fn analyses(&self) -> Result<Vec<crate::analysis::AnalysisSettings>, ModelErrors> {
+        self.input.analyses()
     }
 
     /// The model definition as the file schema holds it.

@@ -18,6 +18,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -28,7 +29,9 @@ use unfold::analysis::{
     AnalysisSettings, IncrementInfo, NewtonFailure, StaticAnalysis, StaticSettings,
 };
 use unfold::io::model_file::read_model;
-use unfold::io::run::{signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest};
+use unfold::io::run::{
+    format_time, signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest,
+};
 use unfold::io::vtk::Encoding;
 use unfold::model::Model;
 
@@ -104,8 +107,18 @@ fn main() -> ExitCode {
             vtk_ascii,
         } => {
             if let Some(n) = threads {
+                if n == 0 {
+                    eprintln!(
+                        "error: --threads 0: give at least 1 (or leave it out to use every core)"
+                    );
+                    return ExitCode::from(EXIT_INPUT);
+                }
+                let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+                if n > cores {
+                    eprintln!("warning: --threads {n}: more threads than the {cores} cores available, which only slows the run down");
+                }
                 if let Err(e) = rayon::ThreadPoolBuilder::new()
-                    .num_threads(n.max(1))
+                    .num_threads(n)
                     .build_global()
                 {
                     eprintln!("error: --threads: {e}");
@@ -118,6 +131,13 @@ fn main() -> ExitCode {
                     .map_or("model".into(), |s| s.to_string_lossy().into_owned());
                 Path::new("results").join(stem)
             });
+            if out.exists() && !out.is_dir() {
+                eprintln!(
+                    "error: --out {}: is a file; results are written into a directory (created if missing)",
+                    out.display()
+                );
+                return ExitCode::from(EXIT_INPUT);
+            }
             let encoding = if vtk_ascii {
                 Encoding::Ascii
             } else {
@@ -156,6 +176,9 @@ fn check(path: &Path) -> ExitCode {
     };
     match preflight::check(&model, &settings[0]) {
         Ok(report) => {
+            for w in &report.warnings {
+                eprintln!("warning: {}: {w}", path.display());
+            }
             println!(
                 "{}: valid model: {}; {} unknowns",
                 path.display(),
@@ -247,13 +270,22 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         );
     }
 
-    let (model, plan) = match read_model(path) {
+    let (mut model, plan) = match read_model(path) {
         Ok(file) => (file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
+    // the start-of-run checks (those of `check`) for the first analysis,
+    // before any result file
+    let checked = match plan.first().and_then(|a| a.as_static()) {
+        Some(first) => preflight::check(&model, first).map(Some),
+        None => Ok(None),
+    };
+    if let (Ok(Some(report)), Some(m)) = (&checked, Arc::get_mut(&mut model)) {
+        m.warnings.extend(report.warnings.iter().cloned());
+    }
     print_warnings(path, &model);
     let Some(settings) = static_settings(path, &plan) else {
         return ExitCode::from(EXIT_INPUT);
@@ -264,6 +296,23 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     let Some(mut analysis) = analyses.next() else {
         return ExitCode::SUCCESS;
     };
+    let label = path.display().to_string();
+    if let Err(e) = checked {
+        // invalid input: summary.json alone says why
+        eprintln!("error: {}: {e}", path.display());
+        let rejected = unfold::io::results::write_rejected(
+            out,
+            &label,
+            &model,
+            &analysis,
+            &plan,
+            &e.to_string(),
+        );
+        if let Err(w) = rejected {
+            eprintln!("error: cannot write results: {w}");
+        }
+        return ExitCode::from(EXIT_INPUT);
+    }
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] [{bar:40}] {msg}")
@@ -275,7 +324,6 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         quiet,
         end_time: plan.last().map_or(1.0, |a| a.end_time()),
     };
-    let label = path.display().to_string();
     let recorder = Recorder::create_sequence(out, &label, &analysis, &plan, terminal);
     let mut recorder = match recorder {
         Ok(r) => r.with_stop(&stop).with_vtk_encoding(encoding),
@@ -299,12 +347,20 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     for e in &report.output_errors {
         eprintln!("error: cannot write results: {e}");
     }
+    // what the result files hold: up to the last step written
+    let kept = match report.last_output_time {
+        Some(t) => format!(
+            "results up to t = {} are kept in {}",
+            format_time(t),
+            out.display()
+        ),
+        None => format!("no result step was written in {}", out.display()),
+    };
     if let Some(i) = report.interrupted {
         eprintln!(
-            "{}: {i} at t = {}; results up to it are kept in {}",
+            "{}: {i} at t = {}; {kept}",
             path.display(),
-            outcome.time,
-            out.display()
+            format_time(outcome.time)
         );
         return ExitCode::from(i.exit_code());
     }
@@ -319,11 +375,7 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         {
             return ExitCode::from(EXIT_INPUT);
         }
-        eprintln!(
-            "note: results up to t = {:.6} are kept in {}",
-            outcome.time,
-            out.display()
-        );
+        eprintln!("note: {kept}");
         return ExitCode::from(EXIT_FAILED);
     }
     if !report.output_errors.is_empty() {

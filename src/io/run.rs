@@ -213,6 +213,23 @@ pub fn stop_on_signals(
     Ok(())
 }
 
+/// A load parameter for messages: six decimals, trailing zeros dropped
+/// (`1`, `0.071849`), or six in exponent form outside `[1e-3, 1e6)`.
+pub fn format_time(t: f64) -> String {
+    if t == 0.0 || !t.is_finite() {
+        return format!("{t}");
+    }
+    if (1e-3..1e6).contains(&t.abs()) {
+        let fixed = format!("{t:.6}");
+        fixed
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        format!("{t:.6e}")
+    }
+}
+
 /// The size of a model in one line: nodes and elements of each kind.
 pub fn describe(model: &Model) -> String {
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
@@ -291,6 +308,9 @@ pub struct RunReport {
     pub output_errors: Vec<io::Error>,
     /// The last line of the run, as written to `log.txt`.
     pub last_line: String,
+    /// The load parameter of the last output step written (the results
+    /// kept), if any.
+    pub last_output_time: Option<f64>,
 }
 
 /// Records a run: result files, `log.txt`, `summary.json`; stops it on
@@ -376,13 +396,14 @@ impl Recorder {
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
                 .iter()
-                .map(|a| format!("{} to t = {}", a.name(), a.end_time()))
+                .map(|a| format!("{} to t = {}", a.name(), format_time(a.end_time())))
                 .collect();
             format!("{} analyses: {}", plan.len(), each.join(", "))
         } else {
             format!(
                 "{} analysis to t = {}",
-                recorder.current.kind, recorder.current.end_time
+                recorder.current.kind,
+                format_time(recorder.current.end_time)
             )
         };
         recorder.line(&format!(
@@ -412,8 +433,8 @@ impl Recorder {
             self.current.index + 1,
             self.analyses,
             self.current.kind,
-            outcome.time,
-            self.current.end_time
+            format_time(outcome.time),
+            format_time(self.current.end_time)
         ));
     }
 
@@ -477,20 +498,28 @@ impl Recorder {
             (None, _) => (RunStatus::Completed, None),
             (Some(_), Some(i)) => (
                 RunStatus::Interrupted,
-                Some(format!("{i} at t = {}", outcome.time)),
+                Some(format!("{i} at t = {}", format_time(outcome.time))),
             ),
             (Some(e), None) => (RunStatus::Failed, Some(e.to_string())),
         };
         self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
+        // the initial equilibria's iterations are counted in the total,
+        // not in the average
+        let initial = if self.analyses > 1 {
+            "the initial equilibria"
+        } else {
+            "the initial equilibrium"
+        };
         let last_line = format!(
-            "{}: {} increments, {} iterations ({:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
+            "{}: {} increments, {} iterations ({} for {initial}; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
             s.status.name(),
             s.increments,
             s.iterations,
+            s.initial_iterations(),
             s.average_iterations,
             s.cutbacks,
-            s.final_time,
+            format_time(s.final_time),
             s.wall_time_s,
             self.writer.dir().display()
         );
@@ -512,6 +541,7 @@ impl Recorder {
             interrupted,
             output_errors,
             last_line,
+            last_output_time: self.writer.last_output_time(),
         }
     }
 }

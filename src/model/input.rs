@@ -43,6 +43,27 @@ impl AngleUnit {
     }
 }
 
+/// The keys of the top level of a model file ([`ModelInput`]'s fields).
+pub const TOP_LEVEL_KEYS: [&str; 17] = [
+    "title",
+    "analysis",
+    "nodes",
+    "sections",
+    "beams",
+    "beam_lines",
+    "rigid_bodies",
+    "point_masses",
+    "springs",
+    "supports",
+    "prescribed",
+    "loads",
+    "gravity",
+    "curves",
+    "joints",
+    "joint_springs",
+    "drivers",
+];
+
 /// A complete model definition.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]

@@ -57,6 +57,21 @@ pub const MIN_RELATIVE_INCREMENT: f64 = 1e-12;
 /// which overflow beyond 1.3e154.
 pub const LARGEST_ELEMENT_VALUE: f64 = 1e150;
 
+/// Relative margin above half or a whole turn before an angle without a
+/// unit is warned about, so that π and 2π written to a few digits
+/// (3.1416, 6.2832) pass.
+const ANGLE_SLACK: f64 = 1e-3;
+
+/// How large an angle written without a unit may be before it looks like
+/// degrees: a rotation vector is at most half a turn long; a driven
+/// angle, a spring's free angle or a table's angle rarely pass a full
+/// turn.
+#[derive(Clone, Copy)]
+enum AngleLimit {
+    HalfTurn,
+    FullTurn,
+}
+
 /// Collects problems and warnings while the model is built.
 #[derive(Default)]
 struct Checker {
@@ -96,6 +111,26 @@ impl Checker {
                 format!("{what} must be finite, got {values:?}"),
             );
             false
+        }
+    }
+
+    /// Warns that an angle written without a `unit` (read in radians) is
+    /// beyond `limit` (half or a whole turn), as an angle in degrees
+    /// would be: `what` says which angle (`"rotation has the length"`).
+    fn unitless_angle(&mut self, entity: &str, what: &str, angle: f64, limit: AngleLimit) {
+        let (bound, beyond) = match limit {
+            AngleLimit::HalfTurn => (std::f64::consts::PI, "half a turn"),
+            AngleLimit::FullTurn => (std::f64::consts::TAU, "a full turn"),
+        };
+        if angle.abs() > bound * (1.0 + ANGLE_SLACK) {
+            self.warn(
+                entity,
+                format!(
+                    "{what} {:.4} rad ({:.1}°), more than {beyond}, and gives no unit: angles are read in radians. If it is in degrees, write unit = \"deg\" (unit = \"rad\" confirms radians)",
+                    angle.abs(),
+                    angle.abs().to_degrees()
+                ),
+            );
         }
     }
 

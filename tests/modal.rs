@@ -564,3 +564,245 @@ fn all_dense_modes_keep_the_lowest_accurate() {
         .windows(2)
         .all(|w| w[0].omega_squared <= w[1].omega_squared));
 }
+
+//------ the command-line tool ------
+
+/// A fresh scratch directory for one test.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("unfold-modal-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs `unfold` with `args`: (exit code, stdout, stderr).
+fn unfold(args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A free steel-like rod of 10 elements, with `analysis` and `extra` text.
+fn free_rod_file(analysis: &str, extra: &str) -> String {
+    format!(
+        r#"
+title = "free rod"
+{analysis}
+
+[[sections]]
+name = "s"
+EA = 2.0e7
+GA2 = 7.0e6
+GA3 = 7.0e6
+GJ = 400.0
+EI2 = 550.0
+EI3 = 550.0
+mass_per_length = 0.85
+inertia_per_length = [4.2e-5, 2.1e-5, 2.1e-5]
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 11
+x = [1.0, 0.0, 0.0]
+
+[[beam_lines]]
+nodes = [1, 11]
+elements = 10
+section = "s"
+orientation = [0.0, 1.0, 0.0]
+first_node = 2
+first_element = 1
+{extra}
+"#
+    )
+}
+
+/// `unfold check` and `unfold run` of a modal analysis of a free rod: the
+/// files of docs/results.md ("Modes"), six zero modes, the frequencies on
+/// stderr and in summary.json, a grid per mode with the shape as its
+/// point vectors.
+#[test]
+fn cli_runs_a_modal_analysis() {
+    let dir = scratch("run");
+    let model = dir.join("free.toml");
+    std::fs::write(
+        &model,
+        free_rod_file("[analysis]\ntype = \"modal\"\nmodes = 8", ""),
+    )
+    .unwrap();
+    let (code, out, err) = unfold(&["check", model.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(
+        out.contains("valid model") && out.contains("modal at t = 0: 8 modes, solver auto"),
+        "{out}"
+    );
+
+    let results = dir.join("out");
+    let (code, out, err) = unfold(&[
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        results.to_str().unwrap(),
+        "--vtk-ascii",
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(
+        err.contains("modal analysis at t = 0: 8 modes (6 rigid-body or mechanism)"),
+        "{err}"
+    );
+    assert!(err.contains("mode   7"), "{err}");
+    let modes = std::fs::read_to_string(results.join("modes.csv")).unwrap();
+    let lines: Vec<&str> = modes.lines().collect();
+    assert!(lines[0].starts_with("analysis,mode,frequency_hz,omega_rad_s"));
+    assert_eq!(lines.len(), 9);
+    let zero: Vec<bool> = lines[1..]
+        .iter()
+        .map(|l| l.split(',').nth(9) == Some("1"))
+        .collect();
+    assert_eq!(zero, [true, true, true, true, true, true, false, false]);
+    let shapes = std::fs::read_to_string(results.join("mode_shapes.csv")).unwrap();
+    // a line per mode and node, after the header
+    assert_eq!(shapes.lines().count(), 1 + 8 * 11);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(results.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["status"], "completed");
+    assert_eq!(summary["modes"][0]["zero_modes"], 6);
+    assert_eq!(
+        summary["modes"][0]["frequencies_hz"]
+            .as_array()
+            .unwrap()
+            .len(),
+        8
+    );
+    assert_eq!(summary["analyses"][0]["type"], "modal");
+    let pvd = std::fs::read_to_string(results.join("modes.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 8);
+    let grid = std::fs::read_to_string(results.join("vtk/mode_0007.vtu")).unwrap();
+    assert!(
+        grid.contains("Vectors=\"mode_displacement\"") && grid.contains("Name=\"mode_rotation\"")
+    );
+
+    // a second run in the same directory with fewer modes leaves no grid
+    // of the first
+    std::fs::write(
+        &model,
+        free_rod_file("[analysis]\ntype = \"modal\"\nmodes = 7", ""),
+    )
+    .unwrap();
+    let (code, _, err) = unfold(&[
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        results.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!results.join("vtk/mode_0008.vtu").exists());
+}
+
+/// A static analysis that fails stops the run: the modal analysis after it
+/// is not run. Here a tip force bends the clamped rod further than three
+/// Newton iterations per increment can follow, with a coarse smallest
+/// increment (as in tests/cli.rs): exit code 1.
+#[test]
+fn cli_does_not_run_a_modal_analysis_after_a_failed_one() {
+    let dir = scratch("after-failure");
+    let model = dir.join("m.toml");
+    let plan = "[[analysis]]\ntype = \"static\"\ninitial_increment = 0.05\nmax_iterations = 3\nmin_increment = 0.01\n\n[[analysis]]\ntype = \"modal\"\n";
+    let extra = "[[supports]]\nnode = 1\nfixed = [\"all\"]\n\n[[loads]]\nnode = 11\nforce = [0.0, 0.0, -5.0e3]\n";
+    std::fs::write(&model, free_rod_file(plan, extra)).unwrap();
+    let results = dir.join("out");
+    let (code, out, err) = unfold(&[
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        results.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("no convergence"), "{err}");
+    assert!(!err.contains("modal analysis at"), "{err}");
+    assert!(!results.join("modes.csv").exists());
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(results.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["status"], "failed");
+    assert_eq!(summary["analyses"].as_array().unwrap().len(), 1);
+    assert!(summary.get("modes").is_none());
+}
+
+/// Input errors of modal analyses: exit code 2, the file named, and what
+/// is wrong: no mass (run and check), bad settings.
+#[test]
+fn cli_rejects_bad_modal_input() {
+    let dir = scratch("bad");
+    let massless = free_rod_file("[analysis]\ntype = \"modal\"", "")
+        .replace("mass_per_length = 0.85\n", "")
+        .replace("inertia_per_length = [4.2e-5, 2.1e-5, 2.1e-5]\n", "");
+    let cases = [
+        (
+            "massless.toml",
+            massless,
+            vec!["no mass", "mass_per_length"],
+        ),
+        (
+            "zero_modes.toml",
+            free_rod_file("[analysis]\ntype = \"modal\"\nmodes = 0", ""),
+            vec!["analysis", "modes must be from 1"],
+        ),
+        (
+            "solver.toml",
+            free_rod_file("[analysis]\ntype = \"modal\"\nsolver = \"qr\"", ""),
+            vec!["unknown solver \"qr\"", "dense, lanczos"],
+        ),
+        (
+            "range.toml",
+            free_rod_file(
+                "[analysis]\ntype = \"modal\"\nfrequency_range = [10.0, 5.0]",
+                "",
+            ),
+            vec!["frequency_range must be [low, high]"],
+        ),
+        (
+            "increment.toml",
+            free_rod_file("[analysis]\ntype = \"modal\"\ninitial_increment = 0.1", ""),
+            vec!["initial_increment does not apply to a modal analysis"],
+        ),
+        (
+            "static_modes.toml",
+            free_rod_file(
+                "[analysis]\nmodes = 4",
+                "[[supports]]\nnode = 1\nfixed = [\"all\"]\n",
+            ),
+            vec!["modes applies to a modal analysis"],
+        ),
+    ];
+    for (name, text, fragments) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        for command in ["check", "run"] {
+            let out = dir.join("out");
+            let (code, _, err) = unfold(
+                &[
+                    command,
+                    path.to_str().unwrap(),
+                    "--out",
+                    out.to_str().unwrap(),
+                ][..if command == "check" { 2 } else { 4 }],
+            );
+            assert_eq!(code, 2, "{command} {name}: {err}");
+            assert!(err.contains(name), "{command} {name}: {err}");
+            for f in &fragments {
+                assert!(err.contains(f), "{command} {name}: lacks «{f}»: {err}");
+            }
+        }
+    }
+}

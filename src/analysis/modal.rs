@@ -172,6 +172,23 @@ impl ModalAnalysis {
         &self.solver
     }
 
+    /// Whether `model` has mass on its free unknowns (in its reference
+    /// configuration): without it a modal analysis fails with
+    /// [`ModalError::NoMass`]. The check of `unfold check`.
+    pub fn has_mass(model: &Model) -> bool {
+        let dofs = crate::dofs::DofMap::new(model);
+        let mut assembler = Assembler::new(model, &dofs);
+        let (mut k, mut m) = (assembler.matrix.clone(), assembler.matrix.clone());
+        let mut state = model.initial_state();
+        model.apply_prescribed(&mut state, 0.0);
+        let ctx = model.context(0.0, Need::with_inertia(0.0, 1.0));
+        assembler.assemble_split(model, &ctx, &state, &mut k, &mut m);
+        let multiplier: Vec<bool> = (0..dofs.n_equations())
+            .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
+            .collect();
+        has_mass(&m, &multiplier)
+    }
+
     /// The modes of the model linearised about `start` (at its time).
     pub fn run(&mut self, start: State, observer: &mut dyn Observer) -> ModalOutcome {
         let started = Instant::now();
@@ -235,10 +252,7 @@ impl ModalAnalysis {
         }
 
         // a model without mass has no modes
-        let has_mass = m
-            .entries()
-            .any(|(i, j, v)| i == j && !multiplier[i] && v != 0.0);
-        let result = if has_mass {
+        let result = if has_mass(&m, &multiplier) {
             let pencil = Pencil {
                 stiffness: &k,
                 mass: &m,
@@ -266,6 +280,13 @@ impl ModalAnalysis {
         outcome.wall_time = started.elapsed().as_secs_f64();
         outcome
     }
+}
+
+/// Whether the mass matrix has a non-zero diagonal entry on an unknown
+/// (it is positive semi-definite: otherwise it is zero there).
+fn has_mass(m: &crate::linalg::SparseMatrix, multiplier: &[bool]) -> bool {
+    m.entries()
+        .any(|(i, j, v)| i == j && !multiplier[i] && v != 0.0)
 }
 
 /// `ω² = (2π f)²` of a frequency in Hz.

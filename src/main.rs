@@ -6,13 +6,15 @@
 //! ```
 //! A model file with a sequence of analyses (`[[analysis]]`) runs them in
 //! order, each from the final state of the one before, into one set of
-//! result files.
+//! result files. A modal analysis (`type = "modal"`) linearises about the
+//! state it is given and leaves it unchanged; its first frequencies are
+//! printed on stderr.
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
 //! written so far are kept) or results could not be written (each error
 //! names its file; the output directory in use by another run); 2 the
 //! command line or the model file is invalid, including a model whose
 //! tangent is singular from the start (a mechanism or an unrestrained
-//! structure); 128 + the signal number (130 SIGINT, 143 SIGTERM, 129
+//! structure) and a modal analysis of a model without mass; 128 + the signal number (130 SIGINT, 143 SIGTERM, 129
 //! SIGHUP) the run was interrupted, with consistent results up to the last
 //! converged increment and `summary.json` saying `interrupted`.
 
@@ -26,7 +28,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use unfold::analysis::preflight;
 use unfold::analysis::statics::StaticError;
 use unfold::analysis::{
-    AnalysisSettings, IncrementInfo, NewtonFailure, StaticAnalysis, StaticSettings,
+    AnalysisSettings, IncrementInfo, ModalAnalysis, ModalError, ModalOutcome, ModalSettings,
+    NewtonFailure, StaticAnalysis, StaticOutcome,
 };
 use unfold::io::model_file::read_model;
 use unfold::io::run::{
@@ -171,10 +174,29 @@ fn check(path: &Path) -> ExitCode {
         }
     };
     print_warnings(path, &model);
-    let Some(settings) = static_settings(path, &analyses) else {
+    if !supported(path, &analyses) {
         return ExitCode::from(EXIT_INPUT);
+    }
+    if analyses.iter().any(|a| a.as_modal().is_some()) && !ModalAnalysis::has_mass(&model) {
+        eprintln!(
+            "error: {}: modal analysis: {}",
+            path.display(),
+            ModalError::NoMass
+        );
+        return ExitCode::from(EXIT_INPUT);
+    }
+    let Some(first_static) = analyses.iter().find_map(|a| a.as_static()) else {
+        // modal analyses only: nothing to solve before them
+        println!(
+            "{}: valid model: {}; {} unknowns",
+            path.display(),
+            describe(&model),
+            ModalAnalysis::new(model.clone(), ModalSettings::lowest(1)).n_equations()
+        );
+        print_modal_plan(&analyses);
+        return ExitCode::SUCCESS;
     };
-    match preflight::check(&model, &settings[0]) {
+    match preflight::check(&model, first_static) {
         Ok(report) => {
             for w in &report.warnings {
                 eprintln!("warning: {}: {w}", path.display());
@@ -194,6 +216,7 @@ fn check(path: &Path) -> ExitCode {
                     report.redundant_constraints
                 );
             }
+            print_modal_plan(&analyses);
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -203,18 +226,72 @@ fn check(path: &Path) -> ExitCode {
     }
 }
 
-/// The settings of the analyses, all static ones (the analyses this tool
-/// runs); `None`, after an error message, if one is of another type.
-fn static_settings(path: &Path, plan: &[AnalysisSettings]) -> Option<Vec<StaticSettings>> {
-    let settings: Option<Vec<StaticSettings>> =
-        plan.iter().map(|a| a.as_static().cloned()).collect();
-    if settings.is_none() || plan.is_empty() {
+/// Whether every analysis of `plan` is one this tool runs (static,
+/// kinematic, modal); if not, after an error message.
+fn supported(path: &Path, plan: &[AnalysisSettings]) -> bool {
+    let all = !plan.is_empty()
+        && plan
+            .iter()
+            .all(|a| a.as_static().is_some() || a.as_modal().is_some());
+    if !all {
         eprintln!(
             "error: {}: an analysis of this model is not one this version runs",
             path.display()
         );
     }
-    settings.filter(|s| !s.is_empty())
+    all
+}
+
+/// One line per modal analysis of `plan`, for `unfold check`.
+fn print_modal_plan(plan: &[AnalysisSettings]) {
+    for (k, a) in plan.iter().enumerate() {
+        if let Some(m) = a.as_modal() {
+            let mut what = format!("{} modes", m.modes);
+            if let Some(f) = m.shift {
+                what += &format!(" nearest {f} Hz");
+            }
+            if let Some((lo, hi)) = m.frequency_range {
+                what += &format!(" in [{lo}, {hi}] Hz");
+            }
+            println!(
+                "analysis {}: modal at t = {}: {what}, solver {}",
+                k + 1,
+                m.time,
+                unfold::io::modes::solver_name(m.solver)
+            );
+        }
+    }
+}
+
+/// Prints the first frequencies of a modal analysis on stderr.
+fn print_modes(outcome: &ModalOutcome) {
+    const SHOWN: usize = 10;
+    eprintln!(
+        "modal analysis at t = {}: {} modes ({} rigid-body or mechanism), {} unknowns, {:.3} s",
+        outcome.time,
+        outcome.modes.len(),
+        outcome.zero_modes,
+        outcome.unknowns,
+        outcome.wall_time
+    );
+    for (k, m) in outcome.modes.iter().take(SHOWN).enumerate() {
+        eprintln!(
+            "  mode {:3}  {:>14.6e} Hz  {:>14.6e} rad/s{}",
+            k + 1,
+            m.frequency,
+            m.angular_frequency,
+            if m.is_zero() { "  (zero mode)" } else { "" }
+        );
+    }
+    if outcome.modes.len() > SHOWN {
+        eprintln!("  ... {} more in modes.csv", outcome.modes.len() - SHOWN);
+    }
+}
+
+/// An analysis of the plan, ready to run.
+enum Planned {
+    Static(Box<StaticAnalysis>),
+    Modal(Box<ModalAnalysis>),
 }
 
 /// Shows a run in the terminal: log lines (unless quiet) above a progress
@@ -287,24 +364,34 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         m.warnings.extend(report.warnings.iter().cloned());
     }
     print_warnings(path, &model);
-    let Some(settings) = static_settings(path, &plan) else {
+    if !supported(path, &plan) {
         return ExitCode::from(EXIT_INPUT);
-    };
-    let mut analyses = settings
-        .into_iter()
-        .map(|s| StaticAnalysis::new(model.clone(), s));
-    let Some(mut analysis) = analyses.next() else {
+    }
+    let mut analyses = plan
+        .iter()
+        .filter_map(|a| match (a.as_static(), a.as_modal()) {
+            (Some(s), _) => Some(Planned::Static(Box::new(StaticAnalysis::new(
+                model.clone(),
+                s.clone(),
+            )))),
+            (_, Some(m)) => Some(Planned::Modal(Box::new(ModalAnalysis::new(
+                model.clone(),
+                m.clone(),
+            )))),
+            _ => None,
+        });
+    let Some(first) = analyses.next() else {
         return ExitCode::SUCCESS;
     };
     let label = path.display().to_string();
-    if let Err(e) = checked {
+    if let (Err(e), Planned::Static(analysis)) = (checked, &first) {
         // invalid input: summary.json alone says why
         eprintln!("error: {}: {e}", path.display());
         let rejected = unfold::io::results::write_rejected(
             out,
             &label,
             &model,
-            &analysis,
+            analysis,
             &plan,
             &e.to_string(),
         );
@@ -324,7 +411,10 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         quiet,
         end_time: plan.last().map_or(1.0, |a| a.end_time()),
     };
-    let recorder = Recorder::create_sequence(out, &label, &analysis, &plan, terminal);
+    let recorder = match &first {
+        Planned::Static(a) => Recorder::create_sequence(out, &label, a, &plan, terminal),
+        Planned::Modal(a) => Recorder::create_modal_first(out, &label, a, &plan, terminal),
+    };
     let mut recorder = match recorder {
         Ok(r) => r.with_stop(&stop).with_vtk_encoding(encoding),
         Err(e) => {
@@ -332,17 +422,55 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
             return ExitCode::from(EXIT_FAILED);
         }
     };
-    // the analyses in order, each from the final state of the one before
-    let mut outcome = analysis.run(model.initial_state(), &mut recorder);
-    for mut next in analyses {
-        if outcome.error.is_some() {
-            break;
+    // the analyses in order, each from the final state of the one before;
+    // none after one that failed
+    let mut state = model.initial_state();
+    let mut last_static: Option<StaticOutcome> = None;
+    let mut after_modal = false;
+    let mut modal_error: Option<ModalError> = None;
+    let mut modal_output_error = false;
+    for (k, planned) in std::iter::once(first).chain(analyses).enumerate() {
+        match planned {
+            Planned::Static(mut analysis) => {
+                match (&last_static, after_modal) {
+                    (Some(previous), false) => recorder.next_analysis(previous, &analysis),
+                    _ if k > 0 => recorder.open_static(&analysis, state.time),
+                    _ => {}
+                }
+                let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
+                state = std::mem::take(&mut outcome.state);
+                let failed = outcome.error.is_some();
+                last_static = Some(outcome);
+                after_modal = false;
+                if failed {
+                    break;
+                }
+            }
+            Planned::Modal(mut analysis) => {
+                let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
+                if let Err(e) = recorder.record_modal(last_static.as_ref(), &analysis, &outcome) {
+                    eprintln!("error: cannot write results: {e}");
+                    modal_output_error = true;
+                }
+                state = std::mem::take(&mut outcome.state);
+                after_modal = true;
+                if let Some(e) = outcome.error.take() {
+                    eprintln!(
+                        "error: {}: modal analysis at t = {}: {e}",
+                        path.display(),
+                        state.time
+                    );
+                    modal_error = Some(e);
+                    break;
+                }
+                print_modes(&outcome);
+                if modal_output_error {
+                    break;
+                }
+            }
         }
-        recorder.next_analysis(&outcome, &next);
-        let start = std::mem::take(&mut outcome.state);
-        outcome = next.run(start, &mut recorder);
     }
-    let report = recorder.finish(&outcome);
+    let report = recorder.finish_with(last_static.as_ref());
 
     for e in &report.output_errors {
         eprintln!("error: cannot write results: {e}");
@@ -360,10 +488,25 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         eprintln!(
             "{}: {i} at t = {}; {kept}",
             path.display(),
-            format_time(outcome.time)
+            format_time(state.time)
         );
         return ExitCode::from(i.exit_code());
     }
+    match modal_error {
+        Some(ModalError::NoMass) => return ExitCode::from(EXIT_INPUT),
+        Some(_) => return ExitCode::from(EXIT_FAILED),
+        None => {}
+    }
+    if modal_output_error {
+        return ExitCode::from(EXIT_FAILED);
+    }
+    let Some(outcome) = &last_static else {
+        return if report.output_errors.is_empty() {
+            ExitCode::SUCCESS
+        } else {
+            ExitCode::from(EXIT_FAILED)
+        };
+    };
     if let Some(e) = &outcome.error {
         eprintln!("error: {}: {e}", path.display());
         // a model that is singular from the start is invalid input

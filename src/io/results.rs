@@ -192,6 +192,10 @@ pub struct Summary {
     pub analyses: Vec<AnalysisRecord>,
     /// Every converged increment.
     pub increment_log: Vec<IncrementRecord>,
+    /// What each modal analysis of the run found (docs/results.md,
+    /// "Modes").
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<super::modes::ModalRecord>,
     /// Iterations of the initial equilibria, left out of the average.
     #[serde(skip)]
     initial_iterations: usize,
@@ -210,6 +214,28 @@ impl Summary {
         first: &StaticAnalysis,
         plan: &[AnalysisSettings],
     ) -> Self {
+        let end_time = plan
+            .last()
+            .map_or(first.settings().end_time, |a| a.end_time());
+        Self::start_with(
+            model_file,
+            model,
+            first.n_equations(),
+            first.solver().nnz(),
+            end_time,
+        )
+    }
+
+    /// The summary of a run on `model` (read from `model_file`) whose first
+    /// analysis has `dofs` unknowns and `nonzeros` non-zeros in its matrix,
+    /// ending at `end_time`, that has not started.
+    pub fn start_with(
+        model_file: &str,
+        model: &Model,
+        dofs: usize,
+        nonzeros: usize,
+        end_time: f64,
+    ) -> Self {
         let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
         Self {
             model: model_file.to_string(),
@@ -222,23 +248,22 @@ impl Summary {
             joints: count(ElementKind::Joint),
             drivers: count(ElementKind::Driver),
             redundant_constraints: 0,
-            dofs: first.n_equations(),
-            nonzeros: first.solver().nnz(),
+            dofs,
+            nonzeros,
             increments: 0,
             iterations: 0,
             average_iterations: 0.0,
             wasted_iterations: 0,
             cutbacks: 0,
             final_time: 0.0,
-            end_time: plan
-                .last()
-                .map_or(first.settings().end_time, |a| a.end_time()),
+            end_time,
             wall_time_s: 0.0,
             output_steps: 0,
             analyses: Vec::new(),
             increment_log: Vec::new(),
+            modes: Vec::new(),
             initial_iterations: 0,
-            unknowns: first.n_equations(),
+            unknowns: dofs,
         }
     }
 
@@ -570,6 +595,7 @@ impl ResultWriter {
         };
 
         remove_leftovers(dir, writes)?;
+        super::modes::remove_leftovers(dir)?;
 
         let mut node_order: Vec<usize> = (0..model.n_nodes()).collect();
         node_order.sort_by_key(|&i| model.node_ids[i]);

@@ -36,6 +36,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicI32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
+use super::modes::ModalFiles;
 use super::results::{file_error, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
@@ -46,6 +47,8 @@ use crate::analysis::{
 use crate::elements::ElementKind;
 use crate::model::Model;
 use crate::state::State;
+
+mod modal;
 
 /// What a person watching the run sees. Every method has an empty
 /// default.
@@ -329,6 +332,14 @@ pub struct Recorder {
     current: Running,
     /// Increments of the analyses before the running one.
     increment_offset: usize,
+    /// Whether `current` is a static analysis not yet closed.
+    open: bool,
+    /// Why a modal analysis of the run failed, if one did.
+    failure: Option<String>,
+    /// The result files of the modal analyses.
+    modal: ModalFiles,
+    /// Encoding of the grids.
+    encoding: Encoding,
 }
 
 /// The analysis being recorded.
@@ -379,9 +390,29 @@ impl Recorder {
         console: impl Console + 'static,
     ) -> io::Result<Self> {
         let model = &**first.model();
+        let summary = Summary::start(model_file, model, first, plan);
+        let running = Running::of(0, first);
+        let unknowns = first.n_equations();
+        Self::create_with(
+            dir, model_file, model, summary, running, unknowns, plan, console,
+        )
+    }
+
+    /// The recorder of a run of `plan` whose first analysis is `running`,
+    /// a static one if `running.kind` is not `modal`.
+    #[allow(clippy::too_many_arguments)]
+    fn create_with(
+        dir: &Path,
+        model_file: &str,
+        model: &Model,
+        summary: Summary,
+        running: Running,
+        unknowns: usize,
+        plan: &[AnalysisSettings],
+        console: impl Console + 'static,
+    ) -> io::Result<Self> {
         let writer = ResultWriter::create(dir, model)?;
         let log = LogFile::create(dir.join("log.txt"))?;
-        let summary = Summary::start(model_file, model, first, plan);
         let mut recorder = Self {
             writer,
             log,
@@ -390,26 +421,37 @@ impl Recorder {
             end_time: summary.end_time,
             summary,
             analyses: plan.len().max(1),
-            current: Running::of(0, first),
+            open: running.kind != "modal",
+            current: running,
             increment_offset: 0,
+            failure: None,
+            modal: ModalFiles::default(),
+            encoding: Encoding::default(),
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
                 .iter()
-                .map(|a| format!("{} to t = {}", a.name(), format_time(a.end_time())))
+                .map(|a| match a.as_modal() {
+                    Some(m) => format!("modal at t = {}", format_time(m.time)),
+                    None => format!("{} to t = {}", a.name(), format_time(a.end_time())),
+                })
                 .collect();
             format!("{} analyses: {}", plan.len(), each.join(", "))
         } else {
-            format!(
-                "{} analysis to t = {}",
-                recorder.current.kind,
-                format_time(recorder.current.end_time)
-            )
+            match recorder.current.kind {
+                "modal" => format!(
+                    "modal analysis at t = {}",
+                    format_time(recorder.current.end_time)
+                ),
+                kind => format!(
+                    "{kind} analysis to t = {}",
+                    format_time(recorder.current.end_time)
+                ),
+            }
         };
         recorder.line(&format!(
-            "{model_file}: {}; {} unknowns; {analyses}",
+            "{model_file}: {}; {unknowns} unknowns; {analyses}",
             describe(model),
-            first.n_equations(),
         ));
         // warnings are shown by the caller; the log keeps them with the run
         for w in &model.warnings {
@@ -428,6 +470,7 @@ impl Recorder {
     pub fn next_analysis(&mut self, outcome: &StaticOutcome, next: &StaticAnalysis) {
         self.close(outcome);
         self.current = Running::of(self.current.index + 1, next);
+        self.open = true;
         self.line(&format!(
             "analysis {} of {}: {} from t = {} to t = {}",
             self.current.index + 1,
@@ -440,6 +483,9 @@ impl Recorder {
 
     /// Adds the running analysis's `outcome` to the summary.
     fn close(&mut self, outcome: &StaticOutcome) {
+        if !std::mem::replace(&mut self.open, false) {
+            return;
+        }
         let c = &self.current;
         self.summary.add(
             c.kind,
@@ -468,6 +514,7 @@ impl Recorder {
     /// Writes the grids in `encoding` (binary by default).
     pub fn with_vtk_encoding(mut self, encoding: Encoding) -> Self {
         self.writer = self.writer.with_vtk_encoding(encoding);
+        self.encoding = encoding;
         self
     }
 
@@ -491,16 +538,29 @@ impl Recorder {
     /// the status (completed, failed or interrupted), the last line of
     /// `log.txt`, and `summary.json`. Write errors are returned in the
     /// report, not lost.
-    pub fn finish(mut self, outcome: &StaticOutcome) -> RunReport {
-        self.close(outcome);
-        let interrupted = outcome.error.as_ref().and_then(Interrupted::of);
-        let (status, message) = match (&outcome.error, interrupted) {
-            (None, _) => (RunStatus::Completed, None),
-            (Some(_), Some(i)) => (
+    pub fn finish(self, outcome: &StaticOutcome) -> RunReport {
+        self.finish_with(Some(outcome))
+    }
+
+    /// As [`Recorder::finish`], for a run whose last static analysis (if
+    /// any) returned `outcome`; a failed modal analysis fails the run.
+    pub fn finish_with(mut self, outcome: Option<&StaticOutcome>) -> RunReport {
+        let error = outcome.and_then(|o| o.error.as_ref());
+        if let Some(o) = outcome {
+            self.close(o);
+        }
+        let interrupted = error.and_then(Interrupted::of);
+        let (status, message) = match (error, interrupted, self.failure.take()) {
+            (None, _, None) => (RunStatus::Completed, None),
+            (None, _, Some(failure)) => (RunStatus::Failed, Some(failure)),
+            (Some(_), Some(i), _) => (
                 RunStatus::Interrupted,
-                Some(format!("{i} at t = {}", format_time(outcome.time))),
+                Some(format!(
+                    "{i} at t = {}",
+                    format_time(self.summary.final_time)
+                )),
             ),
-            (Some(e), None) => (RunStatus::Failed, Some(e.to_string())),
+            (Some(e), None, _) => (RunStatus::Failed, Some(e.to_string())),
         };
         self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
@@ -578,7 +638,8 @@ impl Observer for Recorder {
         }
         // a later analysis starts at the final state of the one before,
         // written already: its equilibrium there is logged, not written
-        let restart = info.increment == 0 && self.current.index > 0;
+        let restart =
+            info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
         let info = &self.renumbered(info);
         let residuals: Vec<String> = info.residuals.iter().map(|r| format!("{r:.1e}")).collect();
         self.line(&format!(

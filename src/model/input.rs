@@ -340,8 +340,9 @@ impl<'de> Deserialize<'de> for Analyses {
 #[serde(deny_unknown_fields)]
 pub struct AnalysisInput {
     /// Analysis type: `"static"` (default) or its alias `"kinetostatic"`
-    /// (nonlinear statics, loads and drivers), or `"kinematic"` (the
-    /// joints and drivers must determine every unknown).
+    /// (nonlinear statics, loads and drivers), `"kinematic"` (the
+    /// joints and drivers must determine every unknown), or `"modal"`
+    /// (natural frequencies and modes about the state reached).
     #[serde(rename = "type", default = "default_analysis_type")]
     pub kind: String,
     /// Final value of the load parameter `t` (pseudo-time), default 1 (each
@@ -395,6 +396,19 @@ pub struct AnalysisInput {
     /// Arc-length control: largest number of increments, default 1000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_increments: Option<usize>,
+    /// Modal analysis: number of modes, default 10.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modes: Option<usize>,
+    /// Modal analysis: frequency (Hz) near which the modes are sought.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shift: Option<f64>,
+    /// Modal analysis: only the modes in `[low, high]` (Hz).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frequency_range: Option<[f64; 2]>,
+    /// Modal analysis: eigen-solver, `auto` (default), `dense` or
+    /// `lanczos`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solver: Option<String>,
 }
 
 fn default_analysis_type() -> String {
@@ -422,6 +436,10 @@ impl Default for AnalysisInput {
             constraint_penalty: None,
             control: None,
             max_increments: None,
+            modes: None,
+            shift: None,
+            frequency_range: None,
+            solver: None,
         }
     }
 }

@@ -336,7 +336,9 @@ impl Model {
         if ck.errors.is_empty() {
             if elements.iter().all(|e| e.kind() == ElementKind::NodalLoad) {
                 ck.push(ModelErrorKind::Missing, "model", "has no elements");
-            } else {
+            } else if !plan.modal_only {
+                // a free structure has rigid-body modes, but no static
+                // equilibrium
                 checks::check_restraint(&mut ck, &node_ids, &elements, &fixed);
             }
         }

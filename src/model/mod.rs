@@ -33,7 +33,7 @@ pub use build::{
 pub use builder::ModelBuilder;
 pub use handles::{
     BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, JointHandle,
-    JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle, SpringHandle,
+    JointSpringHandle, HingeLawHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle, SpringHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.

@@ -148,7 +148,9 @@ impl TapeSpring {
         );
         let cl = self.locking_angle;
         // end segments long enough not to limit the rounding
-        let reach = (2.0 * self.rounding).max(self.snap_width).max(1e-3 * cl.abs().max(1.0));
+        let reach = (2.0 * self.rounding)
+            .max(self.snap_width)
+            .max(1e-3 * cl.abs().max(1.0));
         let ca = cl - md / k;
         let load = vec![(ca - reach, -md), (ca, -md), (ca + reach, -md + k * reach)];
         let cu = cl - ml / k;
@@ -415,7 +417,16 @@ impl Element for HingeLaw {
     }
     fn results(&self, _ctx: &EvalContext, state: &State, out: &mut [f64]) {
         let (c, r) = self.response(state);
-        out[..3].copy_from_slice(&[c, r.moment, r.branch]);
+        // at a converged state (c = c_n) the trial is M_n itself and says
+        // nothing of the direction of motion: the branch is the one the
+        // increment that led there ended on (where the bounds meet, 1 if
+        // c increased, −1 if it decreased)
+        let branch = if c == state.internal[self.internal] {
+            state.internal[self.internal + 2]
+        } else {
+            r.branch
+        };
+        out[..3].copy_from_slice(&[c, r.moment, branch]);
     }
     fn cell_shape(&self) -> CellShape {
         CellShape::None

@@ -87,12 +87,18 @@ fn tape_spring(
     bad(
         &mut ok,
         cl.is_finite(),
-        format!("tape_spring: locking_angle must be finite, got {}", t.locking_angle),
+        format!(
+            "tape_spring: locking_angle must be finite, got {}",
+            t.locking_angle
+        ),
     );
     bad(
         &mut ok,
         w.is_finite() && w > 0.0,
-        format!("tape_spring: snap_width must be positive and finite, got {}", t.snap_width),
+        format!(
+            "tape_spring: snap_width must be positive and finite, got {}",
+            t.snap_width
+        ),
     );
     let rounding = match t.rounding {
         Some(h) => {

@@ -47,8 +47,9 @@ pub use mechanism::{Driver, HingeLaw, Joint, JointSpring};
 pub use structure::{Beam, BeamLine, Node, PointMass, RigidBody, Section, SectionHandle, Spring};
 
 pub use super::handles::{
-    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, JointHandle,
-    JointSpringHandle, HingeLawHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle, SpringHandle,
+    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
+    JointHandle, JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle,
+    SpringHandle,
 };
 pub use super::input::{AngleUnit, StartBranch, TapeSpringInput as TapeSpring};
 pub use super::{Id, Model, ModelErrors};

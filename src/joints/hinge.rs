@@ -432,3 +432,56 @@ impl Element for HingeLaw {
         CellShape::None
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rounded corner is C¹ and lies on the parabola of its definition:
+    /// corner of slopes 0 → 2 at (1, 0), h = 0.1: f(1) = Δs h/4 = 0.05,
+    /// value and slope continuous at 1 ± h (to round-off, 1e-14).
+    #[test]
+    fn rounded_corner_is_c1() {
+        let b = Branch::new(vec![(0.0, 0.0), (1.0, 0.0), (2.0, 2.0)], 0.1);
+        assert!((b.eval(1.0).0 - 0.05).abs() < 1e-15);
+        assert!((b.eval(1.0).1 - 1.0).abs() < 1e-15);
+        for x in [0.9, 1.1] {
+            let e = 1e-12;
+            let (l, r) = (b.eval(x - e), b.eval(x + e));
+            assert!(
+                (l.0 - r.0).abs() < 1e-11 && (l.1 - r.1).abs() < 1e-10,
+                "{x}"
+            );
+        }
+        assert_eq!(b.eval(0.5), (0.0, 0.0));
+        assert_eq!(b.eval(3.0), (4.0, 2.0));
+    }
+
+    /// `crossing` finds a dip of `f_load − f_unload` below zero that lies
+    /// strictly between breaks (inside a rounded corner of the unloading
+    /// bound, which rises above the flat loading bound there by 0.005 at
+    /// c = 1), and accepts bounds that touch.
+    #[test]
+    fn crossing_is_found_between_breaks() {
+        // unload: V-corner at (1, −0.045), slopes −1 → 1, h = 0.2: the
+        // parabola's lowest point −0.045 + 0.05 = 0.005 > 0 = f_load
+        let unload = Branch::new(vec![(0.0, 0.955), (1.0, -0.045), (2.0, 0.955)], 0.2);
+        let load = Branch::new(vec![(0.0, 1.0), (0.5, 0.0), (1.5, 0.0), (2.0, 1.0)], 0.0);
+        let law = Hysteresis {
+            load,
+            unload,
+            elastic: 10.0,
+        };
+        let c = law.crossing().expect("the dip is found");
+        assert!((c - 1.0).abs() < 0.2, "{c}");
+        // touching bounds are accepted
+        let same = Branch::new(vec![(0.0, 0.0), (1.0, 1.0), (2.0, 0.0)], 0.3);
+        let law = Hysteresis {
+            load: same.clone(),
+            unload: same,
+            elastic: 1.0,
+        };
+        assert_eq!(law.crossing(), None);
+        assert_eq!(law.band(), None);
+    }
+}

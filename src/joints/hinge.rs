@@ -457,16 +457,15 @@ mod tests {
         assert_eq!(b.eval(3.0), (4.0, 2.0));
     }
 
-    /// `crossing` finds a dip of `f_load − f_unload` below zero that lies
-    /// strictly between breaks (inside a rounded corner of the unloading
-    /// bound, which rises above the flat loading bound there by 0.005 at
-    /// c = 1), and accepts bounds that touch.
+    /// `crossing` finds where a rounded corner of the unloading bound
+    /// rises above the loading bound: bounds 0.01 apart with the same
+    /// corner at c = 1 (slopes −1 → 1), the loading one sharp, the
+    /// unloading one rounded with h = 0.2, whose parabola reaches
+    /// −0.01 + 2·0.2/4 = 0.09 > 0 at c = 1.
     #[test]
-    fn crossing_is_found_between_breaks() {
-        // unload: V-corner at (1, −0.045), slopes −1 → 1, h = 0.2: the
-        // parabola's lowest point −0.045 + 0.05 = 0.005 > 0 = f_load
-        let unload = Branch::new(vec![(0.0, 0.955), (1.0, -0.045), (2.0, 0.955)], 0.2);
-        let load = Branch::new(vec![(0.0, 1.0), (0.5, 0.0), (1.5, 0.0), (2.0, 1.0)], 0.0);
+    fn crossing_is_found_inside_a_rounded_corner() {
+        let load = Branch::new(vec![(0.0, 1.0), (1.0, 0.0), (2.0, 1.0)], 0.0);
+        let unload = Branch::new(vec![(0.0, 0.99), (1.0, -0.01), (2.0, 0.99)], 0.2);
         let law = Hysteresis {
             load,
             unload,

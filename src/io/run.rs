@@ -236,6 +236,10 @@ pub fn format_time(t: f64) -> String {
 /// The size of a model in one line: nodes and elements of each kind.
 pub fn describe(model: &Model) -> String {
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
+    let hinge_laws = match count(ElementKind::HingeLaw) {
+        0 => String::new(),
+        n => format!(", {n} hinge laws"),
+    };
     format!(
         "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
         model.n_nodes(),
@@ -247,7 +251,7 @@ pub fn describe(model: &Model) -> String {
         count(ElementKind::JointSpring),
         count(ElementKind::Driver),
         count(ElementKind::NodalLoad),
-    )
+    ) + &hinge_laws
 }
 
 /// `log.txt`: a line per increment, iteration, cut-back and note. A write

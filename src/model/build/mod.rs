@@ -13,6 +13,7 @@ mod beams;
 mod checks;
 mod curves;
 mod drivers;
+mod hinge_laws;
 mod joint_springs;
 mod joints;
 mod loads;
@@ -265,6 +266,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.loads.len(),
         input.joints.len(),
         input.joint_springs.len(),
+        input.hinge_laws.len(),
         input.drivers.len(),
         generated,
     ]

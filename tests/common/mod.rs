@@ -1,6 +1,10 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod elliptic;
+pub mod quadrature;
+pub mod rigid_body;
+
 use std::sync::Arc;
 
 use unfold::analysis::observers::History;

@@ -43,11 +43,28 @@ fn unfold(args: &[&str]) -> (i32, String, String) {
 /// The driven bend with the analyses ending at `sequence` (increments of
 /// 0.125 throughout) and a tip load `p`.
 fn driven_bend(sequence: &[f64], p: f64) -> ModelInput {
+    bend_with_analyses(
+        Section::diagonal(
+            1.0e7, 4.166667e6, 4.166667e6, 8.333333e5, 8.333333e5, 8.333333e5,
+        ),
+        sequence,
+        p,
+        None,
+    )
+}
+
+/// The driven bend of section `section` with the static analyses ending at
+/// `sequence`, a tip load `p` and, if `modes` is given, a modal analysis
+/// of that many modes after them.
+fn bend_with_analyses(
+    section: Section,
+    sequence: &[f64],
+    p: f64,
+    modes: Option<usize>,
+) -> ModelInput {
     let mut m = ModelBuilder::new("driven 45° bend");
     let r = 100.0;
-    let square = m.section(Section::diagonal(
-        1.0e7, 4.166667e6, 4.166667e6, 8.333333e5, 8.333333e5, 8.333333e5,
-    ));
+    let square = m.section(section);
     let root = m.node([0.0, 0.0, 0.0]);
     let tip = m.node([
         r * (0.25 * std::f64::consts::PI).sin(),
@@ -75,6 +92,9 @@ fn driven_bend(sequence: &[f64], p: f64) -> ModelInput {
         } else {
             m.then(a);
         }
+    }
+    if let Some(n) = modes {
+        m.then(Analysis::modal(n));
     }
     m.into_input()
 }
@@ -357,5 +377,85 @@ fn restart_files_keep_every_number_to_the_last_bit() {
             ..
         })
     ));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A static analysis 0 → 1 then a modal analysis of the loaded bend; run
+/// whole, and again restarted from the end of the static analysis of a run
+/// of it alone: the modal analysis after the restart point runs, about the
+/// same state, and gives the same frequencies. The restart file written at
+/// the end of the whole run (its last analysis modal) holds the state the
+/// modal analysis was given, unchanged.
+#[test]
+fn a_restart_before_a_modal_analysis_gives_its_frequencies() {
+    let dir = scratch("modal");
+    // the square section of side 1 with density 1: mass 1 per length,
+    // inertia [1/6, 1/12, 1/12] per length
+    let massive = || {
+        Section::diagonal(
+            1.0e7, 4.166667e6, 4.166667e6, 8.333333e5, 8.333333e5, 8.333333e5,
+        )
+        .mass_per_length(1.0)
+        .inertia_per_length([1.0 / 6.0, 1.0 / 12.0, 1.0 / 12.0])
+    };
+    let whole = bend_with_analyses(massive(), &[1.0], 600.0, Some(6));
+    let (code, err, out_whole) = run(&dir, "whole", &whole, &[]);
+    assert_eq!(code, 0, "{err}");
+    let (code, err, out_first) = run(
+        &dir,
+        "first",
+        &bend_with_analyses(massive(), &[1.0], 600.0, None),
+        &[],
+    );
+    assert_eq!(code, 0, "{err}");
+    let restart = out_first.join("restart.json");
+    let (code, err, out_rest) = run(
+        &dir,
+        "rest",
+        &whole,
+        &["--restart", restart.to_str().unwrap()],
+    );
+    assert_eq!(code, 0, "{err}");
+    let log = std::fs::read_to_string(out_rest.join("log.txt")).unwrap();
+    assert!(
+        log.contains("at t = 1 in analysis 2 of 2") && log.contains("modal at t = 1"),
+        "{log}"
+    );
+
+    let frequencies = |out: &Path| -> Vec<f64> {
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["status"], "completed", "{summary}");
+        summary["modes"][0]["frequencies_hz"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_f64().unwrap())
+            .collect()
+    };
+    let (f_whole, f_rest) = (frequencies(&out_whole), frequencies(&out_rest));
+    assert_eq!(f_whole.len(), 6);
+    assert_eq!(f_rest.len(), 6);
+    // the restart carries the state to the last bit and the static runs
+    // took the same increments, so the linearisation is the same: the
+    // frequencies agree to 1e-10 relative (round-off of the assembly and
+    // of the eigen-solver)
+    for (a, b) in f_whole.iter().zip(&f_rest) {
+        assert!(*a > 0.0, "{f_whole:?}");
+        assert!((a - b).abs() <= 1e-10 * a, "{f_whole:?} {f_rest:?}");
+    }
+
+    // the whole run's restart.json names its modal analysis (index 1 from
+    // 0) and holds the state it was given: that of the static analysis,
+    // as the first run ended (same increments; to 1e-12)
+    let r = Restart::read(&out_whole.join("restart.json")).unwrap();
+    assert_eq!((r.analysis, r.analysis_type.as_str()), (1, "modal"));
+    assert_eq!(r.state.time, 1.0);
+    let (dx, dq, dl) = difference(&r.state, &state(&restart), 100.0);
+    assert!(
+        dx < 1e-12 && dq < 1e-12 && dl < 1e-10,
+        "{dx:e} {dq:e} {dl:e}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -152,7 +152,7 @@ fn two_analyses_in_sequence_end_where_one_does() {
 #[test]
 fn step_by_step_is_a_run() {
     let (model, settings) = build(&driven_bend(&[1.0]));
-    let mut all = common::Recorder::default();
+    let mut all = unfold::analysis::observers::History::new();
     let at_once = StaticAnalysis::new(model.clone(), settings[0].clone())
         .run(model.initial_state(), &mut all);
 

@@ -16,14 +16,17 @@
 
 pub mod constraints;
 pub mod control;
+pub mod modal;
 pub mod newton;
+pub mod observers;
 pub mod preflight;
 pub mod settings;
 pub mod statics;
 
 pub use control::EventFunction;
+pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
-pub use settings::{AnalysisSettings, StaticSettings};
+pub use settings::{AnalysisSettings, ModalSettings, StaticSettings};
 pub use statics::{StaticAnalysis, StaticOutcome, Step};
 
 use crate::model::Model;

@@ -10,6 +10,9 @@ pub enum AnalysisSettings {
     /// Nonlinear statics, kinetostatics or kinematics
     /// ([`super::StaticAnalysis`]).
     Static(StaticSettings),
+    /// Natural frequencies and modes about the state reached
+    /// ([`super::ModalAnalysis`]).
+    Modal(ModalSettings),
 }
 
 impl AnalysisSettings {
@@ -17,6 +20,7 @@ impl AnalysisSettings {
     pub fn end_time(&self) -> f64 {
         match self {
             Self::Static(s) => s.end_time,
+            Self::Modal(s) => s.time,
         }
     }
 
@@ -26,6 +30,7 @@ impl AnalysisSettings {
         match self {
             Self::Static(s) if s.kinematic => "kinematic",
             Self::Static(_) => "static",
+            Self::Modal(_) => "modal",
         }
     }
 
@@ -33,6 +38,15 @@ impl AnalysisSettings {
     pub fn as_static(&self) -> Option<&StaticSettings> {
         match self {
             Self::Static(s) => Some(s),
+            Self::Modal(_) => None,
+        }
+    }
+
+    /// The settings of a modal analysis, if it is one.
+    pub fn as_modal(&self) -> Option<&ModalSettings> {
+        match self {
+            Self::Modal(s) => Some(s),
+            _ => None,
         }
     }
 }
@@ -76,4 +90,36 @@ pub struct StaticSettings {
     pub arc_length: bool,
     /// Arc-length control: largest number of increments.
     pub max_increments: usize,
+}
+
+/// Parameters of a modal analysis (docs/model-format.md, `[analysis]` with
+/// `type = "modal"`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModalSettings {
+    /// Number of modes wanted (zero modes included).
+    pub modes: usize,
+    /// Frequency (Hz) near which the modes are sought; `None` for the
+    /// lowest modes.
+    pub shift: Option<f64>,
+    /// Only the modes with frequencies in `[low, high]` (Hz), at most
+    /// `modes` of them, the lowest.
+    pub frequency_range: Option<(f64, f64)>,
+    /// Eigen-solver: dense, Lanczos, or chosen by size.
+    pub solver: crate::eigen::Method,
+    /// `t` at which it runs: the end of the analysis before it (0 for a
+    /// first analysis). A modal analysis does not move `t`.
+    pub time: f64,
+}
+
+impl ModalSettings {
+    /// The `modes` lowest modes, solver chosen by size, at `t = 0`.
+    pub fn lowest(modes: usize) -> Self {
+        Self {
+            modes,
+            shift: None,
+            frequency_range: None,
+            solver: crate::eigen::Method::Auto,
+            time: 0.0,
+        }
+    }
 }

@@ -1,5 +1,7 @@
 //! Input and output: model files in, results out.
 //!
+//! - [`modes`]: the result files of modal analyses (`modes.csv`,
+//!   `mode_shapes.csv`, a grid per mode and `modes.pvd`);
 //! - [`model_file`]: reads a TOML model file into a validated model, with
 //!   errors that name the file, the entity and the problem;
 //! - [`results`]: writes per-step CSV histories, `summary.json`, and VTK
@@ -14,6 +16,7 @@
 //! - [`plot`]: line charts of result histories, as SVG and PNG files.
 
 pub mod model_file;
+pub mod modes;
 pub mod plot;
 pub mod restart;
 pub mod results;

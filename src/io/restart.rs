@@ -466,3 +466,32 @@ impl RestartWriter {
             .write(&self.last_path())
     }
 }
+
+/// Removes the restart files of an earlier run from `dir` (`restart.json`,
+/// `restart-<t>.json` and their temporary files), but `keep`; a run
+/// rejected at its start leaves none of another model behind.
+pub fn remove_earlier(dir: &Path, keep: Option<&Path>) -> io::Result<()> {
+    let named = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", dir.display()));
+    let keep = keep.and_then(|k| k.canonicalize().ok());
+    let entries = match std::fs::read_dir(dir) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        entries => entries.map_err(named)?,
+    };
+    for entry in entries {
+        let path = entry.map_err(named)?.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        let stem = name.strip_suffix(".tmp").unwrap_or(name);
+        let restart = stem == LAST || (stem.starts_with("restart-") && stem.ends_with(".json"));
+        let kept = keep.is_some() && path.canonicalize().ok() == keep;
+        if !restart || kept {
+            continue;
+        }
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != io::ErrorKind::NotFound => {
+                return Err(io::Error::new(e.kind(), format!("{}: {e}", path.display())))
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}

@@ -32,8 +32,9 @@ pub use build::{
 };
 pub use builder::ModelBuilder;
 pub use handles::{
-    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, JointHandle,
-    JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle, SpringHandle,
+    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
+    JointHandle, JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle,
+    SpringHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.

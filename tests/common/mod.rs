@@ -7,36 +7,17 @@ pub mod rigid_body;
 
 use std::sync::Arc;
 
-use unfold::analysis::{IncrementInfo, Observer, StaticAnalysis, StaticOutcome, StaticSettings};
+use unfold::analysis::observers::History;
+use unfold::analysis::{IncrementInfo, StaticAnalysis, StaticOutcome, StaticSettings};
 use unfold::model::builder::{BeamLine, BeamLineHandle, ModelBuilder, SectionHandle};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
-use unfold::state::State;
-
-/// Keeps every converged increment.
-#[derive(Default)]
-pub struct Recorder {
-    pub increments: Vec<IncrementInfo>,
-}
-
-impl Observer for Recorder {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        _: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.increments.push(info.clone());
-        Ok(())
-    }
-}
 
 /// Builds and runs a model (its first analysis, from the initial state),
 /// returning it with the outcome and the converged increments.
 pub fn run(input: &ModelInput) -> (Arc<Model>, StaticOutcome, Vec<IncrementInfo>) {
     let model = Arc::new(Model::from_input(input).expect("valid model"));
-    let mut rec = Recorder::default();
+    let mut rec = History::new();
     let outcome = analysis(&model, input).run(model.initial_state(), &mut rec);
     (model, outcome, rec.increments)
 }

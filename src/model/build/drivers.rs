@@ -3,6 +3,7 @@
 
 use super::curves::RAMP;
 use super::joints::{angle_unit, joint_coordinate, triad, Context, Joints};
+use super::AngleLimit;
 use crate::joints::types::Coordinate;
 use crate::joints::{Driver, Pair, PairCoordinate};
 use crate::model::input::DriverInput;
@@ -107,8 +108,16 @@ pub(super) fn driver(
             return None;
         }
     };
-    if source.is_angle() {
-        warn_fast_angle(cx, entity, d, value, curve);
+    // a value meant in degrees: the per-increment warning, when it
+    // applies, already says so
+    if source.is_angle() && !warn_fast_angle(cx, entity, d, value, curve) && d.unit.is_none() {
+        let total = value.abs() * cx.curves.curves[curve].magnitude(cx.curves.end_time);
+        cx.ck.unitless_angle(
+            entity,
+            "drives its angle up to",
+            total,
+            AngleLimit::FullTurn,
+        );
     }
     let driver = Driver::new(d.id, source, value, curve);
     Some(match window {
@@ -120,12 +129,19 @@ pub(super) fn driver(
 /// Warns when a driven angle would turn by more than half a turn in one
 /// of the largest increments: the increments are then cut back until they
 /// ask less; a value meant in degrees and read in radians does this.
-fn warn_fast_angle(cx: &mut Context, entity: &str, d: &DriverInput, value: f64, curve: usize) {
+/// Whether it warned.
+fn warn_fast_angle(
+    cx: &mut Context,
+    entity: &str,
+    d: &DriverInput,
+    value: f64,
+    curve: usize,
+) -> bool {
     let Some(h) = cx.plan.max_increment else {
-        return;
+        return false;
     };
     if !(h.is_finite() && h > 0.0) {
-        return;
+        return false;
     }
     let end = cx.curves.end_time;
     let change = value.abs() * cx.curves.curves[curve].largest_change(h, end);
@@ -143,5 +159,7 @@ fn warn_fast_angle(cx: &mut Context, entity: &str, d: &DriverInput, value: f64, 
                 h * MAX_TURN_PER_INCREMENT / change
             ),
         );
+        return true;
     }
+    false
 }

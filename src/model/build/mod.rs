@@ -13,6 +13,7 @@ mod beams;
 mod checks;
 mod curves;
 mod drivers;
+mod hinge_laws;
 mod joint_springs;
 mod joints;
 mod loads;
@@ -58,6 +59,21 @@ pub const MIN_RELATIVE_INCREMENT: f64 = 1e-12;
 /// which overflow beyond 1.3e154.
 pub const LARGEST_ELEMENT_VALUE: f64 = 1e150;
 
+/// Relative margin above half or a whole turn before an angle without a
+/// unit is warned about, so that π and 2π written to a few digits
+/// (3.1416, 6.2832) pass.
+const ANGLE_SLACK: f64 = 1e-3;
+
+/// How large an angle written without a unit may be before it looks like
+/// degrees: a rotation vector is at most half a turn long; a driven
+/// angle, a spring's free angle or a table's angle rarely pass a full
+/// turn.
+#[derive(Clone, Copy)]
+enum AngleLimit {
+    HalfTurn,
+    FullTurn,
+}
+
 /// Collects problems and warnings while the model is built.
 #[derive(Default)]
 struct Checker {
@@ -97,6 +113,26 @@ impl Checker {
                 format!("{what} must be finite, got {values:?}"),
             );
             false
+        }
+    }
+
+    /// Warns that an angle written without a `unit` (read in radians) is
+    /// beyond `limit` (half or a whole turn), as an angle in degrees
+    /// would be: `what` says which angle (`"rotation has the length"`).
+    fn unitless_angle(&mut self, entity: &str, what: &str, angle: f64, limit: AngleLimit) {
+        let (bound, beyond) = match limit {
+            AngleLimit::HalfTurn => (std::f64::consts::PI, "half a turn"),
+            AngleLimit::FullTurn => (std::f64::consts::TAU, "a full turn"),
+        };
+        if angle.abs() > bound * (1.0 + ANGLE_SLACK) {
+            self.warn(
+                entity,
+                format!(
+                    "{what} {:.4} rad ({:.1}°), more than {beyond}, and gives no unit: angles are read in radians. If it is in degrees, write unit = \"deg\" (unit = \"rad\" confirms radians)",
+                    angle.abs(),
+                    angle.abs().to_degrees()
+                ),
+            );
         }
     }
 
@@ -231,6 +267,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.loads.len(),
         input.joints.len(),
         input.joint_springs.len(),
+        input.hinge_laws.len(),
         input.drivers.len(),
         generated,
     ]
@@ -303,7 +340,9 @@ impl Model {
         if ck.errors.is_empty() {
             if elements.iter().all(|e| e.kind() == ElementKind::NodalLoad) {
                 ck.push(ModelErrorKind::Missing, "model", "has no elements");
-            } else {
+            } else if !plan.modal_only {
+                // a free structure has rigid-body modes, but no static
+                // equilibrium
                 checks::check_restraint(&mut ck, &node_ids, &elements, &fixed);
             }
         }

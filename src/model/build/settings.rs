@@ -4,7 +4,8 @@
 use super::{
     num, Checker, LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MIN_RELATIVE_INCREMENT,
 };
-use crate::analysis::{AnalysisSettings, StaticSettings};
+use crate::analysis::{AnalysisSettings, ModalSettings, StaticSettings};
+use crate::eigen::Method;
 use crate::model::input::{Analyses, AnalysisInput, ModelInput};
 use crate::model::{ModelErrorKind, ModelErrors};
 
@@ -19,7 +20,12 @@ impl ModelInput {
         // times of the analysis they fall in
         if let Some(o) = &self.output {
             let mut start = 0.0;
-            for s in &mut all {
+            // (a modal analysis has no increments: it neither moves `t`
+            // nor writes restart files)
+            for s in all.iter_mut().filter_map(|a| match a {
+                AnalysisSettings::Static(s) => Some(s),
+                _ => None,
+            }) {
                 let within = o
                     .restart_times
                     .iter()
@@ -31,7 +37,7 @@ impl ModelInput {
             }
         }
         if ck.errors.is_empty() {
-            Ok(all.into_iter().map(AnalysisSettings::Static).collect())
+            Ok(all)
         } else {
             Err(ModelErrors(ck.errors))
         }
@@ -51,16 +57,20 @@ pub(super) struct Plan {
     pub end_time: f64,
     /// Largest `max_increment` of the load-controlled analyses.
     pub max_increment: Option<f64>,
+    /// Every analysis is modal (a free structure is then allowed).
+    pub modal_only: bool,
 }
 
 impl Plan {
-    pub(super) fn of(settings: &[StaticSettings]) -> Self {
+    pub(super) fn of(all: &[AnalysisSettings]) -> Self {
+        let settings: Vec<&StaticSettings> = all.iter().filter_map(|a| a.as_static()).collect();
         let load = settings.iter().filter(|s| !s.arc_length);
         Self {
             kinematic: settings.first().is_some_and(|s| s.kinematic),
             arc_length: settings.iter().any(|s| s.arc_length),
             end_time: settings.last().map_or(1.0, |s| s.end_time),
             max_increment: load.map(|s| s.max_increment).reduce(f64::max),
+            modal_only: settings.is_empty(),
         }
     }
 }
@@ -69,7 +79,7 @@ impl Plan {
 /// (docs/model-format.md). Each analysis of a sequence starts where the one
 /// before ends; the entities of messages are `analysis`, or
 /// `analysis[k]` (from 1) in a sequence.
-pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<StaticSettings> {
+pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSettings> {
     let all = analyses.all();
     let mut start = 0.0;
     let mut out = Vec::with_capacity(all.len());
@@ -80,7 +90,7 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<StaticSetti
             format!("analysis[{}]", k + 1)
         };
         if k > 0 {
-            if a.end_time.is_finite() && a.end_time <= start {
+            if a.kind != "modal" && a.end_time.is_finite() && a.end_time <= start {
                 ck.push(
                     ModelErrorKind::Invalid,
                     &entity,
@@ -104,11 +114,116 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<StaticSetti
                 }
             }
         }
+        if a.kind == "modal" {
+            // a modal analysis does not move t
+            out.push(AnalysisSettings::Modal(modal_settings(
+                ck, &entity, a, start,
+            )));
+            continue;
+        }
+        for (name, given) in [
+            ("modes", a.modes.is_some()),
+            ("shift", a.shift.is_some()),
+            ("frequency_range", a.frequency_range.is_some()),
+            ("solver", a.solver.is_some()),
+        ] {
+            if given {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    &entity,
+                    format!("{name} applies to a modal analysis (type = \"modal\")"),
+                );
+            }
+        }
         let s = settings(ck, &entity, a, start);
         start = s.end_time;
-        out.push(s);
+        out.push(AnalysisSettings::Static(s));
     }
     out
+}
+
+/// Largest number of modes a modal analysis may ask for: beyond it the
+/// dense solver's O(n³) and Lanczos's basis of 2·modes vectors of the
+/// model's size make the request a mistake rather than an analysis.
+const MAX_MODES: usize = 10_000;
+
+/// Settings of a modal analysis at `t = start`, with defaults.
+fn modal_settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> ModalSettings {
+    // the keys of incremental analyses do not apply
+    for (name, given) in [
+        ("initial_increment", a.initial_increment.is_some()),
+        ("min_increment", a.min_increment.is_some()),
+        ("max_increment", a.max_increment.is_some()),
+        ("max_iterations", a.max_iterations.is_some()),
+        ("residual_tolerance", a.residual_tolerance.is_some()),
+        ("displacement_tolerance", a.displacement_tolerance.is_some()),
+        ("rotation_tolerance", a.rotation_tolerance.is_some()),
+        ("output_every", a.output_every.is_some()),
+        ("output_times", a.output_times.is_some()),
+        ("control", a.control.is_some()),
+        ("max_increments", a.max_increments.is_some()),
+    ] {
+        if given {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("{name} does not apply to a modal analysis (it linearises about the state reached and does not move t)"),
+            );
+        }
+    }
+    let modes = a.modes.unwrap_or(10);
+    if modes == 0 || modes > MAX_MODES {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!("modes must be from 1 to {MAX_MODES}, got {modes}"),
+        );
+    }
+    if let Some(f) = a.shift {
+        if !(f.is_finite() && f >= 0.0) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "shift must be a frequency in Hz, zero or positive, got {}",
+                    num(f)
+                ),
+            );
+        }
+    }
+    if let Some([lo, hi]) = a.frequency_range {
+        if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "frequency_range must be [low, high] in Hz with 0 ≤ low < high, got [{}, {}]",
+                    num(lo),
+                    num(hi)
+                ),
+            );
+        }
+    }
+    let solver = match a.solver.as_deref() {
+        None | Some("auto") => Method::Auto,
+        Some("dense") => Method::Dense,
+        Some("lanczos") => Method::Lanczos,
+        Some(other) => {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("unknown solver \"{other}\" (available: auto, dense, lanczos)"),
+            );
+            Method::Auto
+        }
+    };
+    ModalSettings {
+        modes,
+        shift: a.shift,
+        frequency_range: a.frequency_range.map(|[lo, hi]| (lo, hi)),
+        solver,
+        time: start,
+    }
 }
 
 /// Settings of one analysis from `start` to its end, with defaults.
@@ -118,7 +233,7 @@ fn settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> St
             ModelErrorKind::Invalid,
             entity,
             format!(
-                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic)",
+                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic, modal)",
                 a.kind
             ),
         );

@@ -325,6 +325,10 @@ impl Console for Terminal {
         self.bar.finish_and_clear();
         println!("{text}");
     }
+
+    fn warning(&mut self, text: &str) {
+        self.bar.suspend(|| eprintln!("warning: {text}"));
+    }
 }
 
 fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {

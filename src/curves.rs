@@ -285,6 +285,28 @@ impl Curve {
         }
     }
 
+    /// The largest step `h` (at most `t_end`) over which a quantity
+    /// `amplitude·f(t)` changes by at most `limit` anywhere in
+    /// `[0, t_end]`: bisection on [`Self::largest_change`], which grows
+    /// with `h`, to a relative 1e-9 (the `h` returned is on the safe
+    /// side). `t_end` when the whole range changes by less.
+    pub fn largest_step(&self, amplitude: f64, limit: f64, t_end: f64) -> f64 {
+        let change = |h: f64| amplitude.abs() * self.largest_change(h, t_end);
+        if t_end.is_nan() || t_end <= 0.0 || change(t_end) <= limit {
+            return t_end.max(0.0);
+        }
+        let (mut lo, mut hi) = (0.0, t_end);
+        while hi - lo > 1e-9 * hi {
+            let mid = 0.5 * (lo + hi);
+            if change(mid) <= limit {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    }
+
     /// Whether `f` takes one value over `[0, t_end]`.
     pub fn is_constant_on(&self, t_end: f64) -> bool {
         match self.function {
@@ -408,6 +430,24 @@ mod tests {
                 c.name()
             );
         }
+    }
+
+    /// The largest step keeps the change within the limit and is the
+    /// largest that does: for the ramp `h = limit/amplitude`; for a table
+    /// the steepest segment sets it; a slow curve allows the whole range.
+    #[test]
+    fn largest_step_bounds_the_change() {
+        let ramp = Curve::ramp();
+        let h = ramp.largest_step(4.0 * std::f64::consts::PI, 0.5 * std::f64::consts::PI, 1.0);
+        assert!((h - 0.125).abs() <= 1e-9 * 0.125, "{h}");
+        let table =
+            Curve::piecewise_linear("t", vec![(0.0, 0.0), (0.5, 0.1), (0.6, 1.1), (1.0, 1.2)]);
+        // steepest segment: slope 10 over 0.1
+        let h = table.largest_step(1.0, 0.5, 1.0);
+        assert!((h - 0.05).abs() <= 1e-9, "{h}");
+        assert!(table.largest_change(h, 1.0) <= 0.5);
+        assert!(table.largest_change(h * (1.0 + 1e-6), 1.0) > 0.5);
+        assert_eq!(ramp.largest_step(1.0, 2.0, 1.0), 1.0);
     }
 
     #[test]

@@ -334,6 +334,10 @@ impl Console for Terminal {
         self.bar.finish_and_clear();
         println!("{text}");
     }
+
+    fn warning(&mut self, text: &str) {
+        self.bar.suspend(|| eprintln!("warning: {text}"));
+    }
 }
 
 fn run(

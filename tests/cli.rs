@@ -615,8 +615,9 @@ fn load_history_is_explicit_and_visible() {
 
 /// A driver value meant in degrees: read in radians, 90 rad over ten
 /// increments asks for 9 rad per increment (more than half a turn): a
-/// warning names the driver and suggests `unit = "deg"`; with it, the
-/// hinge turns by π/2 in ten increments without a cut-back.
+/// warning names the driver and suggests `unit = "deg"`, and load control
+/// limits the increments to a quarter turn each; with the unit, the hinge
+/// turns by π/2 in ten increments without a cut-back.
 #[test]
 fn angles_in_degrees() {
     let dir = scratch("degrees");
@@ -628,7 +629,12 @@ fn angles_in_degrees() {
             && err.contains("unit = \"deg\""),
         "{err}"
     );
-    assert!(!out.contains(" 0 cut-backs"), "{out}");
+    // load control limits its increments to a quarter turn each
+    // (π/2 / 90 = 1.745e-2) rather than cutting them back
+    assert!(
+        out.contains("note: load increments limited to 1.7453e-2") && out.contains(" 0 cut-backs"),
+        "{out}"
+    );
     let (code, out, err) = run_model(&dir, "deg.toml", &pendulum("90", Some("deg"), kinematic));
     assert_eq!(code, 0, "{err}");
     assert!(!err.contains("warning"), "{err}");
@@ -1057,8 +1063,8 @@ fn angles_that_look_like_degrees_are_warned_about() {
 /// A prescribed rotation changing by more than half a turn over the
 /// largest increment is warned about, as a driver is (within an increment
 /// the analysis cannot tell it from the same rotation less a turn: 4π in
-/// two increments gave no torque at all), with the largest increment that
-/// avoids it: π/4π of t.
+/// two increments gave no torque at all), with the increment load control
+/// takes instead: a quarter turn, (π/2)/4π of t.
 #[test]
 fn a_prescribed_rotation_too_fast_for_an_increment_is_warned_about() {
     let text = format!(
@@ -1069,7 +1075,7 @@ fn a_prescribed_rotation_too_fast_for_an_increment_is_warned_about() {
         &text,
         &[
             "prescribed[1] (node 3): turns the node by up to 6.2832 rad (360.0°) in one increment of t = 0.5 (max_increment): more than half a turn",
-            "Lower max_increment to at most 2.500e-1.",
+            "load increments are limited to 1.250e-1 (a quarter turn each).",
         ],
     );
     let (_, _, err) = check_model("prescribed_fast_again", &text);
@@ -1509,4 +1515,229 @@ fn a_sequence_must_go_forward() {
         "title = \"two-element cantilever\"\nanalysis = []",
     );
     assert_rejected("no_analysis", &text, &["at least one [[analysis]] table"]);
+}
+
+/// The twisted cantilever of the new-user trial (L = 2, GJ = 5920, ten
+/// elements, end rotation 4π about the axis), with increments of
+/// `increment` asked for.
+fn twisted_cantilever(increment: f64) -> String {
+    format!(
+        r#"title = "two full turns"
+[analysis]
+initial_increment = {increment}
+
+[[sections]]
+name = "steel"
+EA = 1.68e8
+GA2 = 5.38e7
+GA3 = 5.38e7
+GJ = 5.92e3
+EI2 = 5.6e3
+EI3 = 2.24e4
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 2
+x = [2.0, 0.0, 0.0]
+
+[[beam_lines]]
+nodes = [1, 2]
+elements = 10
+section = "steel"
+orientation = [0.0, 0.0, 1.0]
+
+[[supports]]
+node = 1
+fixed = ["all"]
+
+[[prescribed]]
+node = 2
+rotation = [12.566370614359172, 0.0, 0.0]
+unit = "rad"
+"#
+    )
+}
+
+/// The torque of a prescribed end rotation of two full turns is
+/// `GJ·4π/L` = 37 196.46 (uniform torsion) whether increments of 0.5 or of
+/// 0.1 are asked for: increments of 0.5 (a full turn each) gave no torque
+/// at all, as a full turn cannot be told from none within an increment;
+/// load control now takes increments of a quarter turn at most, notes it,
+/// and the builder's warning says so. Reaction moment at the clamp, last
+/// step of reactions.csv, to 1e-6 of the torque.
+#[test]
+fn a_prescribed_rotation_of_two_turns_gives_its_torque_whatever_the_increment() {
+    let torque = 5.92e3 * 4.0 * std::f64::consts::PI / 2.0;
+    for (increment, tag) in [(0.5, "two"), (0.1, "ten")] {
+        let dir = scratch(&format!("twist_{tag}"));
+        let (code, out, err) = run_model(&dir, "twist.toml", &twisted_cantilever(increment));
+        assert_eq!(code, 0, "{out}{err}");
+        if increment == 0.5 {
+            assert!(
+                err.contains("load increments are limited to 1.250e-1 (a quarter turn each)"),
+                "{err}"
+            );
+            assert!(
+                out.contains("note: load increments limited to 1.2500e-1"),
+                "{out}"
+            );
+        }
+        let reactions = std::fs::read_to_string(dir.join("out/reactions.csv")).unwrap();
+        let last = reactions.lines().rev().find(|l| l.contains(",1,")).unwrap();
+        // step,time,node,Fx,Fy,Fz,Mx,My,Mz
+        let mx: f64 = last.split(',').nth(6).unwrap().parse().unwrap();
+        println!("{increment}: reaction moment {mx} against {torque}");
+        assert!((mx.abs() - torque).abs() <= 1e-6 * torque, "{last}");
+    }
+}
+
+/// A rotational spring whose relative rotation passes half a turn stops
+/// the run (exit 1) naming the spring and the increment (its law m = Kψ
+/// holds below half a turn: beyond, ψ = log(…) measures the rotation the
+/// other way round and the moment turns the wrong way); the results up to
+/// the last increment before are kept.
+#[test]
+fn a_rotational_spring_past_half_a_turn_stops_the_run() {
+    let rollup = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/cantilever_rollup.toml"),
+    )
+    .unwrap();
+    let spring = format!(
+        "{rollup}\n[[springs]]\nid = 100\nkind = \"rotational\"\nnodes = [11]\nstiffness = 1.0\n"
+    );
+    let dir = scratch("spring_half_turn");
+    let (code, out, err) = run_model(&dir, "rs.toml", &spring);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(
+        err.contains(
+            "spring 100, between t = 0.5 and t = 0.6: its relative rotation passed half a turn"
+        ) && err.contains("a rotational spring's law m = K ψ holds below half a turn only"),
+        "{err}"
+    );
+    assert!(err.contains("results up to t = 0.5 are kept"), "{err}");
+    let summary = std::fs::read_to_string(dir.join("out/summary.json")).unwrap();
+    assert!(summary.contains("\"status\": \"failed\""), "{summary}");
+}
+
+/// Kinematic increments show the largest constraint violation relative to
+/// its tolerance at each iteration (converged: at most 1), not the
+/// relative residual, which without loads stays near 1 (the four-bar
+/// printed 9.7e-1 5.0e-1 6.8e-1 0.0e0); static increments keep the
+/// relative residuals.
+#[test]
+fn kinematic_increments_show_the_constraint_violation() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/four_bar.toml");
+    let dir = scratch("kinematic_lines");
+    let (code, out, err) = unfold(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out
+        .lines()
+        .filter(|l| l.starts_with("increment "))
+        .collect();
+    assert_eq!(lines.len(), 73, "{out}");
+    for line in &lines {
+        let (_, values) = line
+            .split_once("constraint violations (× tolerance): ")
+            .unwrap_or_else(|| panic!("{line}"));
+        let values: Vec<f64> = values.split(' ').map(|v| v.parse().unwrap()).collect();
+        assert!(*values.last().unwrap() <= 1.0, "{line}");
+        assert_eq!(values.len(), line_iterations(line) + 1, "{line}");
+    }
+    // the first increment starts far from the constraints (the crank
+    // turned by its driver, the rest not yet)
+    assert!(
+        lines[1].contains("e8") || lines[1].contains("e9"),
+        "{}",
+        lines[1]
+    );
+    let dir = scratch("static_lines");
+    let (code, out, _) = run_model(&dir, "c.toml", CANTILEVER);
+    assert_eq!(code, 0);
+    assert!(out.contains("relative residuals: "), "{out}");
+    assert!(!out.contains("constraint violations"), "{out}");
+}
+
+/// The number of iterations an increment line gives.
+fn line_iterations(line: &str) -> usize {
+    line.split("iterations")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|s| s.parse().ok())
+        .unwrap()
+}
+
+/// The shallow clamped arch of the new-user trial under load control in
+/// increments of 0.05 warns on stderr, in log.txt and in summary.json
+/// about the increments across which the tangent's determinant changed
+/// sign, among them increment 2 (t = 0.05 to 0.1), across the limit load
+/// t ≈ 0.0845; the run goes on (exit 0).
+#[test]
+fn the_run_warns_about_limit_points_passed() {
+    let text = r#"title = "shallow clamped arch"
+[analysis]
+initial_increment = 0.05
+[[sections]]
+name = "s"
+EA = 1e6
+GA2 = 1e6
+GA3 = 1e6
+GJ = 1.0
+EI2 = 1.0
+EI3 = 1.0
+[[nodes]]
+id = 1
+x = [-1.0, 0.0, 0.0]
+[[nodes]]
+id = 2
+x = [0.0, 0.1, 0.0]
+[[nodes]]
+id = 3
+x = [1.0, 0.0, 0.0]
+[[beam_lines]]
+nodes = [1, 2]
+elements = 10
+section = "s"
+[[beam_lines]]
+nodes = [2, 3]
+elements = 10
+section = "s"
+[[supports]]
+node = 1
+fixed = ["all"]
+[[supports]]
+node = 3
+fixed = ["all"]
+[[loads]]
+node = 2
+force = [0.0, -200.0, 0.0]
+"#;
+    let dir = scratch("arch_limit");
+    let (code, out, err) = run_model(&dir, "arch.toml", text);
+    assert_eq!(code, 0, "{out}{err}");
+    let warning = "warning: increment 2 (t = 0.05 to 0.1): the determinant of the tangent stiffness changed sign within this increment";
+    assert!(
+        err.contains(warning) && err.contains("control = \"arc_length\""),
+        "{err}"
+    );
+    let log = std::fs::read_to_string(dir.join("out/log.txt")).unwrap();
+    assert!(log.contains(warning), "{log}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    let warnings = summary["warnings"].as_array().unwrap();
+    assert!(
+        warnings.iter().any(|w| w
+            .as_str()
+            .unwrap()
+            .starts_with("increment 2 (t = 0.05 to 0.1)")),
+        "{warnings:?}"
+    );
 }

@@ -27,7 +27,7 @@ pub use control::EventFunction;
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
 pub use settings::{AnalysisSettings, ModalSettings, StaticSettings};
-pub use statics::{StaticAnalysis, StaticOutcome, Step};
+pub use statics::{StaticAnalysis, StaticOutcome, Step, LIMIT_POINT_WARNING};
 
 use crate::model::Model;
 use crate::state::State;
@@ -119,6 +119,25 @@ pub trait Observer {
 
     /// A remark worth showing the user (redundant constraints removed).
     fn note(&mut self, _text: &str) {}
+
+    /// After a converged increment that the analysis finds suspect (a
+    /// limit or bifurcation point passed under load control, docs/theory.md
+    /// §9): the analysis goes on, but its results may not be those
+    /// meant.
+    fn warning(&mut self, _info: &WarningInfo) {}
+}
+
+/// A suspect converged increment ([`Observer::warning`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WarningInfo {
+    /// The increment.
+    pub increment: usize,
+    /// Load parameter at its start.
+    pub from: f64,
+    /// Load parameter reached.
+    pub time: f64,
+    /// What is suspect, and what to do.
+    pub message: String,
 }
 
 /// An observer that ignores everything.

@@ -13,12 +13,12 @@
 //! # drop(observer);
 //! ```
 
-use super::{CutbackInfo, EventInfo, IncrementInfo, Observer};
+use super::{CutbackInfo, EventInfo, IncrementInfo, Observer, WarningInfo};
 use crate::model::Model;
 use crate::state::State;
 
 /// Keeps every converged increment, and on request every converged state,
-/// with the cut-backs, events and notes of the analysis.
+/// with the cut-backs, events, notes and warnings of the analysis.
 #[derive(Clone, Debug, Default)]
 pub struct History {
     /// The converged increments, increment 0 (the start) included.
@@ -32,6 +32,8 @@ pub struct History {
     pub events: Vec<EventInfo>,
     /// The remarks of the analysis (redundant constraints removed).
     pub notes: Vec<String>,
+    /// The suspect increments (a limit point passed under load control).
+    pub warnings: Vec<WarningInfo>,
     keep_states: bool,
 }
 
@@ -92,6 +94,10 @@ impl Observer for History {
 
     fn note(&mut self, text: &str) {
         self.notes.push(text.to_string());
+    }
+
+    fn warning(&mut self, info: &WarningInfo) {
+        self.warnings.push(info.clone());
     }
 }
 

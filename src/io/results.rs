@@ -190,6 +190,9 @@ pub struct Summary {
     /// Each analysis of the run, in order (one unless the model file asks
     /// for a sequence).
     pub analyses: Vec<AnalysisRecord>,
+    /// Warnings of the analyses about converged increments (a limit point
+    /// passed under load control), as logged.
+    pub warnings: Vec<String>,
     /// Every converged increment.
     pub increment_log: Vec<IncrementRecord>,
     /// What each modal analysis of the run found (docs/results.md,
@@ -260,6 +263,7 @@ impl Summary {
             wall_time_s: 0.0,
             output_steps: 0,
             analyses: Vec::new(),
+            warnings: Vec::new(),
             increment_log: Vec::new(),
             modes: Vec::new(),
             initial_iterations: 0,

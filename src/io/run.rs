@@ -47,7 +47,7 @@ use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
     AnalysisSettings, CutbackInfo, EventInfo, IncrementInfo, IterationInfo, Observer,
-    StaticAnalysis, StaticOutcome,
+    StaticAnalysis, StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
 use crate::model::Model;
@@ -64,6 +64,8 @@ pub trait Console {
     fn progress(&mut self, _info: &IncrementInfo) {}
     /// The last line of the run (status, counts, where the results are).
     fn finish(&mut self, _text: &str) {}
+    /// A warning of the analysis (shown even when lines are not).
+    fn warning(&mut self, _text: &str) {}
 }
 
 /// A console that shows nothing.
@@ -349,6 +351,9 @@ pub struct Recorder {
     modal: ModalFiles,
     /// Encoding of the grids.
     encoding: Encoding,
+    /// Largest constraint violation (relative to its tolerance) at each
+    /// iteration of the increment being solved.
+    violations: Vec<f64>,
     /// Restart files, and the index in the model's sequence of the first
     /// analysis recorded.
     restart: Option<(RestartWriter, usize)>,
@@ -439,6 +444,7 @@ impl Recorder {
             failure: None,
             modal: ModalFiles::default(),
             encoding: Encoding::default(),
+            violations: Vec::new(),
             restart: None,
         };
         let analyses = if plan.len() > 1 {
@@ -639,6 +645,10 @@ impl Recorder {
 
 impl Observer for Recorder {
     fn iteration(&mut self, info: &IterationInfo) {
+        if info.iteration == 0 {
+            self.violations.clear();
+        }
+        self.violations.push(info.norms.residual_constraint);
         let n = &info.norms;
         self.log.line(&format!(
             "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
@@ -672,14 +682,21 @@ impl Observer for Recorder {
         let restart =
             info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
         let info = &self.renumbered(info);
-        let residuals: Vec<String> = info.residuals.iter().map(|r| format!("{r:.1e}")).collect();
+        // a kinematic analysis has no loads: its residual is all constraint
+        // violation, measured against the tolerance of each constraint
+        let (what, values) = if self.current.kind == "kinematic" {
+            ("constraint violations (× tolerance)", &self.violations)
+        } else {
+            ("relative residuals", &info.residuals)
+        };
+        let values: Vec<String> = values.iter().map(|r| format!("{r:.1e}")).collect();
         self.line(&format!(
-            "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  relative residuals: {}",
+            "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  {what}: {}",
             info.increment,
             info.time,
             info.step,
             info.iterations,
-            residuals.join(" ")
+            values.join(" ")
         ));
         self.console.progress(info);
         if restart {
@@ -713,6 +730,19 @@ impl Observer for Recorder {
 
     fn note(&mut self, text: &str) {
         self.line(&format!("note: {text}"));
+    }
+
+    fn warning(&mut self, info: &WarningInfo) {
+        let text = format!(
+            "increment {} (t = {} to {}): {}",
+            info.increment + self.increment_offset,
+            format_time(info.from),
+            format_time(info.time),
+            info.message
+        );
+        self.log.line(&format!("warning: {text}"));
+        self.console.warning(&text);
+        self.summary.warnings.push(text);
     }
 
     fn cutback(&mut self, info: &CutbackInfo) {

@@ -9,11 +9,12 @@ use crate::joints::{Driver, Pair, PairCoordinate};
 use crate::model::input::DriverInput;
 use crate::model::ModelErrorKind;
 use crate::so3;
+use std::f64::consts::FRAC_PI_2;
 
-/// Largest change of a driven angle in one increment: the branch of an
-/// angle is followed only while an increment turns it by less than half a
-/// turn (docs/joints.md §3.3).
-const MAX_TURN_PER_INCREMENT: f64 = std::f64::consts::PI;
+/// Change of a driven angle in one increment beyond which the increment is
+/// ambiguous: the branch of an angle is followed only while an increment
+/// turns it by less than half a turn (docs/joints.md §3.3).
+const AMBIGUOUS_TURN: f64 = std::f64::consts::PI;
 
 pub(super) fn driver(
     cx: &mut Context,
@@ -127,9 +128,9 @@ pub(super) fn driver(
 }
 
 /// Warns when a driven angle would turn by more than half a turn in one
-/// of the largest increments: the increments are then cut back until they
-/// ask less; a value meant in degrees and read in radians does this.
-/// Whether it warned.
+/// of the largest increments: load control then limits its increments
+/// (`Model::rotation_step_limit`); a value meant in degrees and read in
+/// radians does this. Whether it warned.
 fn warn_fast_angle(
     cx: &mut Context,
     entity: &str,
@@ -145,7 +146,7 @@ fn warn_fast_angle(
     }
     let end = cx.curves.end_time;
     let change = value.abs() * cx.curves.curves[curve].largest_change(h, end);
-    if change > MAX_TURN_PER_INCREMENT {
+    if change > AMBIGUOUS_TURN {
         let hint = if d.unit.is_none() {
             " If the value is in degrees, write unit = \"deg\"."
         } else {
@@ -154,9 +155,9 @@ fn warn_fast_angle(
         cx.ck.warn(
             entity,
             format!(
-                "asks for {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot follow (docs/joints.md §3.3); increments will be cut back. Lower max_increment to at most {:.3e}.{hint}",
+                "asks for {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot follow (docs/joints.md §3.3); load increments are limited to {:.3e} (a quarter turn each).{hint}",
                 change.to_degrees(),
-                h * MAX_TURN_PER_INCREMENT / change
+                cx.curves.curves[curve].largest_step(value, FRAC_PI_2, end)
             ),
         );
         return true;

@@ -236,9 +236,10 @@ impl Builder<'_> {
     /// Warns when a prescribed rotation of angle `angle` following `curve`
     /// changes by more than half a turn over one of the largest increments:
     /// within an increment the analysis cannot tell it from the same
-    /// rotation less a full turn (docs/model-format.md, `[[prescribed]]`);
-    /// the warning suggests degrees if the rotation has no `unit`. Whether
-    /// it warned.
+    /// rotation less a full turn (docs/model-format.md, `[[prescribed]]`),
+    /// so load control limits its increments
+    /// (`Model::rotation_step_limit`); the warning suggests degrees if the
+    /// rotation has no `unit`. Whether it warned.
     fn warn_fast_rotation(
         &mut self,
         entity: &str,
@@ -262,9 +263,13 @@ impl Builder<'_> {
             self.ck.warn(
                 entity,
                 format!(
-                    "turns the node by up to {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot tell from the same rotation less a full turn, so the result may miss whole turns. Lower max_increment to at most {:.3e}.{hint}",
+                    "turns the node by up to {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot tell from the same rotation less a full turn; load increments are limited to {:.3e} (a quarter turn each).{hint}",
                     change.to_degrees(),
-                    h * std::f64::consts::PI / change
+                    self.curves.curves[curve].largest_step(
+                        angle,
+                        std::f64::consts::FRAC_PI_2,
+                        self.curves.end_time
+                    )
                 ),
             );
             return true;

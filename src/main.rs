@@ -1,14 +1,16 @@
 //! `unfold`: command-line front end.
 //!
 //! ```text
-//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii]
+//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii] [--restart FILE]
 //! unfold check MODEL.toml
 //! ```
 //! A model file with a sequence of analyses (`[[analysis]]`) runs them in
 //! order, each from the final state of the one before, into one set of
 //! result files. A modal analysis (`type = "modal"`) linearises about the
 //! state it is given and leaves it unchanged; its first frequencies are
-//! printed on stderr.
+//! printed on stderr. Every run writes `restart.json` (the state at its
+//! last converged step) into its output directory; `--restart FILE`
+//! continues a run from such a file (docs/results.md, "Restart files").
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
 //! written so far are kept) or results could not be written (each error
 //! names its file; the output directory in use by another run); 2 the
@@ -32,10 +34,12 @@ use unfold::analysis::{
     NewtonFailure, StaticAnalysis, StaticOutcome,
 };
 use unfold::io::model_file::read_model;
+use unfold::io::restart::{fingerprint, Restart, RestartError, RestartWriter, Resume};
 use unfold::io::run::{
     format_time, signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest,
 };
 use unfold::io::vtk::Encoding;
+use unfold::model::input::ModelInput;
 use unfold::model::Model;
 
 // `println!` and `eprintln!` that ignore a failed write instead of
@@ -84,6 +88,10 @@ enum Command {
         /// Write the VTK grids as text instead of compressed binary.
         #[arg(long)]
         vtk_ascii: bool,
+        /// Continue from a restart file of an earlier run of this model
+        /// (its `restart.json`, or a `restart-<t>.json`).
+        #[arg(long, value_name = "FILE")]
+        restart: Option<PathBuf>,
     },
     /// Check a model file and print its size, without running it.
     Check {
@@ -108,6 +116,7 @@ fn main() -> ExitCode {
             quiet,
             threads,
             vtk_ascii,
+            restart,
         } => {
             if let Some(n) = threads {
                 if n == 0 {
@@ -146,7 +155,7 @@ fn main() -> ExitCode {
             } else {
                 Encoding::Binary
             };
-            run(&model, &out, quiet, encoding)
+            run(&model, &out, quiet, encoding, restart.as_deref())
         }
     }
 }
@@ -331,7 +340,13 @@ impl Console for Terminal {
     }
 }
 
-fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
+fn run(
+    path: &Path,
+    out: &Path,
+    quiet: bool,
+    encoding: Encoding,
+    restart: Option<&Path>,
+) -> ExitCode {
     // from now on SIGINT, SIGTERM and SIGHUP stop the run after the
     // current increment, with consistent result files
     let stop = StopRequest::new();
@@ -351,8 +366,8 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         );
     }
 
-    let (mut model, plan) = match read_model(path) {
-        Ok(file) => (file.model, file.analyses),
+    let (input, mut model, plan) = match read_model(path) {
+        Ok(file) => (file.input, file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
@@ -371,6 +386,45 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     if !supported(path, &plan) {
         return ExitCode::from(EXIT_INPUT);
     }
+    let label = path.display().to_string();
+    if let (Err(e), Some(first)) = (&checked, plan.first().and_then(|a| a.as_static())) {
+        // invalid input: summary.json alone says why
+        eprintln!("error: {}: {e}", path.display());
+        let analysis = StaticAnalysis::new(model.clone(), first.clone());
+        let rejected = unfold::io::results::write_rejected(
+            out,
+            &label,
+            &model,
+            &analysis,
+            &plan,
+            &e.to_string(),
+            restart,
+        );
+        if let Err(w) = rejected {
+            eprintln!("error: cannot write results: {w}");
+        }
+        return ExitCode::from(EXIT_INPUT);
+    }
+    // a restart: the analysis it continues and its start state
+    let (first, start) = match restart.map(|r| resume(r, &input, &model, &plan)) {
+        None => (0, model.initial_state()),
+        Some(Ok(resume)) => (resume.analysis, resume.state),
+        Some(Err(e)) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
+    let restarts = RestartWriter::new(out, &input).starting_at(start.time);
+    let restart_note = restart.map(|r| {
+        format!(
+            "restarted from {} at t = {} in analysis {} of {}",
+            r.display(),
+            format_time(start.time),
+            first + 1,
+            plan.len()
+        )
+    });
+    let plan = &plan[first..];
     let mut analyses = plan
         .iter()
         .filter_map(|a| match (a.as_static(), a.as_modal()) {
@@ -384,26 +438,9 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
             )))),
             _ => None,
         });
-    let Some(first) = analyses.next() else {
+    let Some(first_planned) = analyses.next() else {
         return ExitCode::SUCCESS;
     };
-    let label = path.display().to_string();
-    if let (Err(e), Planned::Static(analysis)) = (checked, &first) {
-        // invalid input: summary.json alone says why
-        eprintln!("error: {}: {e}", path.display());
-        let rejected = unfold::io::results::write_rejected(
-            out,
-            &label,
-            &model,
-            analysis,
-            &plan,
-            &e.to_string(),
-        );
-        if let Err(w) = rejected {
-            eprintln!("error: cannot write results: {w}");
-        }
-        return ExitCode::from(EXIT_INPUT);
-    }
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] [{bar:40}] {msg}")
@@ -415,25 +452,31 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         quiet,
         end_time: plan.last().map_or(1.0, |a| a.end_time()),
     };
-    let recorder = match &first {
-        Planned::Static(a) => Recorder::create_sequence(out, &label, a, &plan, terminal),
-        Planned::Modal(a) => Recorder::create_modal_first(out, &label, a, &plan, terminal),
+    let recorder = match &first_planned {
+        Planned::Static(a) => Recorder::create_sequence(out, &label, a, plan, terminal),
+        Planned::Modal(a) => Recorder::create_modal_first(out, &label, a, plan, terminal),
     };
     let mut recorder = match recorder {
-        Ok(r) => r.with_stop(&stop).with_vtk_encoding(encoding),
+        Ok(r) => r
+            .with_stop(&stop)
+            .with_vtk_encoding(encoding)
+            .with_restart(restarts, first),
         Err(e) => {
             eprintln!("error: cannot write results: {e}");
             return ExitCode::from(EXIT_FAILED);
         }
     };
+    if let Some(note) = restart_note {
+        recorder.line(&note);
+    }
     // the analyses in order, each from the final state of the one before;
     // none after one that failed
-    let mut state = model.initial_state();
+    let mut state = start;
     let mut last_static: Option<StaticOutcome> = None;
     let mut after_modal = false;
     let mut modal_error: Option<ModalError> = None;
     let mut modal_output_error = false;
-    for (k, planned) in std::iter::once(first).chain(analyses).enumerate() {
+    for (k, planned) in std::iter::once(first_planned).chain(analyses).enumerate() {
         match planned {
             Planned::Static(mut analysis) => {
                 match (&last_static, after_modal) {
@@ -474,7 +517,7 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
             }
         }
     }
-    let report = recorder.finish_with(last_static.as_ref());
+    let report = recorder.finish_with(last_static.as_ref(), &state);
 
     for e in &report.output_errors {
         eprintln!("error: cannot write results: {e}");
@@ -529,4 +572,15 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         return ExitCode::from(EXIT_FAILED);
     }
     ExitCode::SUCCESS
+}
+
+/// Reads the restart file `path` and finds where the run of `model`
+/// continues from it.
+fn resume(
+    path: &Path,
+    input: &ModelInput,
+    model: &Model,
+    plan: &[AnalysisSettings],
+) -> Result<Resume, RestartError> {
+    Restart::read(path)?.resume(path, &fingerprint(input), model, plan)
 }

@@ -9,6 +9,8 @@
 //! - [`run`]: the record of a whole run (results, `log.txt`, summary,
 //!   stopping on a signal), shared by the command-line tool and the
 //!   programs that use the library;
+//! - [`restart`]: restart files, the state of a run from which a later
+//!   run continues;
 //! - [`vtk`]: the VTK unstructured-grid (`.vtu`) and collection (`.pvd`)
 //!   writers;
 //! - [`plot`]: line charts of result histories, as SVG and PNG files.
@@ -16,6 +18,7 @@
 pub mod model_file;
 pub mod modes;
 pub mod plot;
+pub mod restart;
 pub mod results;
 pub mod run;
 pub mod vtk;

@@ -548,8 +548,9 @@ fn remove_leftovers(dir: &Path, writes: impl Fn(&str) -> bool) -> io::Result<()>
 /// analysis started, by the checks of
 /// [`crate::analysis::preflight`]: `summary.json` alone, status `failed`
 /// with `message`. The directory is locked as for a run, and the files of
-/// an earlier run are removed (none would belong to this model); no other
-/// file is written.
+/// an earlier run are removed (none would belong to this model), its
+/// restart files too but `keep` (the restart file given to this run, if
+/// any); no other file is written.
 pub fn write_rejected(
     dir: &Path,
     model_file: &str,
@@ -557,10 +558,12 @@ pub fn write_rejected(
     first: &StaticAnalysis,
     plan: &[AnalysisSettings],
     message: &str,
+    keep: Option<&Path>,
 ) -> io::Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| file_error(dir, e))?;
     let _lock = DirectoryLock::acquire(dir)?;
     remove_leftovers(dir, |_| false)?;
+    super::restart::remove_earlier(dir, keep)?;
     // an empty grid folder of an earlier run goes too
     let _ = std::fs::remove_dir(dir.join("vtk"));
     let mut summary = Summary::start(model_file, model, first, plan);

@@ -27,6 +27,10 @@
 //! looked at between increments, and a second signal, which ends the
 //! process at once, waits for the step being written.
 //!
+//! Restart files ([`super::restart`]): with [`Recorder::with_restart`]
+//! the recorder writes them at the requested times and, when the run ends,
+//! `restart.json` with its last converged state.
+//!
 //! The library never prints: what a person should see goes to a
 //! [`Console`], which the caller provides.
 
@@ -37,6 +41,7 @@ use std::sync::atomic::{AtomicI32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use super::modes::ModalFiles;
+use super::restart::RestartWriter;
 use super::results::{file_error, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
@@ -349,6 +354,9 @@ pub struct Recorder {
     /// Largest constraint violation (relative to its tolerance) at each
     /// iteration of the increment being solved.
     violations: Vec<f64>,
+    /// Restart files, and the index in the model's sequence of the first
+    /// analysis recorded.
+    restart: Option<(RestartWriter, usize)>,
 }
 
 /// The analysis being recorded.
@@ -437,6 +445,7 @@ impl Recorder {
             modal: ModalFiles::default(),
             encoding: Encoding::default(),
             violations: Vec::new(),
+            restart: None,
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -521,6 +530,14 @@ impl Recorder {
         self
     }
 
+    /// Writes restart files with `writer` (io::restart); the first analysis
+    /// recorded is analysis `first_analysis` (from 0) of the model's
+    /// sequence, as in a restarted run.
+    pub fn with_restart(mut self, writer: RestartWriter, first_analysis: usize) -> Self {
+        self.restart = Some((writer, first_analysis));
+        self
+    }
+
     /// Writes the grids in `encoding` (binary by default).
     pub fn with_vtk_encoding(mut self, encoding: Encoding) -> Self {
         self.writer = self.writer.with_vtk_encoding(encoding);
@@ -549,12 +566,15 @@ impl Recorder {
     /// `log.txt`, and `summary.json`. Write errors are returned in the
     /// report, not lost.
     pub fn finish(self, outcome: &StaticOutcome) -> RunReport {
-        self.finish_with(Some(outcome))
+        self.finish_with(Some(outcome), &outcome.state)
     }
 
     /// As [`Recorder::finish`], for a run whose last static analysis (if
-    /// any) returned `outcome`; a failed modal analysis fails the run.
-    pub fn finish_with(mut self, outcome: Option<&StaticOutcome>) -> RunReport {
+    /// any) returned `outcome` and whose last converged state is `state`
+    /// (that of `outcome`, or the state a modal analysis after it was
+    /// given and left unchanged), written to `restart.json`; a failed
+    /// modal analysis fails the run.
+    pub fn finish_with(mut self, outcome: Option<&StaticOutcome>, state: &State) -> RunReport {
         let error = outcome.and_then(|o| o.error.as_ref());
         if let Some(o) = outcome {
             self.close(o);
@@ -572,6 +592,14 @@ impl Recorder {
             ),
             (Some(e), None, _) => (RunStatus::Failed, Some(e.to_string())),
         };
+        let mut output_errors = Vec::new();
+        if let Some((restart, first)) = &self.restart {
+            let _writing = self.stop.output();
+            let index = first + self.current.index;
+            if let Err(e) = restart.finish(index, self.current.kind, state) {
+                output_errors.push(e);
+            }
+        }
         self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
         // the initial equilibria's iterations are counted in the total,
@@ -595,7 +623,6 @@ impl Recorder {
         );
         self.log.line(&last_line);
         self.console.finish(&last_line);
-        let mut output_errors = Vec::new();
         if let Err(e) = self.log.flush() {
             output_errors.push(e);
         }
@@ -689,6 +716,9 @@ impl Observer for Recorder {
                 self.writer.increment(&last, model, state, residual)?;
             } else {
                 self.writer.increment(info, model, state, residual)?;
+            }
+            if let Some((restart, first)) = &mut self.restart {
+                restart.increment(*first + self.current.index, self.current.kind, state)?;
             }
         }
         self.log.flush()?;

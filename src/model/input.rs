@@ -44,7 +44,7 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 18] = [
+pub const TOP_LEVEL_KEYS: [&str; 19] = [
     "title",
     "analysis",
     "nodes",
@@ -63,6 +63,7 @@ pub const TOP_LEVEL_KEYS: [&str; 18] = [
     "joint_springs",
     "hinge_laws",
     "drivers",
+    "output",
 ];
 
 /// A complete model definition.
@@ -125,6 +126,20 @@ pub struct ModelInput {
     /// Prescribed histories of joint coordinates or node components.
     #[serde(default)]
     pub drivers: Vec<DriverInput>,
+    /// What a run writes besides the result files (`[output]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<OutputInput>,
+}
+
+/// `[output]`: files a run writes besides the results.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OutputInput {
+    /// Times at which a restart file `restart-<t>.json` is written
+    /// (besides `restart.json` at the end of every run), in increasing
+    /// order, within the analyses; the analyses land on them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub restart_times: Vec<f64>,
 }
 
 /// A kinematic pair between node A and node B (or the ground).

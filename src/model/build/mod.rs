@@ -19,6 +19,7 @@ mod joints;
 mod loads;
 mod masses;
 mod nodes;
+mod output;
 mod sections;
 mod settings;
 mod springs;
@@ -281,6 +282,7 @@ impl Model {
         let mut ck = Checker::default();
         let plan = settings::Plan::of(&settings::analyses(&mut ck, &input.analysis));
         let curves = CurveTable::build(&mut ck, &input.curves, plan.end_time);
+        output::check(&mut ck, input.output.as_ref(), plan.end_time);
         let mut b = Builder {
             input,
             ck,

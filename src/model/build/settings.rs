@@ -15,7 +15,27 @@ impl ModelInput {
     /// which reports them with the rest of the model).
     pub fn analyses(&self) -> Result<Vec<AnalysisSettings>, ModelErrors> {
         let mut ck = Checker::default();
-        let all = analyses(&mut ck, &self.analysis);
+        let mut all = analyses(&mut ck, &self.analysis);
+        // the analyses land on the restart times: they join the output
+        // times of the analysis they fall in
+        if let Some(o) = &self.output {
+            let mut start = 0.0;
+            // (a modal analysis has no increments: it neither moves `t`
+            // nor writes restart files)
+            for s in all.iter_mut().filter_map(|a| match a {
+                AnalysisSettings::Static(s) => Some(s),
+                _ => None,
+            }) {
+                let within = o
+                    .restart_times
+                    .iter()
+                    .filter(|&&t| t > start && t <= s.end_time);
+                s.output_times.extend(within);
+                s.output_times.sort_by(f64::total_cmp);
+                s.output_times.dedup();
+                start = s.end_time;
+            }
+        }
         if ck.errors.is_empty() {
             Ok(all)
         } else {

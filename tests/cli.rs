@@ -1681,44 +1681,8 @@ fn line_iterations(line: &str) -> usize {
 /// t ≈ 0.0845; the run goes on (exit 0).
 #[test]
 fn the_run_warns_about_limit_points_passed() {
-    let text = r#"title = "shallow clamped arch"
-[analysis]
-initial_increment = 0.05
-[[sections]]
-name = "s"
-EA = 1e6
-GA2 = 1e6
-GA3 = 1e6
-GJ = 1.0
-EI2 = 1.0
-EI3 = 1.0
-[[nodes]]
-id = 1
-x = [-1.0, 0.0, 0.0]
-[[nodes]]
-id = 2
-x = [0.0, 0.1, 0.0]
-[[nodes]]
-id = 3
-x = [1.0, 0.0, 0.0]
-[[beam_lines]]
-nodes = [1, 2]
-elements = 10
-section = "s"
-[[beam_lines]]
-nodes = [2, 3]
-elements = 10
-section = "s"
-[[supports]]
-node = 1
-fixed = ["all"]
-[[supports]]
-node = 3
-fixed = ["all"]
-[[loads]]
-node = 2
-force = [0.0, -200.0, 0.0]
-"#;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/shallow_arch.toml");
+    let text = &std::fs::read_to_string(path).expect("the arch model");
     let dir = scratch("arch_limit");
     let (code, out, err) = run_model(&dir, "arch.toml", text);
     assert_eq!(code, 0, "{out}{err}");

@@ -10,6 +10,8 @@
 //! rotations, a multiplier-enforced hinge and a driver whose internal
 //! variables (the unwrapped angle) must come through the restart.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -43,14 +45,7 @@ fn unfold(args: &[&str]) -> (i32, String, String) {
 /// The driven bend with the analyses ending at `sequence` (increments of
 /// 0.125 throughout) and a tip load `p`.
 fn driven_bend(sequence: &[f64], p: f64) -> ModelInput {
-    bend_with_analyses(
-        Section::diagonal(
-            1.0e7, 4.166667e6, 4.166667e6, 8.333333e5, 8.333333e5, 8.333333e5,
-        ),
-        sequence,
-        p,
-        None,
-    )
+    bend_with_analyses(common::bend_section(), sequence, p, None)
 }
 
 /// The driven bend of section `section` with the static analyses ending at
@@ -62,37 +57,7 @@ fn bend_with_analyses(
     p: f64,
     modes: Option<usize>,
 ) -> ModelInput {
-    let mut m = ModelBuilder::new("driven 45° bend");
-    let r = 100.0;
-    let square = m.section(section);
-    let root = m.node([0.0, 0.0, 0.0]);
-    let tip = m.node([
-        r * (0.25 * std::f64::consts::PI).sin(),
-        r * (1.0 - (0.25 * std::f64::consts::PI).cos()),
-        0.0,
-    ]);
-    m.add(
-        BeamLine::between(root, tip, 8, square)
-            .arc([0.0, r, 0.0])
-            .orientation([0.0, 0.0, 1.0]),
-    );
-    let hinge = m.add(Joint::revolute(root, Ground).axis([1.0, 0.0, 0.0]));
-    m.add(Driver::on(hinge).value(0.15));
-    m.add(Load::force(tip, [0.0, 0.0, p]));
-    for (k, &end) in sequence.iter().enumerate() {
-        let a = Analysis::statics()
-            .end_time(end)
-            .initial_increment(0.125)
-            .max_increment(0.125)
-            .residual_tolerance(1e-11)
-            .displacement_tolerance(1e-11)
-            .rotation_tolerance(1e-11);
-        if k == 0 {
-            m.analysis(a);
-        } else {
-            m.then(a);
-        }
-    }
+    let mut m = common::driven_bend(section, sequence, p);
     if let Some(n) = modes {
         m.then(Analysis::modal(n));
     }

@@ -22,47 +22,10 @@ use unfold::state::State;
 /// length ≈ 1 rising 0.1 to an apex loaded by `200 t` downwards (EA = 1e6,
 /// every bending and torsional stiffness 1), ten elements each.
 fn arch(analysis: &str) -> ModelInput {
-    let text = format!(
-        r#"
-title = "shallow clamped arch"
-[analysis]
-{analysis}
-[[sections]]
-name = "s"
-EA = 1e6
-GA2 = 1e6
-GA3 = 1e6
-GJ = 1.0
-EI2 = 1.0
-EI3 = 1.0
-[[nodes]]
-id = 1
-x = [-1.0, 0.0, 0.0]
-[[nodes]]
-id = 2
-x = [0.0, 0.1, 0.0]
-[[nodes]]
-id = 3
-x = [1.0, 0.0, 0.0]
-[[beam_lines]]
-nodes = [1, 2]
-elements = 10
-section = "s"
-[[beam_lines]]
-nodes = [2, 3]
-elements = 10
-section = "s"
-[[supports]]
-node = 1
-fixed = ["all"]
-[[supports]]
-node = 3
-fixed = ["all"]
-[[loads]]
-node = 2
-force = [0.0, -200.0, 0.0]
-"#
-    );
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/shallow_arch.toml");
+    let text = std::fs::read_to_string(path)
+        .expect("the arch model")
+        .replace("initial_increment = 0.05\n", &format!("{analysis}\n"));
     parse_model(&text, std::path::Path::new("arch.toml")).unwrap()
 }
 

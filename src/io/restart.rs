@@ -262,9 +262,12 @@ impl Restart {
             return Err(parse(format!("its \"format\" is not \"{FORMAT}\"")));
         }
         if header.version != Some(VERSION) {
+            let found = match header.version {
+                Some(v) => format!("version {v}"),
+                None => "no \"version\"".to_string(),
+            };
             return Err(parse(format!(
-                "version {:?}; this unfold reads version {VERSION}",
-                header.version
+                "{found}; this unfold reads version {VERSION}"
             )));
         }
         let file: RestartFile = serde_json::from_str(&text).map_err(|e| parse(e.to_string()))?;

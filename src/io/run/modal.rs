@@ -132,7 +132,9 @@ impl Recorder {
                 if m.is_zero() { "  (rigid-body or mechanism mode)" } else { "" }
             ));
         }
-        self.line(&format!(
+        // the console gets the frequencies from the caller; the log keeps
+        // the line with the run
+        self.log.line(&format!(
             "modal analysis at t = {}: {} modes ({} zero) in {:.3} s",
             outcome.time,
             outcome.modes.len(),

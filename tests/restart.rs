@@ -424,3 +424,23 @@ fn a_restart_before_a_modal_analysis_gives_its_frequencies() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A restart time at the start of the run (t = 0, where the model itself
+/// is the state) or beyond the last analysis is refused at input (exit 2),
+/// naming `[output]`, instead of being silently ignored.
+#[test]
+fn restart_times_outside_the_run_are_refused() {
+    let dir = scratch("times_outside");
+    for (name, t) in [("at_zero", 0.0), ("beyond", 3.0)] {
+        let mut input = driven_bend(&[2.0], 600.0);
+        input.output = Some(OutputInput {
+            restart_times: vec![t],
+        });
+        let (code, err, _) = run(&dir, name, &input, &[]);
+        assert_eq!(code, 2, "t = {t}: {err}");
+        assert!(
+            err.contains("output") && err.contains("restart_times must lie after the start"),
+            "t = {t}: {err}"
+        );
+    }
+}

@@ -4,18 +4,20 @@ use super::{num, Checker};
 use crate::model::input::OutputInput;
 use crate::model::ModelErrorKind;
 
-/// Checks `[output]` against the span of the analyses, `[0, end_time]`.
+/// Checks `[output]` against the span of the analyses, `(0, end_time]`: the
+/// state at t = 0 is the model itself, so a restart there would restart
+/// nothing.
 pub(super) fn check(ck: &mut Checker, output: Option<&OutputInput>, end_time: f64) {
     let Some(o) = output else {
         return;
     };
     for &t in &o.restart_times {
-        if !(t.is_finite() && (0.0..=end_time).contains(&t)) {
+        if !(t.is_finite() && t > 0.0 && t <= end_time) {
             ck.push(
                 ModelErrorKind::Invalid,
                 "output",
                 format!(
-                    "restart_times must lie within the analyses, from t = 0 to the end_time of the last ({}), got {}",
+                    "restart_times must lie after the start of the analyses (t = 0, where the model itself is the start) and up to the end_time of the last ({}), got {}",
                     num(end_time),
                     num(t)
                 ),

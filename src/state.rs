@@ -192,12 +192,8 @@ impl State {
         k: usize,
         h: f64,
     ) {
-        let nq = 6 * nodes.len();
-        if k < nq {
-            self.velocity[nodes[k / 6]][k % 6] += h;
-        } else if k < nq + n_coordinates {
-            self.coordinate_rates[offsets.coordinates + k - nq] += h;
-        }
+        let (nodal, coordinates) = (&mut self.velocity, &mut self.coordinate_rates);
+        change_local(nodal, coordinates, nodes, n_coordinates, offsets, k, h);
     }
 
     /// Changes the acceleration of local unknown `k` of an element by `h`
@@ -210,12 +206,28 @@ impl State {
         k: usize,
         h: f64,
     ) {
-        let nq = 6 * nodes.len();
-        if k < nq {
-            self.acceleration[nodes[k / 6]][k % 6] += h;
-        } else if k < nq + n_coordinates {
-            self.coordinate_accelerations[offsets.coordinates + k - nq] += h;
-        }
+        let (nodal, coordinates) = (&mut self.acceleration, &mut self.coordinate_accelerations);
+        change_local(nodal, coordinates, nodes, n_coordinates, offsets, k, h);
+    }
+}
+
+/// Adds `h` to local unknown `k` of an element in a pair of rate vectors
+/// (nodal, coordinates): [`State::change_local_rate`] and
+/// [`State::change_local_acceleration`].
+fn change_local(
+    nodal: &mut [[f64; 6]],
+    coordinates: &mut [f64],
+    nodes: &[usize],
+    n_coordinates: usize,
+    offsets: &crate::elements::Offsets,
+    k: usize,
+    h: f64,
+) {
+    let nq = 6 * nodes.len();
+    if k < nq {
+        nodal[nodes[k / 6]][k % 6] += h;
+    } else if k < nq + n_coordinates {
+        coordinates[offsets.coordinates + k - nq] += h;
     }
 }
 

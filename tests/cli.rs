@@ -1521,44 +1521,16 @@ fn a_sequence_must_go_forward() {
 /// elements, end rotation 4π about the axis), with increments of
 /// `increment` asked for.
 fn twisted_cantilever(increment: f64) -> String {
-    format!(
-        r#"title = "two full turns"
-[analysis]
-initial_increment = {increment}
-
-[[sections]]
-name = "steel"
-EA = 1.68e8
-GA2 = 5.38e7
-GA3 = 5.38e7
-GJ = 5.92e3
-EI2 = 5.6e3
-EI3 = 2.24e4
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [2.0, 0.0, 0.0]
-
-[[beam_lines]]
-nodes = [1, 2]
-elements = 10
-section = "steel"
-orientation = [0.0, 0.0, 1.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[prescribed]]
-node = 2
-rotation = [12.566370614359172, 0.0, 0.0]
-unit = "rad"
-"#
-    )
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/twisted_cantilever.toml"
+    );
+    std::fs::read_to_string(path)
+        .expect("the twisted cantilever")
+        .replace(
+            "initial_increment = 0.5\n",
+            &format!("initial_increment = {increment}\n"),
+        )
 }
 
 /// The torque of a prescribed end rotation of two full turns is

@@ -145,38 +145,9 @@ fn stable_paths_are_not_warned_about() {
 #[test]
 fn prescribed_rotations_turn_by_at_most_a_quarter_turn_per_increment() {
     let twisted = |increment: f64| {
-        let text = format!(
-            r#"
-[analysis]
-initial_increment = {increment}
-[[sections]]
-name = "steel"
-EA = 1.68e8
-GA2 = 5.38e7
-GA3 = 5.38e7
-GJ = 5.92e3
-EI2 = 5.6e3
-EI3 = 2.24e4
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 2
-x = [2.0, 0.0, 0.0]
-[[beam_lines]]
-nodes = [1, 2]
-elements = 10
-section = "steel"
-orientation = [0.0, 0.0, 1.0]
-first_node = 3
-[[supports]]
-node = 1
-fixed = ["all"]
-[[prescribed]]
-node = 2
-rotation = [12.566370614359172, 0.0, 0.0]
-unit = "rad"
-"#
+        let text = common::model_text("twisted_cantilever.toml").replace(
+            "initial_increment = 0.5\n",
+            &format!("initial_increment = {increment}\n"),
         );
         run(&parse_model(&text, std::path::Path::new("twist.toml")).unwrap())
     };

@@ -110,3 +110,11 @@ pub fn driven_bend(section: Section, sequence: &[f64], p: f64) -> ModelBuilder {
     }
     m
 }
+
+/// The text of the model file `name` of tests/data.
+pub fn model_text(name: &str) -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}

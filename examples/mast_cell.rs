@@ -877,11 +877,16 @@ fn main() -> Result<(), Box<dyn Error>> {
             .first()
             .map_or("results/mast_cell", |s| s.as_str()),
     );
-    let increments: usize = positional
-        .get(1)
-        .map(|s| s.parse())
-        .transpose()?
-        .unwrap_or(96);
+    let increments: usize = match positional.get(1) {
+        None => 96,
+        Some(a) => match a.parse::<usize>() {
+            Ok(n) if n > 0 => n,
+            _ => {
+                eprintln!("error: INCREMENTS must be a positive whole number, got \"{a}\"\nusage: cargo run --release --example mast_cell -- [OUTPUT_DIRECTORY] [INCREMENTS] [--drive-top | --lower-top]");
+                std::process::exit(2);
+            }
+        },
+    };
 
     let start = Instant::now();
     let cell = build_design(&design, increments)?;
@@ -960,7 +965,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     println!("results in {}", out.display());
     if let Some(e) = run.outcome.error {
         if let Some(i) = Interrupted::of(&e) {
-            eprintln!("{i} at t = {}; results up to it are kept", run.outcome.time);
+            eprintln!(
+                "{i} at t = {}; results up to it are kept",
+                unfold::io::run::format_time(run.outcome.time)
+            );
             std::process::exit(i.exit_code().into());
         }
         return Err(e.into());

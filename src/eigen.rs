@@ -492,6 +492,24 @@ fn rayleigh_ritz(s: &Symmetric, z: &[Vec<f64>]) -> Result<(Vec<f64>, Mat<f64>), 
     Ok((theta, coefficients))
 }
 
+/// The Rayleigh quotient `zᵀKz / zᵀMz` of each vector and the vector
+/// `M`-normalised.
+fn rayleigh_quotients(s: &Symmetric, z: &[Vec<f64>]) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let n = s.dim();
+    let (mut kz, mut mz) = (vec![0.0; n], vec![0.0; n]);
+    z.iter()
+        .map(|zi| {
+            s.k.mul_vec(zi, &mut kz);
+            s.unknowns_only(&mut kz);
+            s.m.mul_vec(zi, &mut mz);
+            s.unknowns_only(&mut mz);
+            let mass = dot(zi, &mz);
+            let scale = 1.0 / mass.sqrt();
+            (dot(zi, &kz) / mass, zi.iter().map(|v| v * scale).collect())
+        })
+        .unzip()
+}
+
 /// Eigenvalues (ascending) and `B`-orthonormal eigenvectors of the
 /// symmetric-definite pencil `(A, B)`, by the Cholesky factor `B = LLᵀ`
 /// and the symmetric eigenproblem of `L⁻¹AL⁻ᵀ`; `None` if `B` is not
@@ -757,9 +775,21 @@ pub fn solve_dense(pencil: &Pencil, settings: &EigenSettings) -> Result<ModalSol
     };
     let z: Vec<Vec<f64>> = (0..wanted.len()).map(|k| to_full(k, &xu)).collect();
 
-    // Rayleigh–Ritz, then the multipliers: least squares Bᵀμ = −(Kx − ω²Mx)
-    let (lambda, coefficients) = rayleigh_ritz(&s, &z)?;
-    let x = combine(&z, &coefficients);
+    // Rayleigh quotients, then the multipliers: least squares
+    // Bᵀμ = −(Kx − ω²Mx). Not a Rayleigh–Ritz step over all the modes: the
+    // dense modes are already Ritz vectors of the whole space, and with
+    // many modes the projected stiffness spans the whole spectrum, whose
+    // eigenvectors then carry errors of ε ‖K‖ / gap along the stiff modes
+    // (measured: residuals of 1 on the lowest modes of a 234-unknown beam
+    // when all its modes were asked)
+    let (mut lambda, mut x) = rayleigh_quotients(&s, &z);
+    // by increasing ω² (members of a degenerate pair may swap by round-off)
+    let mut order: Vec<usize> = (0..lambda.len()).collect();
+    order.sort_by(|&a, &b| lambda[a].total_cmp(&lambda[b]));
+    (lambda, x) = order
+        .into_iter()
+        .map(|k| (lambda[k], std::mem::take(&mut x[k])))
+        .unzip();
     let mut mus = vec![vec![0.0; s.dim()]; x.len()];
     if let Some((qr, rank)) = &null_space {
         let mut rhs = Mat::<f64>::zeros(nu, x.len());

@@ -16,6 +16,8 @@
 //! ([`State::displace_local`]) and the examples go through it, so that a
 //! tangent is always the derivative along the update that Newton applies.
 
+use serde::{Deserialize, Serialize};
+
 use crate::dofs::DofMap;
 use crate::so3::{self, Rotation, Vec3};
 
@@ -26,13 +28,21 @@ use crate::so3::{self, Rotation, Vec3};
 /// vectors of coordinates as long as it has coordinates, whatever the
 /// analysis: statics leaves the rates at zero, so that an element never
 /// has to ask whether they are there.
-#[derive(Clone, Debug, Default, PartialEq)]
+///
+/// It serialises (serde) field by field under the names below, positions
+/// as `[x, y, z]` and orientations as unit quaternions `[w, x, y, z]`
+/// (the restart files of [`crate::io::restart`]); every number is kept
+/// to the last bit.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct State {
     /// Time, or load parameter in statics.
     pub time: f64,
     /// Node positions, global frame.
+    #[serde(with = "serde_positions")]
     pub x: Vec<Vec3>,
     /// Node orientations (material frame to global frame).
+    #[serde(with = "serde_orientations")]
     pub q: Vec<Rotation>,
     /// Generalised coordinates of elements (a slider's curve parameter,
     /// modal amplitudes).
@@ -182,12 +192,8 @@ impl State {
         k: usize,
         h: f64,
     ) {
-        let nq = 6 * nodes.len();
-        if k < nq {
-            self.velocity[nodes[k / 6]][k % 6] += h;
-        } else if k < nq + n_coordinates {
-            self.coordinate_rates[offsets.coordinates + k - nq] += h;
-        }
+        let (nodal, coordinates) = (&mut self.velocity, &mut self.coordinate_rates);
+        change_local(nodal, coordinates, nodes, n_coordinates, offsets, k, h);
     }
 
     /// Changes the acceleration of local unknown `k` of an element by `h`
@@ -200,12 +206,74 @@ impl State {
         k: usize,
         h: f64,
     ) {
-        let nq = 6 * nodes.len();
-        if k < nq {
-            self.acceleration[nodes[k / 6]][k % 6] += h;
-        } else if k < nq + n_coordinates {
-            self.coordinate_accelerations[offsets.coordinates + k - nq] += h;
-        }
+        let (nodal, coordinates) = (&mut self.acceleration, &mut self.coordinate_accelerations);
+        change_local(nodal, coordinates, nodes, n_coordinates, offsets, k, h);
+    }
+}
+
+/// Adds `h` to local unknown `k` of an element in a pair of rate vectors
+/// (nodal, coordinates): [`State::change_local_rate`] and
+/// [`State::change_local_acceleration`].
+fn change_local(
+    nodal: &mut [[f64; 6]],
+    coordinates: &mut [f64],
+    nodes: &[usize],
+    n_coordinates: usize,
+    offsets: &crate::elements::Offsets,
+    k: usize,
+    h: f64,
+) {
+    let nq = 6 * nodes.len();
+    if k < nq {
+        nodal[nodes[k / 6]][k % 6] += h;
+    } else if k < nq + n_coordinates {
+        coordinates[offsets.coordinates + k - nq] += h;
+    }
+}
+
+/// Positions as arrays `[x, y, z]`.
+mod serde_positions {
+    use super::Vec3;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(x: &[Vec3], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(x.iter().map(|v| [v.x, v.y, v.z]))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Vec3>, D::Error> {
+        let raw = Vec::<[f64; 3]>::deserialize(d)?;
+        Ok(raw.into_iter().map(Vec3::from).collect())
+    }
+}
+
+/// Orientations as unit quaternions `[w, x, y, z]`; one that is not of
+/// unit length (to 1e-10) is refused, not normalised.
+mod serde_orientations {
+    use super::Rotation;
+    use nalgebra::Quaternion;
+    use serde::{de::Error, Deserialize, Deserializer, Serializer};
+
+    /// Largest departure of `|q|` from 1 accepted when reading.
+    const UNIT_TOLERANCE: f64 = 1e-10;
+
+    pub fn serialize<S: Serializer>(q: &[Rotation], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(q.iter().map(|r| [r.w, r.i, r.j, r.k]))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Rotation>, D::Error> {
+        let raw = Vec::<[f64; 4]>::deserialize(d)?;
+        raw.into_iter()
+            .enumerate()
+            .map(|(i, [w, x, y, z])| {
+                let q = Quaternion::new(w, x, y, z);
+                if (q.norm() - 1.0).abs() > UNIT_TOLERANCE {
+                    return Err(D::Error::custom(format!(
+                        "orientation {i} [{w}, {x}, {y}, {z}] is not a unit quaternion"
+                    )));
+                }
+                Ok(Rotation::new_unchecked(q))
+            })
+            .collect()
     }
 }
 

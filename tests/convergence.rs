@@ -11,29 +11,13 @@ use std::f64::consts::PI;
 use common::node;
 use std::sync::Arc;
 
-use unfold::analysis::{IncrementInfo, NewtonFailure, Observer, StaticOutcome};
+use unfold::analysis::observers::History;
+use unfold::analysis::{NewtonFailure, StaticOutcome};
 use unfold::elements::{Element, ElementKind, ElementOutput, EvalContext};
 use unfold::model::input::{BeamLineInput, ModelInput};
 use unfold::model::Model;
 use unfold::so3;
 use unfold::state::State;
-
-/// Keeps the iterations of every converged increment.
-#[derive(Default)]
-struct Iterations(Vec<usize>);
-
-impl Observer for Iterations {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        _: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.0.push(info.iterations);
-        Ok(())
-    }
-}
 
 /// A straight line of `n` beam elements from node 1 at `a` to node 2 at
 /// `b`; interior nodes get ids 3, 4, ... in order from `a`.
@@ -64,9 +48,10 @@ fn line(
 /// increment after the initial equilibrium.
 fn run_model(model: Model, input: &ModelInput) -> (Arc<Model>, StaticOutcome, Vec<usize>) {
     let model = Arc::new(model);
-    let mut iterations = Iterations::default();
-    let outcome = common::analysis(&model, input).run(model.initial_state(), &mut iterations);
-    (model, outcome, iterations.0[1..].to_vec())
+    let mut history = History::new();
+    let outcome = common::analysis(&model, input).run(model.initial_state(), &mut history);
+    let iterations = history.increments[1..].iter().map(|i| i.iterations);
+    (model, outcome, iterations.collect())
 }
 
 /// The cantilever of the README and the crate example: 2 m, 10 elements,

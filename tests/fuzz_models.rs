@@ -317,8 +317,20 @@ fn check(text: &str, path: &Path) -> Result<Model, String> {
         .to_string()
     };
     let analyses = input.analyses().map_err(invalid)?;
-    let settings = analyses[0].as_static().ok_or("not a static analysis")?;
-    preflight::check(&model, settings).map_err(|e| format!("{}: {e}", path.display()))?;
+    // as `unfold check`: the mass of a model with modal analyses, then the
+    // preflight of the first static analysis, if any
+    if analyses.iter().any(|a| a.as_modal().is_some())
+        && !unfold::analysis::ModalAnalysis::has_mass(&model)
+    {
+        return Err(format!(
+            "{}: modal analysis: {}",
+            path.display(),
+            unfold::analysis::ModalError::NoMass
+        ));
+    }
+    if let Some(settings) = analyses.iter().find_map(|a| a.as_static()) {
+        preflight::check(&model, settings).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
     Ok(model)
 }
 

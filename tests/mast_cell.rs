@@ -213,33 +213,25 @@ fn imposing_the_top_too_over_controls_the_cell() {
 #[test]
 fn assembled_tangent_of_the_bent_cell_matches_finite_differences() {
     use unfold::analysis::newton::NewtonSolver;
-    use unfold::analysis::{IncrementInfo, Observer, StaticAnalysis};
+    use unfold::analysis::observers::OnIncrement;
+    use unfold::analysis::{IncrementInfo, StaticAnalysis};
     use unfold::state::State;
 
-    struct Grab(Option<State>);
-    impl Observer for Grab {
-        fn increment(
-            &mut self,
-            i: &IncrementInfo,
-            _: &Model,
-            s: &State,
-            _: &[f64],
-        ) -> std::io::Result<()> {
-            // t = 1.25: the longerons are bent at a quarter of the fold
-            if i.increment == 3 * INCREMENTS / 4 - INCREMENTS / 8 {
-                self.0 = Some(s.clone());
-            }
-            Ok(())
-        }
-    }
     let input = mast_cell::build(INCREMENTS).input;
     let model = std::sync::Arc::new(Model::from_input(&input).unwrap());
-    let mut grab = Grab(None);
+    let mut grabbed = None;
     let settings = input.analyses().unwrap()[0].as_static().unwrap().clone();
-    let outcome =
-        StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut grab);
+    let outcome = StaticAnalysis::new(model.clone(), settings).run(
+        model.initial_state(),
+        &mut OnIncrement(|i: &IncrementInfo, _: &Model, s: &State| {
+            // t = 1.25: the longerons are bent at a quarter of the fold
+            if i.increment == 3 * INCREMENTS / 4 - INCREMENTS / 8 {
+                grabbed = Some(s.clone());
+            }
+        }),
+    );
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
-    let state = grab.0.expect("the increment was reached");
+    let state = grabbed.expect("the increment was reached");
     let t = state.time;
     assert!(t > 1.2, "t = {t}");
 

@@ -26,8 +26,9 @@
 use std::f64::consts::{FRAC_PI_4, PI, TAU};
 
 use unfold::analysis::newton::NewtonSolver;
+use unfold::analysis::observers::History;
 use unfold::analysis::statics::StaticError;
-use unfold::analysis::{IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
+use unfold::analysis::{StaticAnalysis, StaticOutcome};
 use unfold::elements::ElementKind;
 use unfold::joints::JointType;
 use unfold::model::input::{AnalysisInput, DriverInput, Id, JointInput, ModelInput};
@@ -47,44 +48,10 @@ const LIMIT: f64 = 1e-8;
 // helpers
 // ---------------------------------------------------------------------
 
-/// Records every converged state and the notes of the analysis.
-#[derive(Default)]
-struct Path {
-    increments: Vec<IncrementInfo>,
-    states: Vec<State>,
-    notes: Vec<String>,
-}
-
-impl Observer for Path {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.increments.push(info.clone());
-        self.states.push(state.clone());
-        Ok(())
-    }
-
-    fn note(&mut self, text: &str) {
-        self.notes.push(text.to_string());
-    }
-}
-
-impl Path {
-    /// Newton iterations over the converged increments (increment 0
-    /// included).
-    fn iterations(&self) -> usize {
-        self.increments.iter().map(|i| i.iterations).sum()
-    }
-}
-
 /// Builds and runs a model, keeping every converged state.
-fn simulate(input: &ModelInput) -> (std::sync::Arc<Model>, StaticOutcome, Path) {
+fn simulate(input: &ModelInput) -> (std::sync::Arc<Model>, StaticOutcome, History) {
     let model = std::sync::Arc::new(Model::from_input(input).expect("valid model"));
-    let mut path = Path::default();
+    let mut path = History::with_states();
     let settings = input.analyses().unwrap()[0].as_static().unwrap().clone();
     let outcome =
         StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut path);

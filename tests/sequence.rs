@@ -22,42 +22,7 @@ use unfold::so3;
 
 /// The driven bend, with the analyses of `sequence` (end times).
 fn driven_bend(sequence: &[f64]) -> ModelBuilder {
-    let mut m = ModelBuilder::new("driven 45° bend");
-    let (r, p) = (100.0, 600.0);
-    let square = m.section(Section::diagonal(
-        1.0e7, 4.166667e6, 4.166667e6, 8.333333e5, 8.333333e5, 8.333333e5,
-    ));
-    let root = m.node([0.0, 0.0, 0.0]);
-    let tip = m.node([
-        r * (0.25 * std::f64::consts::PI).sin(),
-        r * (1.0 - (0.25 * std::f64::consts::PI).cos()),
-        0.0,
-    ]);
-    m.add(
-        BeamLine::between(root, tip, 8, square)
-            .arc([0.0, r, 0.0])
-            .orientation([0.0, 0.0, 1.0]),
-    );
-    let hinge = m.add(Joint::revolute(root, Ground).axis([1.0, 0.0, 0.0]));
-    m.add(Driver::on(hinge).value(0.15));
-    m.add(Load::force(tip, [0.0, 0.0, p]));
-    for (k, &end) in sequence.iter().enumerate() {
-        // increments of 0.125 throughout, tolerances tight enough to
-        // compare end states at 1e-9
-        let a = Analysis::statics()
-            .end_time(end)
-            .initial_increment(0.125)
-            .max_increment(0.125)
-            .residual_tolerance(1e-11)
-            .displacement_tolerance(1e-11)
-            .rotation_tolerance(1e-11);
-        if k == 0 {
-            m.analysis(a);
-        } else {
-            m.then(a);
-        }
-    }
-    m
+    common::driven_bend(common::bend_section(), sequence, 600.0)
 }
 
 /// The model and the settings of its analyses.
@@ -152,7 +117,7 @@ fn two_analyses_in_sequence_end_where_one_does() {
 #[test]
 fn step_by_step_is_a_run() {
     let (model, settings) = build(&driven_bend(&[1.0]));
-    let mut all = common::Recorder::default();
+    let mut all = unfold::analysis::observers::History::new();
     let at_once = StaticAnalysis::new(model.clone(), settings[0].clone())
         .run(model.initial_state(), &mut all);
 

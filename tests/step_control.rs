@@ -5,37 +5,11 @@
 
 use std::sync::Arc;
 
-use unfold::analysis::{EventFunction, EventInfo, IncrementInfo, Observer, StaticAnalysis};
+use unfold::analysis::observers::History;
+use unfold::analysis::{EventFunction, StaticAnalysis};
 use unfold::model::builder::*;
 use unfold::model::Model;
 use unfold::state::State;
-
-/// Every increment, event and note of a run, with the states.
-#[derive(Default)]
-struct Log {
-    increments: Vec<(IncrementInfo, State)>,
-    events: Vec<EventInfo>,
-    notes: Vec<String>,
-}
-
-impl Observer for Log {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.increments.push((info.clone(), state.clone()));
-        Ok(())
-    }
-    fn event(&mut self, info: &EventInfo) {
-        self.events.push(info.clone());
-    }
-    fn note(&mut self, text: &str) {
-        self.notes.push(text.to_string());
-    }
-}
 
 /// "The `z` of node `node` reaches `value`": `g = z − value`.
 struct Reaches {
@@ -84,16 +58,12 @@ fn bend() -> (Arc<Model>, unfold::analysis::StaticSettings, usize) {
 #[test]
 fn a_step_lands_on_an_event() {
     let (model, settings, tip) = bend();
-    let mut plain = Log::default();
+    let mut plain = History::with_states();
     let reference =
         StaticAnalysis::new(model.clone(), settings.clone()).run(model.initial_state(), &mut plain);
     assert!(reference.error.is_none(), "{:?}", reference.error);
     // the increments of the plain run that bracket z = 40
-    let z: Vec<(f64, f64)> = plain
-        .increments
-        .iter()
-        .map(|(i, s)| (i.time, s.x[tip].z))
-        .collect();
+    let z: Vec<(f64, f64)> = plain.steps().map(|(i, s)| (i.time, s.x[tip].z)).collect();
     let k = z
         .iter()
         .position(|&(_, zk)| zk > 40.0)
@@ -105,7 +75,7 @@ fn a_step_lands_on_an_event() {
         value: 40.0,
         tolerance: 4e-8,
     };
-    let mut log = Log::default();
+    let mut log = History::with_states();
     let outcome = StaticAnalysis::new(model.clone(), settings)
         .with_event(Box::new(event))
         .run(model.initial_state(), &mut log);
@@ -120,8 +90,7 @@ fn a_step_lands_on_an_event() {
     assert!(e.time > t_before && e.time < t_after, "t = {}", e.time);
     assert!(outcome.event_retries >= 1);
     let (info, state) = log
-        .increments
-        .iter()
+        .steps()
         .find(|(i, _)| i.increment == e.increment)
         .expect("the event's increment");
     assert!(info.output);
@@ -172,7 +141,7 @@ fn a_driver_handing_over_has_the_rank_analysed_again() {
     );
     let model = Arc::new(m.build().unwrap());
     let settings = m.analyses().unwrap()[0].as_static().unwrap().clone();
-    let mut log = Log::default();
+    let mut log = History::with_states();
     let outcome = StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut log);
     for n in &log.notes {
         println!("note: {n}");
@@ -192,7 +161,7 @@ fn a_driver_handing_over_has_the_rank_analysed_again() {
     let (hub, end) = (model.node(hub), model.node(end));
     let mut at_half = false;
     let mut worst = 0.0f64;
-    for (info, state) in &log.increments {
+    for (info, state) in log.steps() {
         let t = info.time;
         let expected = if t <= 0.4 {
             0.5 * t

@@ -18,7 +18,9 @@ pub mod constraints;
 pub mod control;
 pub mod dynamics;
 pub mod energy;
+pub mod modal;
 pub mod newton;
+pub mod observers;
 pub mod preflight;
 pub mod settings;
 pub mod statics;
@@ -26,9 +28,10 @@ pub mod statics;
 pub use control::EventFunction;
 pub use dynamics::{DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
 pub use energy::{Energies, EnergyBalance};
+pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
-pub use settings::{AnalysisSettings, DynamicSettings, StaticSettings};
-pub use statics::{StaticAnalysis, StaticOutcome, Step};
+pub use settings::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
+pub use statics::{StaticAnalysis, StaticOutcome, Step, LIMIT_POINT_WARNING};
 
 use crate::model::Model;
 use crate::state::State;
@@ -120,6 +123,25 @@ pub trait Observer {
 
     /// A remark worth showing the user (redundant constraints removed).
     fn note(&mut self, _text: &str) {}
+
+    /// After a converged increment that the analysis finds suspect (a
+    /// limit or bifurcation point passed under load control, docs/theory.md
+    /// §9): the analysis goes on, but its results may not be those
+    /// meant.
+    fn warning(&mut self, _info: &WarningInfo) {}
+}
+
+/// A suspect converged increment ([`Observer::warning`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WarningInfo {
+    /// The increment.
+    pub increment: usize,
+    /// Load parameter at its start.
+    pub from: f64,
+    /// Load parameter reached.
+    pub time: f64,
+    /// What is suspect, and what to do.
+    pub message: String,
 }
 
 /// An observer that ignores everything.

@@ -57,7 +57,7 @@ use super::{IterationInfo, Observer};
 use crate::assembly::Assembler;
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
 use crate::elements::{ConstraintKind, ElementOutput, Need};
-use crate::linalg::{smallest_relative_pivot, SolveError, SparseLu};
+use crate::linalg::{smallest_relative_pivot, DeterminantSign, LuKernel, SolveError, SparseLu};
 use crate::model::{Model, COMPONENT_NAMES};
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -304,6 +304,11 @@ pub struct NewtonSolver {
     active: Vec<bool>,
     /// Scaling of the constraint equations (their multipliers' `k`).
     scaling: crate::elements::ConstraintScaling,
+    /// Sign of the tangent's determinant (docs/theory.md §9): the
+    /// workspace, and the sign of the last Newton system factored by the
+    /// simplicial kernel.
+    determinant: DeterminantSign,
+    newton_sign: Option<f64>,
 }
 
 impl NewtonSolver {
@@ -338,6 +343,8 @@ impl NewtonSolver {
             redundant: Vec::new(),
             active: Vec::new(),
             scaling: model.scaling,
+            determinant: DeterminantSign::default(),
+            newton_sign: None,
         }
     }
 
@@ -401,6 +408,7 @@ impl NewtonSolver {
         self.dofs = DofMap::with_suppressed(model, &self.redundant);
         self.assembler = Assembler::new(model, &self.dofs);
         self.lu = None;
+        self.newton_sign = None;
         self.held_entries = None;
         self.resize();
     }
@@ -1294,8 +1302,28 @@ impl NewtonSolver {
         }
         self.analyze()?;
         let lu = self.lu.as_mut().expect("analysed above");
+        self.newton_sign = None;
         lu.factor(&self.assembler.matrix)?;
+        if lu.kernel() == LuKernel::Simplicial {
+            // read off the factors: a pass over them, no more
+            self.newton_sign = self.determinant.of(lu, &self.assembler.matrix);
+        }
         lu.solve_in_place(&mut self.rhs)
+    }
+
+    /// Sign of the determinant of the tangent after a converged solve
+    /// (docs/theory.md §9): that of the last Newton system factored (at
+    /// the last iterate but one, within the tolerances of the converged
+    /// state) with the simplicial kernel; with the supernodal kernel, that
+    /// of the tangent assembled at the converged state, factored once more
+    /// by the simplicial kernel, below 5,000 unknowns only (`None` above:
+    /// [`DeterminantSign`]).
+    pub fn tangent_sign(&mut self) -> Option<f64> {
+        let lu = self.lu.as_ref()?;
+        match lu.kernel() {
+            LuKernel::Simplicial => self.newton_sign,
+            LuKernel::Supernodal => self.determinant.of(lu, &self.assembler.matrix),
+        }
     }
 
     /// `‖r‖₂` over the free translation equations of the last assembly.

@@ -5,7 +5,12 @@
 //! 1. The rank of the constraints at the reference configuration
 //!    (docs/joints.md §5): redundant constraint equations are counted, and
 //!    a kinematic analysis whose joints and drivers leave motions free is
-//!    rejected ([`StaticError::Indeterminate`]).
+//!    rejected ([`StaticError::Indeterminate`]). A redundant equation of a
+//!    driver is warned about: the driver either repeats what the joints
+//!    and the other drivers impose (two drivers turning one axle through
+//!    two hinges by the same angle) or contradicts it (an over-driven
+//!    mechanism), which only the first increment tells: the analysis then
+//!    stops ([`StaticError::Inconsistent`]).
 //! 2. The initial stiffness: the tangent at `t = 0` is factored and solved
 //!    for a probe load that acts on every unknown (the analysis's first
 //!    correction acts only along the loads of `t = 0`, so a run with no
@@ -21,8 +26,9 @@ use super::newton::{NewtonFailure, NewtonSolver};
 use super::settings::StaticSettings;
 use super::statics::StaticError;
 use crate::dofs::DofKind;
+use crate::elements::ElementKind;
 use crate::linalg::{smallest_relative_pivot, SparseLu};
-use crate::model::Model;
+use crate::model::{Model, ModelWarning};
 
 // the Newton solver's thresholds: a check reports what a run would
 use super::newton::{non_finite_origin, RUNAWAY_CORRECTION, SINGULAR_PIVOT};
@@ -38,6 +44,9 @@ pub struct Preflight {
     /// Motions the constraints leave free (to springs and beams in
     /// statics; none in a kinematic analysis).
     pub free_motions: usize,
+    /// Input that is valid but probably not meant: a driver equation among
+    /// the redundant ones.
+    pub warnings: Vec<ModelWarning>,
 }
 
 /// Runs the checks of the module documentation on `model`, for the first
@@ -74,7 +83,29 @@ pub fn check(model: &Model, settings: &StaticSettings) -> Result<Preflight, Stat
         unknowns,
         redundant_constraints: rank.redundant.len(),
         free_motions: free,
+        warnings: redundant_drivers(model, &rank.redundant),
     })
+}
+
+/// A warning for each redundant equation (`redundant`: indices among the
+/// multipliers) that belongs to a driver.
+fn redundant_drivers(model: &Model, redundant: &[usize]) -> Vec<ModelWarning> {
+    let mut warnings = Vec::new();
+    for (k, e) in model.elements.iter().enumerate() {
+        let (offset, n) = (model.offsets(k).multipliers, e.n_multipliers());
+        if e.kind() == ElementKind::Driver {
+            for &k in redundant.iter().filter(|&&k| k >= offset && k < offset + n) {
+                warnings.push(ModelWarning {
+                    entity: format!("driver {}", e.id()),
+                    message: format!(
+                        "equation {} is redundant with the joints and the other drivers at t = 0: the driver repeats or contradicts what they impose (an over-driven mechanism); if it contradicts them the run stops at its first increment (\"inconsistent constraints\"): remove the driver or free the motion it drives",
+                        k - offset + 1
+                    ),
+                });
+            }
+        }
+    }
+    warnings
 }
 
 /// Solves `K Δq = b` for a probe load `b` with every component of the size

@@ -13,6 +13,9 @@ pub enum AnalysisSettings {
     /// Implicit dynamics, Lie-group generalised-α
     /// ([`super::DynamicAnalysis`]).
     Dynamic(DynamicSettings),
+    /// Natural frequencies and modes about the state reached
+    /// ([`super::ModalAnalysis`]).
+    Modal(ModalSettings),
 }
 
 impl AnalysisSettings {
@@ -21,6 +24,7 @@ impl AnalysisSettings {
         match self {
             Self::Static(s) => s.end_time,
             Self::Dynamic(s) => s.end_time,
+            Self::Modal(s) => s.time,
         }
     }
 
@@ -31,6 +35,7 @@ impl AnalysisSettings {
             Self::Static(s) if s.kinematic => "kinematic",
             Self::Static(_) => "static",
             Self::Dynamic(_) => "dynamic",
+            Self::Modal(_) => "modal",
         }
     }
 
@@ -38,7 +43,15 @@ impl AnalysisSettings {
     pub fn as_static(&self) -> Option<&StaticSettings> {
         match self {
             Self::Static(s) => Some(s),
-            Self::Dynamic(_) => None,
+            _ => None,
+        }
+    }
+
+    /// The settings of a modal analysis, if it is one.
+    pub fn as_modal(&self) -> Option<&ModalSettings> {
+        match self {
+            Self::Modal(s) => Some(s),
+            _ => None,
         }
     }
 
@@ -46,7 +59,7 @@ impl AnalysisSettings {
     pub fn as_dynamic(&self) -> Option<&DynamicSettings> {
         match self {
             Self::Dynamic(s) => Some(s),
-            Self::Static(_) => None,
+            _ => None,
         }
     }
 }
@@ -190,3 +203,35 @@ pub const DEFAULT_RHO_INFINITY: f64 = 0.9;
 /// 1e-4 of its motion, i.e. about four significant digits over a
 /// swing; tighten it for validation runs.
 pub const DEFAULT_ERROR_TOLERANCE: f64 = 1e-4;
+
+/// Parameters of a modal analysis (docs/model-format.md, `[analysis]` with
+/// `type = "modal"`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModalSettings {
+    /// Number of modes wanted (zero modes included).
+    pub modes: usize,
+    /// Frequency (Hz) near which the modes are sought; `None` for the
+    /// lowest modes.
+    pub shift: Option<f64>,
+    /// Only the modes with frequencies in `[low, high]` (Hz), at most
+    /// `modes` of them, the lowest.
+    pub frequency_range: Option<(f64, f64)>,
+    /// Eigen-solver: dense, Lanczos, or chosen by size.
+    pub solver: crate::eigen::Method,
+    /// `t` at which it runs: the end of the analysis before it (0 for a
+    /// first analysis). A modal analysis does not move `t`.
+    pub time: f64,
+}
+
+impl ModalSettings {
+    /// The `modes` lowest modes, solver chosen by size, at `t = 0`.
+    pub fn lowest(modes: usize) -> Self {
+        Self {
+            modes,
+            shift: None,
+            frequency_range: None,
+            solver: crate::eigen::Method::Auto,
+            time: 0.0,
+        }
+    }
+}

@@ -31,7 +31,7 @@ use super::control::{
 };
 use super::newton::{NewtonFailure, NewtonSolver};
 use super::settings::StaticSettings;
-use super::{IncrementInfo, Observer};
+use super::{IncrementInfo, Observer, WarningInfo};
 use crate::model::Model;
 use crate::state::State;
 
@@ -78,6 +78,20 @@ pub enum StaticError {
         constraint: String,
         /// Violation relative to the tolerance.
         violation: f64,
+    },
+    /// A converged increment took an element where its law does not hold
+    /// (a rotational spring or a beam element whose relative rotation
+    /// passed half a turn).
+    #[error("{element}, between t = {from} and t = {time}: {reason}")]
+    LawViolated {
+        /// The element, as in messages (`spring 100`, `beam 3`).
+        element: String,
+        /// Load parameter at the start of the increment.
+        from: f64,
+        /// Load parameter reached.
+        time: f64,
+        /// What happened.
+        reason: String,
     },
     /// Arc-length control used its increments before reaching `end_time`.
     #[error("arc-length control: end_time not reached in {increments} increments (t = {time:.6}); raise max_increments or the increment sizes")]
@@ -166,6 +180,9 @@ struct Run {
     iterations: usize,
     wasted: usize,
     redundant: usize,
+    /// Sign of the tangent's determinant at the last accepted state, under
+    /// load control (docs/theory.md §9).
+    sign: Option<f64>,
     started: Instant,
     finished: bool,
     error: Option<StaticError>,
@@ -256,6 +273,7 @@ impl StaticAnalysis {
             iterations: 0,
             wasted: 0,
             redundant: 0,
+            sign: None,
             started,
             finished: false,
             error: None,
@@ -297,6 +315,9 @@ impl StaticAnalysis {
             }
         };
         run.accepted.clone_from(&run.state);
+        if watches_stability(s) {
+            run.sign = self.solver.tangent_sign();
+        }
         let written = observer.increment(&info, model, &run.state, self.solver.residual());
 
         // the step controller, in units of t or of arc length
@@ -318,10 +339,22 @@ impl StaticAnalysis {
             };
             StepController::new(bounds, s.end_time).with_max_increments(s.max_increments)
         } else {
+            // no prescribed rotation or driven angle turns by more than a
+            // quarter turn in one increment (Model::rotation_step_limit)
+            let mut max = s.max_increment;
+            if let Some(limit) = model.rotation_step_limit(s.end_time) {
+                let limit = limit.max(s.min_increment);
+                if limit < s.max_increment || limit < s.initial_increment {
+                    observer.note(&format!(
+                        "load increments limited to {limit:.4e} so that prescribed rotations and driven angles turn by at most a quarter turn in each"
+                    ));
+                }
+                max = max.min(limit);
+            }
             let bounds = StepBounds {
-                initial: s.initial_increment,
+                initial: s.initial_increment.min(max),
                 min: s.min_increment,
-                max: s.max_increment,
+                max,
             };
             StepController::new(bounds, s.end_time)
         };
@@ -439,6 +472,18 @@ impl StaticAnalysis {
     }
 }
 
+/// What a change of sign of the tangent's determinant under load control
+/// means, and what to do (docs/theory.md §9).
+pub const LIMIT_POINT_WARNING: &str = "the determinant of the tangent stiffness changed sign within this increment: the equilibrium path passed a limit point or a bifurcation point, past which load control may follow an unstable branch or jump to a distant one (snap-through) without showing the path between; arc-length control (control = \"arc_length\") follows the path through limit points";
+
+/// Whether the sign of the tangent's determinant is watched: load control
+/// of a static analysis with stiffness (not a kinematic one, where the
+/// tangent is that of the constraints; arc-length control follows limit
+/// points).
+fn watches_stability(s: &StaticSettings) -> bool {
+    !s.kinematic && !s.arc_length
+}
+
 impl Stepper for Statics<'_> {
     type Error = StaticError;
 
@@ -482,6 +527,8 @@ impl Stepper for Statics<'_> {
             ));
         }
         run.redundant = run.redundant.max(rank.redundant.len());
+        // another system: its determinant is not compared with the last
+        run.sign = None;
         if self.settings.kinematic && rank.degrees_of_freedom() > 0 {
             return Err(self.solver.indeterminate(model, &rank));
         }
@@ -590,7 +637,35 @@ impl Stepper for Statics<'_> {
     ) -> Result<(), StaticError> {
         let (model, run) = (self.model, &mut *self.run);
         run.state.time = info.time;
+        let from = run.accepted.time;
+        // laws that hold below half a turn of a relative rotation
+        for e in &model.elements {
+            if let Some(reason) = e.law_violated(&run.accepted, &run.state) {
+                return Err(StaticError::LawViolated {
+                    element: format!("{} {}", e.kind().name(), e.id()),
+                    from,
+                    time: info.time,
+                    reason,
+                });
+            }
+        }
         model.update_internal(&mut run.state);
+        // a change of sign of the tangent's determinant: an odd number of
+        // its eigenvalues crossed zero within the increment
+        if watches_stability(self.settings) {
+            let sign = self.solver.tangent_sign();
+            if let (Some(before), Some(after)) = (run.sign, sign) {
+                if before != after {
+                    observer.warning(&WarningInfo {
+                        increment: info.increment,
+                        from,
+                        time: info.time,
+                        message: LIMIT_POINT_WARNING.to_string(),
+                    });
+                }
+            }
+            run.sign = sign;
+        }
         if let Some((constraint, violation)) =
             self.solver
                 .violated_redundant(model, &run.state, self.settings)

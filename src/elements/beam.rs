@@ -335,6 +335,26 @@ fn add_mat(k: &mut Mat12, r: usize, c: usize, m: &Mat3) {
 }
 
 impl Element for Beam {
+    /// An element whose end sections turn relative to each other past half
+    /// a turn: `φ = log(Λ₁ᵀ Λ₂)` (B1) jumps there by a full turn and the
+    /// interpolation with it (docs/theory.md §3.1); the mesh is too coarse
+    /// for the bending or twist reached.
+    fn law_violated(&self, before: &State, after: &State) -> Option<String> {
+        let phi = |s: &State| {
+            let l1 = s.q[self.nodes[0]] * self.offsets[0];
+            let l2 = s.q[self.nodes[1]] * self.offsets[1];
+            so3::log(&(l1.inverse() * l2))
+        };
+        let (a, b) = (phi(before), phi(after));
+        ((b - a).norm() > std::f64::consts::PI).then(|| {
+            format!(
+                "the relative rotation of its end sections passed half a turn (from {:.4} to {:.4} rad, measured the other way round), which one element cannot represent (docs/theory.md §3.1); divide the beam into more elements",
+                a.norm(),
+                b.norm()
+            )
+        })
+    }
+
     fn kind(&self) -> ElementKind {
         ElementKind::Beam
     }
@@ -458,6 +478,32 @@ mod tests {
     use crate::elements::testing::{eval, motion, rate_errors, set_motion, tangent_error};
     use approx::assert_relative_eq;
     use proptest::prelude::*;
+
+    /// A step that turns the end sections of an element past half a turn
+    /// relative to each other (0.9π to 1.1π about the beam's axis, which
+    /// the logarithm measures as −0.9π) violates its law; steps below half
+    /// a turn (0.3π to 0.9π), or backwards, do not.
+    #[test]
+    fn relative_rotations_past_half_a_turn_are_found() {
+        let x = [Vec3::zeros(), Vec3::new(1.0, 0.0, 0.0)];
+        let r = [Rotation::identity(); 2];
+        let beam = test_beam(x, r, [0.0; 6]);
+        let twisted = |a: f64| {
+            state_of(
+                x,
+                [
+                    Rotation::identity(),
+                    so3::exp(&Vec3::new(a * std::f64::consts::PI, 0.0, 0.0)),
+                ],
+            )
+        };
+        let (s3, s9, s11) = (twisted(0.3), twisted(0.9), twisted(1.1));
+        assert!(beam.law_violated(&s3, &s9).is_none());
+        assert!(beam.law_violated(&s9, &s3).is_none());
+        let why = beam.law_violated(&s9, &s11).expect("half a turn passed");
+        assert!(why.contains("passed half a turn"), "{why}");
+        assert!(beam.law_violated(&s11, &s9).is_some());
+    }
 
     fn ctx(curves: &[crate::curves::Curve]) -> EvalContext<'_> {
         EvalContext {

@@ -25,6 +25,8 @@ pub enum ElementKind {
     Joint,
     /// Spring or damper on a joint coordinate.
     JointSpring,
+    /// Hysteretic moment law on a joint coordinate (hinge law with memory).
+    HingeLaw,
     /// Prescribed history of a joint coordinate or node component.
     Driver,
 }
@@ -54,7 +56,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 9] = [
+    pub const ALL: [ElementKind; 10] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -63,6 +65,7 @@ impl ElementKind {
         Self::Constraint,
         Self::Joint,
         Self::JointSpring,
+        Self::HingeLaw,
         Self::Driver,
     ];
 
@@ -77,6 +80,7 @@ impl ElementKind {
             Self::Constraint => "constraint",
             Self::Joint => "joint",
             Self::JointSpring => "joint spring",
+            Self::HingeLaw => "hinge law",
             Self::Driver => "driver",
         }
     }
@@ -93,6 +97,7 @@ impl ElementKind {
             Self::Joint => 7,
             Self::JointSpring => 8,
             Self::Driver => 9,
+            Self::HingeLaw => 10,
         }
     }
 
@@ -106,6 +111,7 @@ impl ElementKind {
             Self::Joint => Some("joints.csv"),
             Self::Driver => Some("drivers.csv"),
             Self::JointSpring => Some("joint_springs.csv"),
+            Self::HingeLaw => Some("hinge_laws.csv"),
             Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
     }

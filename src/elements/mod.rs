@@ -289,6 +289,24 @@ pub trait Element: Send + Sync {
     /// (unwrapped joint angles, hysteresis); `internal` holds the old ones.
     fn update_internal(&self, _ctx: &EvalContext, _state: &State, _internal: &mut [f64]) {}
 
+    /// Checks that the element's law holds along a converged step from
+    /// `before` to `after` (consecutive converged states): `Some(why)` if
+    /// the step took the element where its law does not hold (a relative
+    /// rotation measured by the principal logarithm passing half a turn,
+    /// where it jumps by a full turn: docs/theory.md §3.1, §5). The
+    /// analysis then stops.
+    fn law_violated(&self, _before: &State, _after: &State) -> Option<String> {
+        None
+    }
+
+    /// An angle the element imposes as `amplitude·f(t)` (a driver on an
+    /// angle): its amplitude and curve `f`. The step controller keeps the
+    /// change of such angles within an increment below half a turn
+    /// ([`crate::model::Model::rotation_step_limit`]).
+    fn imposed_angle(&self) -> Option<(f64, crate::curves::CurveIndex)> {
+        None
+    }
+
     /// Size of the local vector: 6 per node, then the coordinates and the
     /// multipliers.
     fn n_local(&self) -> usize {

@@ -146,6 +146,27 @@ impl Element for Spring {
         ElementKind::Spring
     }
 
+    /// A rotational spring whose relative rotation passes half a turn:
+    /// `ψ = log(…)` jumps there from `π u` to `−π u`, and with it the
+    /// moment `K ψ`, which then turns the spring the wrong way (S2 holds
+    /// below π). Between two converged states the relative rotation
+    /// changes by less than half a turn, so a jump of `ψ` by more than π
+    /// is that crossing.
+    fn law_violated(&self, before: &State, after: &State) -> Option<String> {
+        if self.kind != SpringKind::Rotational {
+            return None;
+        }
+        let (_, a) = self.relative_rotation(before);
+        let (_, b) = self.relative_rotation(after);
+        ((b - a).norm() > std::f64::consts::PI).then(|| {
+            format!(
+                "its relative rotation passed half a turn (from {:.4} to {:.4} rad, measured the other way round): a rotational spring's law m = K ψ holds below half a turn only (docs/theory.md §5), beyond it the moment would turn the spring the wrong way; use a joint spring on a revolute joint, whose angle may go any number of turns",
+                a.norm(),
+                b.norm()
+            )
+        })
+    }
+
     fn id(&self) -> Id {
         self.id
     }

@@ -163,9 +163,11 @@ pub struct Summary {
     pub drivers: usize,
     /// Constraint equations removed as redundant.
     pub redundant_constraints: usize,
-    /// Free unknowns (equations).
+    /// Equations solved: free unknowns, after the redundant constraint
+    /// equations were removed (before the run starts: all of them).
     pub dofs: usize,
-    /// Non-zeros of the system matrix.
+    /// Non-zeros of the system matrix as first assembled (redundant
+    /// constraint equations included).
     pub nonzeros: usize,
     /// Converged increments after the initial equilibrium.
     pub increments: usize,
@@ -188,11 +190,21 @@ pub struct Summary {
     /// Each analysis of the run, in order (one unless the model file asks
     /// for a sequence).
     pub analyses: Vec<AnalysisRecord>,
+    /// Warnings of the analyses about converged increments (a limit point
+    /// passed under load control), as logged.
+    pub warnings: Vec<String>,
     /// Every converged increment.
     pub increment_log: Vec<IncrementRecord>,
+    /// What each modal analysis of the run found (docs/results.md,
+    /// "Modes").
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<super::modes::ModalRecord>,
     /// Iterations of the initial equilibria, left out of the average.
     #[serde(skip)]
     initial_iterations: usize,
+    /// Free unknowns before redundant constraint equations are removed.
+    #[serde(skip)]
+    unknowns: usize,
 }
 
 impl Summary {
@@ -204,6 +216,28 @@ impl Summary {
         model: &Model,
         first: &StaticAnalysis,
         plan: &[AnalysisSettings],
+    ) -> Self {
+        let end_time = plan
+            .last()
+            .map_or(first.settings().end_time, |a| a.end_time());
+        Self::start_with(
+            model_file,
+            model,
+            first.n_equations(),
+            first.solver().nnz(),
+            end_time,
+        )
+    }
+
+    /// The summary of a run on `model` (read from `model_file`) whose first
+    /// analysis has `dofs` unknowns and `nonzeros` non-zeros in its matrix,
+    /// ending at `end_time`, that has not started.
+    pub fn start_with(
+        model_file: &str,
+        model: &Model,
+        dofs: usize,
+        nonzeros: usize,
+        end_time: f64,
     ) -> Self {
         let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
         Self {
@@ -217,22 +251,23 @@ impl Summary {
             joints: count(ElementKind::Joint),
             drivers: count(ElementKind::Driver),
             redundant_constraints: 0,
-            dofs: first.n_equations(),
-            nonzeros: first.solver().nnz(),
+            dofs,
+            nonzeros,
             increments: 0,
             iterations: 0,
             average_iterations: 0.0,
             wasted_iterations: 0,
             cutbacks: 0,
             final_time: 0.0,
-            end_time: plan
-                .last()
-                .map_or(first.settings().end_time, |a| a.end_time()),
+            end_time,
             wall_time_s: 0.0,
             output_steps: 0,
             analyses: Vec::new(),
+            warnings: Vec::new(),
             increment_log: Vec::new(),
+            modes: Vec::new(),
             initial_iterations: 0,
+            unknowns: dofs,
         }
     }
 
@@ -260,6 +295,8 @@ impl Summary {
         self.redundant_constraints = self
             .redundant_constraints
             .max(outcome.redundant_constraints);
+        // the equations solved: without the redundant ones
+        self.dofs = self.unknowns.saturating_sub(self.redundant_constraints);
         self.increments += outcome.increments;
         self.iterations += outcome.iterations;
         self.wasted_iterations += outcome.wasted_iterations;
@@ -275,6 +312,12 @@ impl Summary {
         };
     }
 
+    /// Newton iterations of the initial equilibria of the analyses added
+    /// (counted in `iterations`, not in `average_iterations`).
+    pub fn initial_iterations(&self) -> usize {
+        self.initial_iterations
+    }
+
     /// The final status, the increments recorded by `writer`.
     pub fn finish(&mut self, writer: &ResultWriter, status: RunStatus, message: Option<String>) {
         self.status = status;
@@ -284,52 +327,105 @@ impl Summary {
     }
 }
 
-/// A lock held on an output directory for the life of a run (an advisory
+/// A lock held on an output directory for the life of a run: an advisory
 /// lock on `.unfold.lock`, released by the system when the process ends,
-/// however it ends).
+/// however it ends, so that the file left by a killed process does not
+/// block the next run. The file itself is removed when the lock is
+/// dropped (while still locked: a run that opened it meanwhile finds, once
+/// it holds the lock, that the file is no longer the one at the path, and
+/// starts again).
 #[derive(Debug)]
 pub struct DirectoryLock {
-    _file: File,
+    file: File,
+    path: PathBuf,
 }
+
+/// Attempts at locking a directory whose lock file is being replaced.
+const LOCK_ATTEMPTS: usize = 10;
 
 impl DirectoryLock {
     /// Locks `dir`, or fails with [`io::ErrorKind::ResourceBusy`] if
     /// another run holds it.
     pub fn acquire(dir: &Path) -> io::Result<Self> {
         let path = dir.join(LOCK_FILE);
-        let mut file = std::fs::OpenOptions::new()
+        for _ in 0..LOCK_ATTEMPTS {
+            let file = Self::try_acquire(dir, &path)?;
+            // the file locked must still be the one at the path (not one
+            // removed by the run that held it)
+            if same_file(&file, &path) {
+                let mut lock = Self { file, path };
+                // the owner, for the message of a run refused (best effort)
+                let _ = lock
+                    .file
+                    .set_len(0)
+                    .and_then(|()| write!(lock.file, "{}", std::process::id()));
+                return Ok(lock);
+            }
+        }
+        Err(io::Error::new(
+            io::ErrorKind::ResourceBusy,
+            format!(
+                "{}: its lock file {LOCK_FILE} keeps being replaced by other runs; choose another output directory",
+                dir.display()
+            ),
+        ))
+    }
+
+    /// Opens and locks the lock file `path` of `dir`.
+    fn try_acquire(dir: &Path, path: &Path) -> io::Result<File> {
+        let file = std::fs::OpenOptions::new()
             .read(true)
             .write(true)
             .create(true)
             .truncate(false)
-            .open(&path)
-            .map_err(|e| file_error(&path, e))?;
+            .open(path)
+            .map_err(|e| file_error(path, e))?;
         match file.try_lock() {
-            Ok(()) => {}
+            Ok(()) => Ok(file),
             Err(std::fs::TryLockError::WouldBlock) => {
-                let owner = std::fs::read_to_string(&path).unwrap_or_default();
+                let owner = std::fs::read_to_string(path).unwrap_or_default();
                 let owner = owner.trim();
                 let by = if owner.is_empty() {
                     String::new()
                 } else {
                     format!(" (process {owner})")
                 };
-                return Err(io::Error::new(
+                Err(io::Error::new(
                     io::ErrorKind::ResourceBusy,
                     format!(
                         "{}: another run is writing its results there{by}; wait for it to end or choose another output directory",
                         dir.display()
                     ),
-                ));
+                ))
             }
-            Err(std::fs::TryLockError::Error(e)) => return Err(file_error(&path, e)),
+            Err(std::fs::TryLockError::Error(e)) => Err(file_error(path, e)),
         }
-        // the owner, for the message above (best effort)
-        let _ = file
-            .set_len(0)
-            .and_then(|()| write!(file, "{}", std::process::id()));
-        Ok(Self { _file: file })
     }
+}
+
+impl Drop for DirectoryLock {
+    fn drop(&mut self) {
+        // removed while locked (see the type's documentation); the lock
+        // goes with the file handle
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// Whether `path` names the open `file` (the same inode).
+#[cfg(unix)]
+fn same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Without inode numbers a lock file in use cannot be removed (Windows),
+/// so the file at the path is the one opened.
+#[cfg(not(unix))]
+fn same_file(_file: &File, _path: &Path) -> bool {
+    true
 }
 
 /// A CSV file written one step at a time: the rows of a step are gathered
@@ -420,6 +516,63 @@ fn is_step_grid(name: &str) -> bool {
     name.starts_with("step_") && (name.ends_with(".vtu") || name.ends_with(".tmp"))
 }
 
+/// Removes from `dir` the files of an earlier run that this one will not
+/// rewrite (those `writes` does not name), every temporary file and every
+/// grid `vtk/step_NNNNN.vtu`.
+fn remove_leftovers(dir: &Path, writes: impl Fn(&str) -> bool) -> io::Result<()> {
+    for name in owned_files() {
+        if !writes(name) {
+            remove_if_present(&dir.join(name))?;
+        }
+        remove_if_present(&dir.join(format!("{name}.tmp")))?;
+    }
+    // the temporary collection of earlier versions
+    remove_if_present(&dir.join("unfold.tmp"))?;
+    let vtk_dir = dir.join("vtk");
+    let entries = match std::fs::read_dir(&vtk_dir) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        entries => entries.map_err(|e| file_error(&vtk_dir, e))?,
+    };
+    for entry in entries {
+        let path = entry.map_err(|e| file_error(&vtk_dir, e))?.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if is_step_grid(name) {
+            remove_if_present(&path)?;
+        }
+    }
+    Ok(())
+}
+
+/// Records in `dir` a run of `model` (read from `model_file`, analyses
+/// `plan`, the first of which is `first`) rejected before its first
+/// analysis started, by the checks of
+/// [`crate::analysis::preflight`]: `summary.json` alone, status `failed`
+/// with `message`. The directory is locked as for a run, and the files of
+/// an earlier run are removed (none would belong to this model), its
+/// restart files too but `keep` (the restart file given to this run, if
+/// any); no other file is written.
+pub fn write_rejected(
+    dir: &Path,
+    model_file: &str,
+    model: &Model,
+    first: &StaticAnalysis,
+    plan: &[AnalysisSettings],
+    message: &str,
+    keep: Option<&Path>,
+) -> io::Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| file_error(dir, e))?;
+    let _lock = DirectoryLock::acquire(dir)?;
+    remove_leftovers(dir, |_| false)?;
+    super::restart::remove_earlier(dir, keep)?;
+    // an empty grid folder of an earlier run goes too
+    let _ = std::fs::remove_dir(dir.join("vtk"));
+    let mut summary = Summary::start(model_file, model, first, plan);
+    summary.status = RunStatus::Failed;
+    summary.message = Some(message.to_string());
+    let text = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;
+    vtk::write_atomically(&dir.join("summary.json"), (text + "\n").as_bytes())
+}
+
 impl ResultWriter {
     /// Locks `dir` (creating it and `dir/vtk`), removes the result files
     /// of an earlier run that this one will not rewrite (see the module
@@ -448,23 +601,8 @@ impl ResultWriter {
                 .is_none_or(has),
         };
 
-        // leftovers of an earlier run
-        for name in owned_files() {
-            if !writes(name) {
-                remove_if_present(&dir.join(name))?;
-            }
-            remove_if_present(&dir.join(format!("{name}.tmp")))?;
-        }
-        // the temporary collection of earlier versions
-        remove_if_present(&dir.join("unfold.tmp"))?;
-        let entries = std::fs::read_dir(&vtk_dir).map_err(|e| file_error(&vtk_dir, e))?;
-        for entry in entries {
-            let path = entry.map_err(|e| file_error(&vtk_dir, e))?.path();
-            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-            if is_step_grid(name) {
-                remove_if_present(&path)?;
-            }
-        }
+        remove_leftovers(dir, writes)?;
+        super::modes::remove_leftovers(dir)?;
 
         let mut node_order: Vec<usize> = (0..model.n_nodes()).collect();
         node_order.sort_by_key(|&i| model.node_ids[i]);
@@ -544,6 +682,11 @@ impl ResultWriter {
     /// Number of output steps written.
     pub fn output_steps(&self) -> usize {
         self.pvd.len()
+    }
+
+    /// The load parameter of the last output step written, if any.
+    pub fn last_output_time(&self) -> Option<f64> {
+        self.pvd.last().map(|p| p.0)
     }
 
     /// Writes `summary.json` (through a temporary file, so that it is

@@ -27,6 +27,10 @@
 //! looked at between increments, and a second signal, which ends the
 //! process at once, waits for the step being written.
 //!
+//! Restart files ([`super::restart`]): with [`Recorder::with_restart`]
+//! the recorder writes them at the requested times and, when the run ends,
+//! `restart.json` with its last converged state.
+//!
 //! The library never prints: what a person should see goes to a
 //! [`Console`], which the caller provides.
 
@@ -36,16 +40,20 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicI32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
+use super::modes::ModalFiles;
+use super::restart::RestartWriter;
 use super::results::{file_error, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
     AnalysisSettings, CutbackInfo, EventInfo, IncrementInfo, IterationInfo, Observer,
-    StaticAnalysis, StaticOutcome,
+    StaticAnalysis, StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
 use crate::model::Model;
 use crate::state::State;
+
+mod modal;
 
 /// What a person watching the run sees. Every method has an empty
 /// default.
@@ -56,6 +64,8 @@ pub trait Console {
     fn progress(&mut self, _info: &IncrementInfo) {}
     /// The last line of the run (status, counts, where the results are).
     fn finish(&mut self, _text: &str) {}
+    /// A warning of the analysis (shown even when lines are not).
+    fn warning(&mut self, _text: &str) {}
 }
 
 /// A console that shows nothing.
@@ -213,9 +223,30 @@ pub fn stop_on_signals(
     Ok(())
 }
 
+/// A load parameter for messages: six decimals, trailing zeros dropped
+/// (`1`, `0.071849`), or six in exponent form outside `[1e-3, 1e6)`.
+pub fn format_time(t: f64) -> String {
+    if t == 0.0 || !t.is_finite() {
+        return format!("{t}");
+    }
+    if (1e-3..1e6).contains(&t.abs()) {
+        let fixed = format!("{t:.6}");
+        fixed
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        format!("{t:.6e}")
+    }
+}
+
 /// The size of a model in one line: nodes and elements of each kind.
 pub fn describe(model: &Model) -> String {
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
+    let hinge_laws = match count(ElementKind::HingeLaw) {
+        0 => String::new(),
+        n => format!(", {n} hinge laws"),
+    };
     format!(
         "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
         model.n_nodes(),
@@ -227,7 +258,7 @@ pub fn describe(model: &Model) -> String {
         count(ElementKind::JointSpring),
         count(ElementKind::Driver),
         count(ElementKind::NodalLoad),
-    )
+    ) + &hinge_laws
 }
 
 /// `log.txt`: a line per increment, iteration, cut-back and note. A write
@@ -291,6 +322,9 @@ pub struct RunReport {
     pub output_errors: Vec<io::Error>,
     /// The last line of the run, as written to `log.txt`.
     pub last_line: String,
+    /// The load parameter of the last output step written (the results
+    /// kept), if any.
+    pub last_output_time: Option<f64>,
 }
 
 /// Records a run: result files, `log.txt`, `summary.json`; stops it on
@@ -309,6 +343,20 @@ pub struct Recorder {
     current: Running,
     /// Increments of the analyses before the running one.
     increment_offset: usize,
+    /// Whether `current` is a static analysis not yet closed.
+    open: bool,
+    /// Why a modal analysis of the run failed, if one did.
+    failure: Option<String>,
+    /// The result files of the modal analyses.
+    modal: ModalFiles,
+    /// Encoding of the grids.
+    encoding: Encoding,
+    /// Largest constraint violation (relative to its tolerance) at each
+    /// iteration of the increment being solved.
+    violations: Vec<f64>,
+    /// Restart files, and the index in the model's sequence of the first
+    /// analysis recorded.
+    restart: Option<(RestartWriter, usize)>,
 }
 
 /// The analysis being recorded.
@@ -359,9 +407,29 @@ impl Recorder {
         console: impl Console + 'static,
     ) -> io::Result<Self> {
         let model = &**first.model();
+        let summary = Summary::start(model_file, model, first, plan);
+        let running = Running::of(0, first);
+        let unknowns = first.n_equations();
+        Self::create_with(
+            dir, model_file, model, summary, running, unknowns, plan, console,
+        )
+    }
+
+    /// The recorder of a run of `plan` whose first analysis is `running`,
+    /// a static one if `running.kind` is not `modal`.
+    #[allow(clippy::too_many_arguments)]
+    fn create_with(
+        dir: &Path,
+        model_file: &str,
+        model: &Model,
+        summary: Summary,
+        running: Running,
+        unknowns: usize,
+        plan: &[AnalysisSettings],
+        console: impl Console + 'static,
+    ) -> io::Result<Self> {
         let writer = ResultWriter::create(dir, model)?;
         let log = LogFile::create(dir.join("log.txt"))?;
-        let summary = Summary::start(model_file, model, first, plan);
         let mut recorder = Self {
             writer,
             log,
@@ -370,25 +438,39 @@ impl Recorder {
             end_time: summary.end_time,
             summary,
             analyses: plan.len().max(1),
-            current: Running::of(0, first),
+            open: running.kind != "modal",
+            current: running,
             increment_offset: 0,
+            failure: None,
+            modal: ModalFiles::default(),
+            encoding: Encoding::default(),
+            violations: Vec::new(),
+            restart: None,
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
                 .iter()
-                .map(|a| format!("{} to t = {}", a.name(), a.end_time()))
+                .map(|a| match a.as_modal() {
+                    Some(m) => format!("modal at t = {}", format_time(m.time)),
+                    None => format!("{} to t = {}", a.name(), format_time(a.end_time())),
+                })
                 .collect();
             format!("{} analyses: {}", plan.len(), each.join(", "))
         } else {
-            format!(
-                "{} analysis to t = {}",
-                recorder.current.kind, recorder.current.end_time
-            )
+            match recorder.current.kind {
+                "modal" => format!(
+                    "modal analysis at t = {}",
+                    format_time(recorder.current.end_time)
+                ),
+                kind => format!(
+                    "{kind} analysis to t = {}",
+                    format_time(recorder.current.end_time)
+                ),
+            }
         };
         recorder.line(&format!(
-            "{model_file}: {}; {} unknowns; {analyses}",
+            "{model_file}: {}; {unknowns} unknowns; {analyses}",
             describe(model),
-            first.n_equations(),
         ));
         // warnings are shown by the caller; the log keeps them with the run
         for w in &model.warnings {
@@ -407,18 +489,22 @@ impl Recorder {
     pub fn next_analysis(&mut self, outcome: &StaticOutcome, next: &StaticAnalysis) {
         self.close(outcome);
         self.current = Running::of(self.current.index + 1, next);
+        self.open = true;
         self.line(&format!(
             "analysis {} of {}: {} from t = {} to t = {}",
             self.current.index + 1,
             self.analyses,
             self.current.kind,
-            outcome.time,
-            self.current.end_time
+            format_time(outcome.time),
+            format_time(self.current.end_time)
         ));
     }
 
     /// Adds the running analysis's `outcome` to the summary.
     fn close(&mut self, outcome: &StaticOutcome) {
+        if !std::mem::replace(&mut self.open, false) {
+            return;
+        }
         let c = &self.current;
         self.summary.add(
             c.kind,
@@ -444,9 +530,18 @@ impl Recorder {
         self
     }
 
+    /// Writes restart files with `writer` (io::restart); the first analysis
+    /// recorded is analysis `first_analysis` (from 0) of the model's
+    /// sequence, as in a restarted run.
+    pub fn with_restart(mut self, writer: RestartWriter, first_analysis: usize) -> Self {
+        self.restart = Some((writer, first_analysis));
+        self
+    }
+
     /// Writes the grids in `encoding` (binary by default).
     pub fn with_vtk_encoding(mut self, encoding: Encoding) -> Self {
         self.writer = self.writer.with_vtk_encoding(encoding);
+        self.encoding = encoding;
         self
     }
 
@@ -470,33 +565,64 @@ impl Recorder {
     /// the status (completed, failed or interrupted), the last line of
     /// `log.txt`, and `summary.json`. Write errors are returned in the
     /// report, not lost.
-    pub fn finish(mut self, outcome: &StaticOutcome) -> RunReport {
-        self.close(outcome);
-        let interrupted = outcome.error.as_ref().and_then(Interrupted::of);
-        let (status, message) = match (&outcome.error, interrupted) {
-            (None, _) => (RunStatus::Completed, None),
-            (Some(_), Some(i)) => (
+    pub fn finish(self, outcome: &StaticOutcome) -> RunReport {
+        self.finish_with(Some(outcome), &outcome.state)
+    }
+
+    /// As [`Recorder::finish`], for a run whose last static analysis (if
+    /// any) returned `outcome` and whose last converged state is `state`
+    /// (that of `outcome`, or the state a modal analysis after it was
+    /// given and left unchanged), written to `restart.json`; a failed
+    /// modal analysis fails the run.
+    pub fn finish_with(mut self, outcome: Option<&StaticOutcome>, state: &State) -> RunReport {
+        let error = outcome.and_then(|o| o.error.as_ref());
+        if let Some(o) = outcome {
+            self.close(o);
+        }
+        let interrupted = error.and_then(Interrupted::of);
+        let (status, message) = match (error, interrupted, self.failure.take()) {
+            (None, _, None) => (RunStatus::Completed, None),
+            (None, _, Some(failure)) => (RunStatus::Failed, Some(failure)),
+            (Some(_), Some(i), _) => (
                 RunStatus::Interrupted,
-                Some(format!("{i} at t = {}", outcome.time)),
+                Some(format!(
+                    "{i} at t = {}",
+                    format_time(self.summary.final_time)
+                )),
             ),
-            (Some(e), None) => (RunStatus::Failed, Some(e.to_string())),
+            (Some(e), None, _) => (RunStatus::Failed, Some(e.to_string())),
         };
+        let mut output_errors = Vec::new();
+        if let Some((restart, first)) = &self.restart {
+            let _writing = self.stop.output();
+            let index = first + self.current.index;
+            if let Err(e) = restart.finish(index, self.current.kind, state) {
+                output_errors.push(e);
+            }
+        }
         self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
+        // the initial equilibria's iterations are counted in the total,
+        // not in the average
+        let initial = if self.analyses > 1 {
+            "the initial equilibria"
+        } else {
+            "the initial equilibrium"
+        };
         let last_line = format!(
-            "{}: {} increments, {} iterations ({:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
+            "{}: {} increments, {} iterations ({} for {initial}; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
             s.status.name(),
             s.increments,
             s.iterations,
+            s.initial_iterations(),
             s.average_iterations,
             s.cutbacks,
-            s.final_time,
+            format_time(s.final_time),
             s.wall_time_s,
             self.writer.dir().display()
         );
         self.log.line(&last_line);
         self.console.finish(&last_line);
-        let mut output_errors = Vec::new();
         if let Err(e) = self.log.flush() {
             output_errors.push(e);
         }
@@ -512,12 +638,17 @@ impl Recorder {
             interrupted,
             output_errors,
             last_line,
+            last_output_time: self.writer.last_output_time(),
         }
     }
 }
 
 impl Observer for Recorder {
     fn iteration(&mut self, info: &IterationInfo) {
+        if info.iteration == 0 {
+            self.violations.clear();
+        }
+        self.violations.push(info.norms.residual_constraint);
         let n = &info.norms;
         self.log.line(&format!(
             "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
@@ -548,16 +679,24 @@ impl Observer for Recorder {
         }
         // a later analysis starts at the final state of the one before,
         // written already: its equilibrium there is logged, not written
-        let restart = info.increment == 0 && self.current.index > 0;
+        let restart =
+            info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
         let info = &self.renumbered(info);
-        let residuals: Vec<String> = info.residuals.iter().map(|r| format!("{r:.1e}")).collect();
+        // a kinematic analysis has no loads: its residual is all constraint
+        // violation, measured against the tolerance of each constraint
+        let (what, values) = if self.current.kind == "kinematic" {
+            ("constraint violations (× tolerance)", &self.violations)
+        } else {
+            ("relative residuals", &info.residuals)
+        };
+        let values: Vec<String> = values.iter().map(|r| format!("{r:.1e}")).collect();
         self.line(&format!(
-            "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  relative residuals: {}",
+            "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  {what}: {}",
             info.increment,
             info.time,
             info.step,
             info.iterations,
-            residuals.join(" ")
+            values.join(" ")
         ));
         self.console.progress(info);
         if restart {
@@ -578,6 +717,9 @@ impl Observer for Recorder {
             } else {
                 self.writer.increment(info, model, state, residual)?;
             }
+            if let Some((restart, first)) = &mut self.restart {
+                restart.increment(*first + self.current.index, self.current.kind, state)?;
+            }
         }
         self.log.flush()?;
         match stop {
@@ -588,6 +730,19 @@ impl Observer for Recorder {
 
     fn note(&mut self, text: &str) {
         self.line(&format!("note: {text}"));
+    }
+
+    fn warning(&mut self, info: &WarningInfo) {
+        let text = format!(
+            "increment {} (t = {} to {}): {}",
+            info.increment + self.increment_offset,
+            format_time(info.from),
+            format_time(info.time),
+            info.message
+        );
+        self.log.line(&format!("warning: {text}"));
+        self.console.warning(&text);
+        self.summary.warnings.push(text);
     }
 
     fn cutback(&mut self, info: &CutbackInfo) {

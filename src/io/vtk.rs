@@ -231,6 +231,43 @@ pub fn write_vtu(
     state: &State,
     encoding: Encoding,
 ) -> io::Result<()> {
+    write_grid(path, model, ctx, state, encoding, None)
+}
+
+/// A mode shape on the nodes: translation and rotation (global frame) of
+/// each node.
+#[derive(Clone, Copy, Debug)]
+pub struct ModeField<'a> {
+    /// Translation of each node.
+    pub translation: &'a [Vec3],
+    /// Rotation (small rotation vector) of each node.
+    pub rotation: &'a [Vec3],
+}
+
+/// Writes the grid of `state` to `path` with a mode shape as the point
+/// vectors `mode_displacement` (the default vectors of the file, for
+/// ParaView's Warp By Vector) and `mode_rotation`; a joint point moves
+/// with its node, `u + θ × (p − x)`, and with the ground not at all.
+pub fn write_mode_vtu(
+    path: &Path,
+    model: &Model,
+    ctx: &EvalContext,
+    state: &State,
+    encoding: Encoding,
+    mode: ModeField,
+) -> io::Result<()> {
+    assert!(mode.translation.len() == model.n_nodes() && mode.rotation.len() == model.n_nodes());
+    write_grid(path, model, ctx, state, encoding, Some(mode))
+}
+
+fn write_grid(
+    path: &Path,
+    model: &Model,
+    ctx: &EvalContext,
+    state: &State,
+    encoding: Encoding,
+    mode: Option<ModeField>,
+) -> io::Result<()> {
     let n_nodes = model.n_nodes();
     let joints = attachments(model, state);
     let joints_at_reference = if joints.is_empty() {
@@ -255,6 +292,26 @@ pub fn write_vtu(
         let r = so3::matrix(&state.q[i]);
         for (c, a) in axes.iter_mut().enumerate() {
             push3(a, &r.column(c).into_owned());
+        }
+    }
+    // the mode shape at the nodes, then at the joint points
+    let mut mode_u = Vec::new();
+    let mut mode_theta = Vec::new();
+    if let Some(m) = &mode {
+        for i in 0..n_nodes {
+            push3(&mut mode_u, &m.translation[i]);
+            push3(&mut mode_theta, &m.rotation[i]);
+        }
+        for (_, a) in &joints {
+            let (u, theta) = a.node.map_or((Vec3::zeros(), Vec3::zeros()), |n| {
+                let theta = m.rotation[n];
+                (
+                    m.translation[n] + theta.cross(&(a.point - state.x[n])),
+                    theta,
+                )
+            });
+            push3(&mut mode_u, &u);
+            push3(&mut mode_theta, &theta);
         }
     }
     for (j, (k, a)) in joints.iter().enumerate() {
@@ -357,14 +414,25 @@ pub fn write_vtu(
     );
 
     // point data
-    doc.xml
-        .push_str("      <PointData Scalars=\"node_id\" Vectors=\"displacement\">\n");
+    let vectors = if mode.is_some() {
+        "mode_displacement"
+    } else {
+        "displacement"
+    };
+    let _ = writeln!(
+        doc.xml,
+        "      <PointData Scalars=\"node_id\" Vectors=\"{vectors}\">"
+    );
     doc.array("node_id", 1, &node_id);
     doc.array("joint_id", 1, &joint_id);
     doc.array("displacement", 3, &displacement);
     doc.array("rotation", 3, &rotation);
     for (c, a) in axes.iter().enumerate() {
         doc.array(&format!("axis_{}", c + 1), 3, a);
+    }
+    if mode.is_some() {
+        doc.array("mode_displacement", 3, &mode_u);
+        doc.array("mode_rotation", 3, &mode_theta);
     }
     doc.xml.push_str("      </PointData>\n");
 

@@ -165,6 +165,9 @@ impl Element for Driver {
     fn constraints_active(&self, time: f64, _state: &State) -> bool {
         self.is_active(time)
     }
+    fn imposed_angle(&self) -> Option<(f64, CurveIndex)> {
+        self.source.is_angle().then_some((self.value, self.curve))
+    }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         if !self.is_active(ctx.time) {
             // released: k λ = 0

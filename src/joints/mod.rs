@@ -11,6 +11,7 @@
 
 pub mod coordinate;
 pub mod driver;
+pub mod hinge;
 pub mod hyperdual;
 pub mod joint;
 pub mod kinematics;
@@ -19,6 +20,7 @@ pub mod types;
 
 pub use coordinate::PairCoordinate;
 pub use driver::Driver;
+pub use hinge::{Branch, HingeLaw, Hysteresis, Response, TapeSpring};
 pub use joint::Joint;
 pub use kinematics::Pair;
 pub use spring::{JointSpring, Law};

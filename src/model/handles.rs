@@ -106,6 +106,11 @@ element_handle!(
     ElementKind::JointSpring
 );
 element_handle!(
+    /// A hysteretic moment law on a joint coordinate.
+    HingeLawHandle,
+    ElementKind::HingeLaw
+);
+element_handle!(
     /// A driver.
     DriverHandle,
     ElementKind::Driver

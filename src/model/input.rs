@@ -43,6 +43,30 @@ impl AngleUnit {
     }
 }
 
+/// The keys of the top level of a model file ([`ModelInput`]'s fields).
+pub const TOP_LEVEL_KEYS: [&str; 20] = [
+    "title",
+    "analysis",
+    "nodes",
+    "sections",
+    "beams",
+    "beam_lines",
+    "rigid_bodies",
+    "point_masses",
+    "springs",
+    "supports",
+    "prescribed",
+    "loads",
+    "gravity",
+    "curves",
+    "joints",
+    "joint_springs",
+    "hinge_laws",
+    "drivers",
+    "initial_motion",
+    "output",
+];
+
 /// A complete model definition.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -96,12 +120,30 @@ pub struct ModelInput {
     /// Springs and dampers on joint coordinates.
     #[serde(default)]
     pub joint_springs: Vec<JointSpringInput>,
+    /// Hysteretic moment laws on joint coordinates (hinge laws with
+    /// memory).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hinge_laws: Vec<HingeLawInput>,
     /// Prescribed histories of joint coordinates or node components.
     #[serde(default)]
     pub drivers: Vec<DriverInput>,
     /// Rigid motions of sets of nodes at the start (dynamic analyses).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial_motion: Vec<InitialMotionInput>,
+    /// What a run writes besides the result files (`[output]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<OutputInput>,
+}
+
+/// `[output]`: files a run writes besides the results.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OutputInput {
+    /// Times at which a restart file `restart-<t>.json` is written
+    /// (besides `restart.json` at the end of every run), in increasing
+    /// order, within the analyses; the analyses land on them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub restart_times: Vec<f64>,
 }
 
 /// A kinematic pair between node A and node B (or the ground).
@@ -186,6 +228,76 @@ pub struct JointSpringInput {
     /// Nonlinear damper: points `[rate, force]`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub damping_table: Vec<[f64; 2]>,
+}
+
+/// A hysteretic moment law on a joint coordinate (docs/joints.md §4.1):
+/// two bounding branches, given as tables or as the tape-spring shape,
+/// and the elastic slope between them.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct HingeLawInput {
+    /// Element id.
+    pub id: Id,
+    /// The joint.
+    pub joint: Id,
+    /// Which coordinate (`angle`, `slide`, `angle1`...), default the joint's
+    /// first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Unit of the angles when the coordinate is an angle: table abscissae,
+    /// the angles of the tape-spring shape, and the angle in the slopes
+    /// (N·m per unit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+    /// `k_e > 0`: slope of the moment between the bounds (N·m/rad or N/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elastic_slope: Option<f64>,
+    /// The loading bound `f_load`: points `[coordinate, moment]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub load_table: Vec<[f64; 2]>,
+    /// The unloading bound `f_unload`: points `[coordinate, moment]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unload_table: Vec<[f64; 2]>,
+    /// Both bounds from the analytic tape-spring shape.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tape_spring: Option<TapeSpringInput>,
+    /// The bound the hinge starts on in the reference configuration:
+    /// `load` (default) or `unload`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<StartBranch>,
+}
+
+/// The bound a hinge law starts on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StartBranch {
+    /// The loading bound `f_load(0)`.
+    #[default]
+    Load,
+    /// The unloading bound `f_unload(0)`.
+    Unload,
+}
+
+/// Parameters of the tape-spring shape (docs/joints.md §4.1), angles in
+/// the unit of the entry.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TapeSpringInput {
+    /// `M_d ≥ 0`: moment deploying the hinge over its travel (N·m).
+    pub deployment_moment: f64,
+    /// `c_L`: angle at which the hinge locks.
+    pub locking_angle: f64,
+    /// `M_L > M_d`: moment that unlocks (folds) the locked hinge (N·m).
+    pub locking_peak: f64,
+    /// `K > 0`: slope of the locked branch (N·m per angle unit).
+    pub locked_stiffness: f64,
+    /// `w > 0`: width over which the moment falls from `M_L` to `M_d` when
+    /// the hinge unlocks.
+    pub snap_width: f64,
+    /// `h ≥ 0`: half-width of the rounding of the corners (default: a
+    /// quarter of the smaller of `w` and `M_d/K`; 0 for sharp corners).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rounding: Option<f64>,
 }
 
 /// A prescribed history `value · f(t)` of a joint coordinate, or of a
@@ -322,8 +434,9 @@ impl<'de> Deserialize<'de> for Analyses {
 #[serde(deny_unknown_fields)]
 pub struct AnalysisInput {
     /// Analysis type: `"static"` (default) or its alias `"kinetostatic"`
-    /// (nonlinear statics, loads and drivers), or `"kinematic"` (the
-    /// joints and drivers must determine every unknown).
+    /// (nonlinear statics, loads and drivers), `"kinematic"` (the
+    /// joints and drivers must determine every unknown), or `"modal"`
+    /// (natural frequencies and modes about the state reached).
     #[serde(rename = "type", default = "default_analysis_type")]
     pub kind: String,
     /// Final value of the load parameter `t` (pseudo-time), default 1 (each
@@ -399,6 +512,19 @@ pub struct AnalysisInput {
     /// true); `false` for fixed steps.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adaptive: Option<bool>,
+    /// Modal analysis: number of modes, default 10.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modes: Option<usize>,
+    /// Modal analysis: frequency (Hz) near which the modes are sought.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shift: Option<f64>,
+    /// Modal analysis: only the modes in `[low, high]` (Hz).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frequency_range: Option<[f64; 2]>,
+    /// Modal analysis: eigen-solver, `auto` (default), `dense` or
+    /// `lanczos`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solver: Option<String>,
 }
 
 fn default_analysis_type() -> String {
@@ -432,6 +558,10 @@ impl Default for AnalysisInput {
             rho_infinity: None,
             error_tolerance: None,
             adaptive: None,
+            modes: None,
+            shift: None,
+            frequency_range: None,
+            solver: None,
         }
     }
 }

@@ -32,8 +32,9 @@ pub use build::{
 };
 pub use builder::ModelBuilder;
 pub use handles::{
-    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, JointHandle,
-    JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle, SpringHandle,
+    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
+    JointHandle, JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle,
+    SpringHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.
@@ -63,6 +64,13 @@ pub enum Prescribed {
         curve: CurveIndex,
     },
 }
+
+/// The most a prescribed rotation or a driven angle may turn in one load
+/// increment: a quarter turn, half of the half turn beyond which the
+/// increment would be ambiguous, leaving the other half to the Newton
+/// iterations of the free rotations that follow it
+/// ([`Model::rotation_step_limit`]).
+pub const MAX_TURN_PER_INCREMENT: f64 = std::f64::consts::FRAC_PI_2;
 
 /// A validated model.
 pub struct Model {
@@ -341,6 +349,30 @@ impl Model {
             Some((g, c)) => g * self.curves[c].value(t),
             None => Vec3::zeros(),
         }
+    }
+
+    /// The largest load increment over which no prescribed rotation and no
+    /// driven angle changes by more than [`MAX_TURN_PER_INCREMENT`]
+    /// anywhere in `[0, end_time]`, if any of them moves: beyond half a
+    /// turn an increment cannot tell a rotation from the same rotation less
+    /// a full turn (docs/joints.md §3.3), so a larger increment would miss
+    /// whole turns or converge to the wrong branch. Load control keeps its
+    /// increments below it.
+    pub fn rotation_step_limit(&self, end_time: f64) -> Option<f64> {
+        let prescribed = self.prescribed.iter().filter_map(|p| match p {
+            Prescribed::Rotation { psi, curve, .. } => Some((psi.norm(), *curve)),
+            Prescribed::Translation { .. } => None,
+        });
+        let driven = self.elements.iter().filter_map(|e| e.imposed_angle());
+        prescribed
+            .chain(driven)
+            .filter(|&(amplitude, curve)| {
+                amplitude != 0.0 && !self.curves[curve].is_constant_on(end_time)
+            })
+            .map(|(amplitude, curve)| {
+                self.curves[curve].largest_step(amplitude, MAX_TURN_PER_INCREMENT, end_time)
+            })
+            .reduce(f64::min)
     }
 
     /// Sets the prescribed components of `state` to their values at `t`.

@@ -4,7 +4,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::Builder;
-use super::{drivers, joint_springs};
+use super::{drivers, hinge_laws, joint_springs};
 use crate::elements::Element;
 use crate::joints::types::{Coordinate, JointParameters};
 use crate::joints::{Joint, JointType, Pair, PairCoordinate};
@@ -84,6 +84,13 @@ pub(super) fn build(cx: &mut Builder) {
         let entity = format!("joint spring {}", s.id);
         let id_ok = cx.claim_id(&entity, s.id);
         if let (Some(e), true) = (joint_springs::joint_spring(cx, &entity, s, &joints), id_ok) {
+            cx.elements.push(Box::new(e));
+        }
+    }
+    for h in &input.hinge_laws {
+        let entity = format!("hinge law {}", h.id);
+        let id_ok = cx.claim_id(&entity, h.id);
+        if let (Some(e), true) = (hinge_laws::hinge_law(cx, &entity, h, &joints), id_ok) {
             cx.elements.push(Box::new(e));
         }
     }

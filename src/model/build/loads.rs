@@ -72,6 +72,12 @@ impl Builder<'_> {
         {
             return None;
         }
+        if a.norm() > 0.0 && self.elements.iter().all(|e| e.mass() == 0.0) {
+            self.ck.warn(
+                "gravity",
+                "acts on no mass: no beam's section has mass_per_length and the model has no rigid body or point mass, so gravity loads nothing; give the masses, or remove [gravity]",
+            );
+        }
         let end = self.curves.end_time;
         let c = &self.curves.curves[curve];
         let has_drivers = !self.input.drivers.is_empty();

@@ -14,11 +14,13 @@ mod checks;
 mod curves;
 mod drivers;
 mod initial;
+mod hinge_laws;
 mod joint_springs;
 mod joints;
 mod loads;
 mod masses;
 mod nodes;
+mod output;
 mod sections;
 mod settings;
 mod springs;
@@ -57,6 +59,21 @@ pub const MIN_RELATIVE_INCREMENT: f64 = 1e-12;
 /// configuration: the analysis measures residuals by sums of squares,
 /// which overflow beyond 1.3e154.
 pub const LARGEST_ELEMENT_VALUE: f64 = 1e150;
+
+/// Relative margin above half or a whole turn before an angle without a
+/// unit is warned about, so that π and 2π written to a few digits
+/// (3.1416, 6.2832) pass.
+const ANGLE_SLACK: f64 = 1e-3;
+
+/// How large an angle written without a unit may be before it looks like
+/// degrees: a rotation vector is at most half a turn long; a driven
+/// angle, a spring's free angle or a table's angle rarely pass a full
+/// turn.
+#[derive(Clone, Copy)]
+enum AngleLimit {
+    HalfTurn,
+    FullTurn,
+}
 
 /// Collects problems and warnings while the model is built.
 #[derive(Default)]
@@ -97,6 +114,26 @@ impl Checker {
                 format!("{what} must be finite, got {values:?}"),
             );
             false
+        }
+    }
+
+    /// Warns that an angle written without a `unit` (read in radians) is
+    /// beyond `limit` (half or a whole turn), as an angle in degrees
+    /// would be: `what` says which angle (`"rotation has the length"`).
+    fn unitless_angle(&mut self, entity: &str, what: &str, angle: f64, limit: AngleLimit) {
+        let (bound, beyond) = match limit {
+            AngleLimit::HalfTurn => (std::f64::consts::PI, "half a turn"),
+            AngleLimit::FullTurn => (std::f64::consts::TAU, "a full turn"),
+        };
+        if angle.abs() > bound * (1.0 + ANGLE_SLACK) {
+            self.warn(
+                entity,
+                format!(
+                    "{what} {:.4} rad ({:.1}°), more than {beyond}, and gives no unit: angles are read in radians. If it is in degrees, write unit = \"deg\" (unit = \"rad\" confirms radians)",
+                    angle.abs(),
+                    angle.abs().to_degrees()
+                ),
+            );
         }
     }
 
@@ -233,6 +270,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.loads.len(),
         input.joints.len(),
         input.joint_springs.len(),
+        input.hinge_laws.len(),
         input.drivers.len(),
         generated,
     ]
@@ -247,6 +285,7 @@ impl Model {
         let mut ck = Checker::default();
         let plan = settings::Plan::of(&settings::analyses(&mut ck, &input.analysis));
         let curves = CurveTable::build(&mut ck, &input.curves, plan.end_time);
+        output::check(&mut ck, input.output.as_ref(), plan.end_time);
         let mut b = Builder {
             input,
             ck,
@@ -305,8 +344,10 @@ impl Model {
         if ck.errors.is_empty() {
             if elements.iter().all(|e| e.kind() == ElementKind::NodalLoad) {
                 ck.push(ModelErrorKind::Missing, "model", "has no elements");
-            } else if !plan.dynamic_only {
-                // in dynamics inertia holds a free part
+            } else if !plan.no_statics {
+                // a free part has no static equilibrium; in dynamics its
+                // inertia holds it, a modal analysis gives its rigid-body
+                // modes
                 checks::check_restraint(&mut ck, &node_ids, &elements, &fixed);
             }
         }

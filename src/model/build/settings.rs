@@ -5,7 +5,8 @@ use super::{
     num, Checker, LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MIN_RELATIVE_INCREMENT,
 };
 use crate::analysis::settings::{DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
-use crate::analysis::{AnalysisSettings, DynamicSettings, StaticSettings};
+use crate::analysis::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
+use crate::eigen::Method;
 use crate::model::input::{Analyses, AnalysisInput, ModelInput};
 use crate::model::{ModelErrorKind, ModelErrors};
 
@@ -15,7 +16,27 @@ impl ModelInput {
     /// which reports them with the rest of the model).
     pub fn analyses(&self) -> Result<Vec<AnalysisSettings>, ModelErrors> {
         let mut ck = Checker::default();
-        let all = analyses(&mut ck, &self.analysis);
+        let mut all = analyses(&mut ck, &self.analysis);
+        // the analyses land on the restart times: they join the output
+        // times of the analysis they fall in
+        if let Some(o) = &self.output {
+            let mut start = 0.0;
+            // (a modal analysis has no increments: it neither moves `t`
+            // nor writes restart files)
+            for s in all.iter_mut().filter_map(|a| match a {
+                AnalysisSettings::Static(s) => Some(s),
+                _ => None,
+            }) {
+                let within = o
+                    .restart_times
+                    .iter()
+                    .filter(|&&t| t > start && t <= s.end_time);
+                s.output_times.extend(within);
+                s.output_times.sort_by(f64::total_cmp);
+                s.output_times.dedup();
+                start = s.end_time;
+            }
+        }
         if ck.errors.is_empty() {
             Ok(all)
         } else {
@@ -37,9 +58,10 @@ pub(super) struct Plan {
     pub end_time: f64,
     /// Largest `max_increment` of the load-controlled analyses.
     pub max_increment: Option<f64>,
-    /// Every analysis is dynamic: parts free to move as rigid bodies are
-    /// allowed (their inertia holds them).
-    pub dynamic_only: bool,
+    /// No analysis seeks a static equilibrium (dynamic and modal analyses
+    /// only): parts free to move as rigid bodies are allowed (their inertia
+    /// holds them; a modal analysis reports their rigid-body modes).
+    pub no_statics: bool,
     /// The first analysis is dynamic (loads and gravity act in full from
     /// the start by default).
     pub first_dynamic: bool,
@@ -57,7 +79,7 @@ impl Plan {
             arc_length: statics().any(|s| s.arc_length),
             end_time: settings.last().map_or(1.0, |s| s.end_time()),
             max_increment: load.map(|s| s.max_increment).reduce(f64::max),
-            dynamic_only: !settings.is_empty() && statics().next().is_none(),
+            no_statics: statics().next().is_none(),
             first_dynamic: settings.first().is_some_and(|s| s.as_dynamic().is_some()),
         }
     }
@@ -78,7 +100,7 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
             format!("analysis[{}]", k + 1)
         };
         if k > 0 {
-            if a.end_time.is_finite() && a.end_time <= start {
+            if a.kind != "modal" && a.end_time.is_finite() && a.end_time <= start {
                 ck.push(
                     ModelErrorKind::Invalid,
                     &entity,
@@ -102,17 +124,31 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
                 }
             }
         }
+        if a.kind == "modal" {
+            // a modal analysis does not move t
+            out.push(AnalysisSettings::Modal(modal_settings(
+                ck, &entity, a, start,
+            )));
+            continue;
+        }
+        for (name, given) in [
+            ("modes", a.modes.is_some()),
+            ("shift", a.shift.is_some()),
+            ("frequency_range", a.frequency_range.is_some()),
+            ("solver", a.solver.is_some()),
+        ] {
+            if given {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    &entity,
+                    format!("{name} applies to a modal analysis (type = \"modal\")"),
+                );
+            }
+        }
         let s = if a.kind == "dynamic" {
             AnalysisSettings::Dynamic(dynamic_settings(ck, &entity, a, start))
         } else {
-            for (key, given) in [
-                ("time_step", a.time_step.is_some()),
-                ("min_step", a.min_step.is_some()),
-                ("max_step", a.max_step.is_some()),
-                ("rho_infinity", a.rho_infinity.is_some()),
-                ("error_tolerance", a.error_tolerance.is_some()),
-                ("adaptive", a.adaptive.is_some()),
-            ] {
+            for (key, given) in dynamic_keys(a) {
                 if given {
                     ck.push(
                         ModelErrorKind::Invalid,
@@ -129,6 +165,105 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
     out
 }
 
+/// The keys that only dynamic analyses take, and whether each is given.
+fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 6] {
+    [
+        ("time_step", a.time_step.is_some()),
+        ("min_step", a.min_step.is_some()),
+        ("max_step", a.max_step.is_some()),
+        ("rho_infinity", a.rho_infinity.is_some()),
+        ("error_tolerance", a.error_tolerance.is_some()),
+        ("adaptive", a.adaptive.is_some()),
+    ]
+}
+
+/// Largest number of modes a modal analysis may ask for: beyond it the
+/// dense solver's O(n³) and Lanczos's basis of 2·modes vectors of the
+/// model's size make the request a mistake rather than an analysis.
+const MAX_MODES: usize = 10_000;
+
+/// Settings of a modal analysis at `t = start`, with defaults.
+fn modal_settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> ModalSettings {
+    // the keys of incremental analyses do not apply
+    for (name, given) in [
+        ("initial_increment", a.initial_increment.is_some()),
+        ("min_increment", a.min_increment.is_some()),
+        ("max_increment", a.max_increment.is_some()),
+        ("max_iterations", a.max_iterations.is_some()),
+        ("residual_tolerance", a.residual_tolerance.is_some()),
+        ("displacement_tolerance", a.displacement_tolerance.is_some()),
+        ("rotation_tolerance", a.rotation_tolerance.is_some()),
+        ("output_every", a.output_every.is_some()),
+        ("output_times", a.output_times.is_some()),
+        ("control", a.control.is_some()),
+        ("max_increments", a.max_increments.is_some()),
+    ]
+    .into_iter()
+    .chain(dynamic_keys(a))
+    {
+        if given {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("{name} does not apply to a modal analysis (it linearises about the state reached and does not move t)"),
+            );
+        }
+    }
+    let modes = a.modes.unwrap_or(10);
+    if modes == 0 || modes > MAX_MODES {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!("modes must be from 1 to {MAX_MODES}, got {modes}"),
+        );
+    }
+    if let Some(f) = a.shift {
+        if !(f.is_finite() && f >= 0.0) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "shift must be a frequency in Hz, zero or positive, got {}",
+                    num(f)
+                ),
+            );
+        }
+    }
+    if let Some([lo, hi]) = a.frequency_range {
+        if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "frequency_range must be [low, high] in Hz with 0 ≤ low < high, got [{}, {}]",
+                    num(lo),
+                    num(hi)
+                ),
+            );
+        }
+    }
+    let solver = match a.solver.as_deref() {
+        None | Some("auto") => Method::Auto,
+        Some("dense") => Method::Dense,
+        Some("lanczos") => Method::Lanczos,
+        Some(other) => {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("unknown solver \"{other}\" (available: auto, dense, lanczos)"),
+            );
+            Method::Auto
+        }
+    };
+    ModalSettings {
+        modes,
+        shift: a.shift,
+        frequency_range: a.frequency_range.map(|[lo, hi]| (lo, hi)),
+        solver,
+        time: start,
+    }
+}
+
 /// Settings of one analysis from `start` to its end, with defaults.
 fn settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> StaticSettings {
     if !matches!(a.kind.as_str(), "static" | "kinetostatic" | "kinematic") {
@@ -136,7 +271,7 @@ fn settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> St
             ModelErrorKind::Invalid,
             entity,
             format!(
-                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic, dynamic)",
+                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic, dynamic, modal)",
                 a.kind
             ),
         );

@@ -417,6 +417,33 @@ impl Analysis {
         Self::of_type("kinematic")
     }
 
+    /// Modal analysis: the `modes` lowest natural modes about the state
+    /// reached (docs/theory.md §14.7).
+    pub fn modal(modes: usize) -> Self {
+        let mut a = Self::of_type("modal");
+        a.0.modes = Some(modes);
+        a
+    }
+
+    /// Modal analysis: the modes nearest to this frequency (Hz).
+    pub fn shift(mut self, frequency: f64) -> Self {
+        self.0.shift = Some(frequency);
+        self
+    }
+
+    /// Modal analysis: only the modes with frequencies in `[low, high]`
+    /// (Hz).
+    pub fn frequency_range(mut self, low: f64, high: f64) -> Self {
+        self.0.frequency_range = Some([low, high]);
+        self
+    }
+
+    /// Modal analysis: the eigen-solver, `auto`, `dense` or `lanczos`.
+    pub fn solver(mut self, solver: &str) -> Self {
+        self.0.solver = Some(solver.into());
+        self
+    }
+
     /// Final value of the load parameter (default 1).
     pub fn end_time(mut self, t: f64) -> Self {
         self.0.end_time = t;
@@ -509,14 +536,15 @@ impl Analysis {
     /// a model file.
     pub fn settings(self) -> Result<crate::analysis::StaticSettings, crate::model::ModelErrors> {
         match self.analysis_settings()? {
-            crate::analysis::AnalysisSettings::Dynamic(_) => {
-                Err(crate::model::ModelErrors(vec![crate::model::ModelError {
-                    kind: crate::model::ModelErrorKind::Invalid,
-                    entity: "analysis".into(),
-                    message: "a dynamic analysis has dynamic settings: use analysis_settings or dynamic_settings".into(),
-                }]))
-            }
             crate::analysis::AnalysisSettings::Static(s) => Ok(s),
+            other => Err(crate::model::ModelErrors(vec![crate::model::ModelError {
+                kind: crate::model::ModelErrorKind::Invalid,
+                entity: "analysis".into(),
+                message: format!(
+                    "a {} analysis has no static settings: use analysis_settings",
+                    other.name()
+                ),
+            }])),
         }
     }
 

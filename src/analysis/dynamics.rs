@@ -1231,6 +1231,17 @@ impl Dynamics<'_> {
         (norms, worst.0)
     }
 
+    /// Whether corrections `dx` (translations) and `dth` (rotations) are
+    /// within [`PLATEAU_FACTOR`] ε of the unknowns they correct (the
+    /// largest node position plus the model size, and 1 rad): the state
+    /// can be made no closer to the solution in floating point.
+    fn at_round_off(&self, dx: f64, dth: f64) -> bool {
+        let state = &self.run.state;
+        let size = self.model.length_scale + state.x.iter().map(|x| x.norm()).fold(0.0, f64::max);
+        let round = PLATEAU_FACTOR * f64::EPSILON;
+        dx <= round * size && dth <= round
+    }
+
     fn solver_assembler(&self) -> &crate::assembly::Assembler {
         self.solver.assembler()
     }
@@ -1346,11 +1357,18 @@ impl Dynamics<'_> {
                 let converged = norms.relative_residual <= tol
                     && norms.residual_constraint <= 1.0
                     && self.correction_converged(&x, ratio, motion, &norms);
+                // the residual stopped decreasing at its round-off: within
+                // PLATEAU_FACTOR ε of the flux, or left by a correction
+                // that no longer changes the unknowns (the round-off of a
+                // stiff element's force is ε E A |x|/L, not ε of the
+                // force: a stiff beam's residual stops at ~1e-8 of the
+                // flux)
                 let plateau = || {
                     let (loose, _) = self.norms(PLATEAU_FACTOR, motion);
+                    let (dx, dth) = last.unwrap_or_default();
                     ratio > 0.5
-                        && loose.relative_residual <= tol
                         && loose.residual_constraint <= 1.0
+                        && (loose.relative_residual <= tol || self.at_round_off(dx, dth))
                 };
                 if converged || plateau() {
                     return Ok((iteration, residuals));

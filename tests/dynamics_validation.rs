@@ -332,7 +332,15 @@ fn stiff_beam_pendulum_from_the_horizontal_has_the_elliptic_integral_period() {
     let crossings = zero_crossings(&samples);
     assert_eq!(crossings.len(), 3, "{crossings:?}");
     let measured = crossings[2] - crossings[0];
-    // limit 1e-4 relative (task target)
+    eprintln!(
+        "period {measured} s, elliptic integral {period} s: {:e}",
+        measured / period - 1.0
+    );
+    // limit 1e-4 relative (task target; measured 4.3e-6). Newton
+    // converges quadratically to a residual of ~1e-8 of the flux, the
+    // round-off of forces ε E A |x|/L with EA = 1e9, and accepts it as its
+    // round-off plateau (corrections of 1e-16 m); with a plateau judged by
+    // ε of the flux alone the step was cut to 1e-6 s without end
     assert!(
         (measured / period - 1.0).abs() < 1e-4,
         "period {measured} s against 4√(L_eq/g) K(1/2) = {period} s"

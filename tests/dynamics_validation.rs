@@ -246,8 +246,10 @@ fn heavy_top_follows_an_independent_integration_with_second_order_convergence() 
     );
 
     // ρ∞ = 0.9: with ρ∞ = 1 the index-3 multiplier of the spherical joint
-    // is not damped, and at h = 5e-5 the Newton iterations per step grow
-    // from 2 to 6 until the run breaks down at t ≈ 0.77 s (measured)
+    // is not damped (the trapezoidal rule is unstable on index-3
+    // constraints, Cardona & Géradin 1989): at h = 5e-5 the Newton
+    // iterations per step grow from 2 to 6 by t = 0.75 s, the steps are cut
+    // from t ≈ 0.77 s and the run fails at t ≈ 0.95 s (measured)
     let rho = 0.9;
     // the error of the method at 1 s is ≈ 10.5 h² rad (measured: 1.7e-3,
     // 4.2e-4, 1.05e-4, 2.6e-5, 6.6e-6 rad at h = 4e-4 … 2.5e-5), so

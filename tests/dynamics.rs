@@ -22,9 +22,6 @@ struct Trace {
 
 impl Observer for Trace {
     fn iteration(&mut self, info: &IterationInfo) {
-        if std::env::var("TRACE2").is_ok() {
-            eprintln!("  it {} t {:.6} {:?}", info.iteration, info.time, info.norms);
-        }
         self.iterations.push(info.clone());
     }
     fn increment(
@@ -34,9 +31,6 @@ impl Observer for Trace {
         state: &State,
         _: &[f64],
     ) -> std::io::Result<()> {
-        if std::env::var("TRACE").is_ok() {
-            eprintln!("step {} t {:.6} h {:.3e} it {} {:?}", info.increment, info.time, info.step, info.iterations, info.residuals);
-        }
         self.steps.push((info.clone(), state.clone()));
         Ok(())
     }

@@ -247,6 +247,9 @@ struct Work {
     /// `T(hΔθ)` of every node (D7).
     factors: Vec<Mat3>,
     rhs: Vec<f64>,
+    /// The force flux of the step, by dof: the larger of the flux at the
+    /// predictor and at the iterate (see [`Dynamics::norms`]).
+    flux: Vec<f64>,
     /// Matrix entries in a constraint row or multiplier column, with the
     /// kinds of their row and column (0 none, 1 distance, 2 angle).
     scaled: Vec<(usize, u8, u8)>,
@@ -259,6 +262,7 @@ impl Work {
     /// `matrix`, if it changed.
     fn prepare(&mut self, dofs: &DofMap, matrix: &SparseMatrix, n_nodes: usize) {
         self.factors.resize(n_nodes, Mat3::identity());
+        self.flux.resize(6 * n_nodes, 0.0);
         if self.n_equations == dofs.n_equations() && !self.scaled.is_empty() {
             return;
         }
@@ -1135,12 +1139,26 @@ impl Dynamics<'_> {
     /// The convergence measures of the current iterate (the assembler
     /// holds its residual): norms, and the unknown with the largest
     /// residual relative to its group's flux.
+    ///
+    /// The flux of a node is that of the step ([`Work::flux`]): the larger,
+    /// dof by dof, of `Σₑ |rₑ|` at the predictor and at the iterate. The
+    /// inertia force `M v̇` is part of each element's own residual, so at
+    /// the iterate it cancels inside the element and leaves no trace in
+    /// `Σₑ |rₑ|`: on a node carried by a single body (a free rigid body)
+    /// the flux would be the residual itself and the relative residual 1
+    /// whatever its size. At the predictor `v̇ = 0` (D5), and `Σₑ |rₑ|` there
+    /// is the force that `M v̇` balances at the solution.
     fn norms(&self, floor: f64, motion: (f64, f64)) -> (ConvergenceNorms, usize) {
         let (dofs, assembler) = (&self.solver.dofs, self.solver_assembler());
+        let step_flux = &self.run.work.flux;
+        let flux_of = |d: usize| {
+            let f = assembler.flux[d];
+            step_flux.get(d).map_or(f, |&g| f.max(g))
+        };
         let (mut rf, mut rm, mut rq, mut ef, mut em, mut eq_c) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
         let (mut ff, mut fm) = (0.0, 0.0);
         for d in 0..6 * dofs.n_nodes() {
-            let f = assembler.flux[d];
+            let f = flux_of(d);
             if d % 6 < 3 {
                 ff += f * f;
             } else {
@@ -1155,7 +1173,7 @@ impl Dynamics<'_> {
         for eq in 0..dofs.n_equations() {
             let d = dofs.dof(eq);
             let r = assembler.residual[d];
-            let excess = (r.abs() - eps * assembler.flux[d]).max(0.0);
+            let excess = (r.abs() - eps * flux_of(d)).max(0.0);
             let relative = match dofs.kind(d) {
                 DofKind::Translation => {
                     rf += r * r;
@@ -1211,6 +1229,17 @@ impl Dynamics<'_> {
             rotation_correction: 0.0,
         };
         (norms, worst.0)
+    }
+
+    /// Whether corrections `dx` (translations) and `dth` (rotations) are
+    /// within [`PLATEAU_FACTOR`] ε of the unknowns they correct (the
+    /// largest node position plus the model size, and 1 rad): the state
+    /// can be made no closer to the solution in floating point.
+    fn at_round_off(&self, dx: f64, dth: f64) -> bool {
+        let state = &self.run.state;
+        let size = self.model.length_scale + state.x.iter().map(|x| x.norm()).fold(0.0, f64::max);
+        let round = PLATEAU_FACTOR * f64::EPSILON;
+        dx <= round * size && dth <= round
     }
 
     fn solver_assembler(&self) -> &crate::assembly::Assembler {
@@ -1289,6 +1318,11 @@ impl Dynamics<'_> {
                 }
                 let ctx = dynamic_context(model, t, &sc, h);
                 assembler.assemble_factored(model, &ctx, &run.state, &run.work.factors);
+                // the flux of the step: Σₑ |rₑ| at the predictor (v̇ = 0)
+                if iteration == 0 {
+                    let n = run.work.flux.len();
+                    run.work.flux.copy_from_slice(&assembler.flux[..n]);
+                }
             }
             let motion = self.step_motion(h);
             let (mut norms, worst) = self.norms(FLOOR_FACTOR, motion);
@@ -1323,11 +1357,18 @@ impl Dynamics<'_> {
                 let converged = norms.relative_residual <= tol
                     && norms.residual_constraint <= 1.0
                     && self.correction_converged(&x, ratio, motion, &norms);
+                // the residual stopped decreasing at its round-off: within
+                // PLATEAU_FACTOR ε of the flux, or left by a correction
+                // that no longer changes the unknowns (the round-off of a
+                // stiff element's force is ε E A |x|/L, not ε of the
+                // force: a stiff beam's residual stops at ~1e-8 of the
+                // flux)
                 let plateau = || {
                     let (loose, _) = self.norms(PLATEAU_FACTOR, motion);
+                    let (dx, dth) = last.unwrap_or_default();
                     ratio > 0.5
-                        && loose.relative_residual <= tol
                         && loose.residual_constraint <= 1.0
+                        && (loose.relative_residual <= tol || self.at_round_off(dx, dth))
                 };
                 if converged || plateau() {
                     return Ok((iteration, residuals));

@@ -417,6 +417,33 @@ impl Analysis {
         Self::of_type("kinematic")
     }
 
+    /// Implicit dynamics (Lie-group generalised-α, docs/theory.md §15)
+    /// from the state reached to `end_time`; a model whose analyses are
+    /// all dynamic or modal may have parts free to move as rigid bodies.
+    pub fn dynamic() -> Self {
+        Self::of_type("dynamic")
+    }
+
+    /// Dynamics: the first time step (default a hundredth of the span).
+    pub fn time_step(mut self, h: f64) -> Self {
+        self.0.time_step = Some(h);
+        self
+    }
+
+    /// Dynamics: the spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`
+    /// (default 0.9).
+    pub fn rho_infinity(mut self, rho: f64) -> Self {
+        self.0.rho_infinity = Some(rho);
+        self
+    }
+
+    /// Dynamics: fixed steps of `time_step` instead of steps sized by the
+    /// error estimate.
+    pub fn fixed_step(mut self) -> Self {
+        self.0.adaptive = Some(false);
+        self
+    }
+
     /// Modal analysis: the `modes` lowest natural modes about the state
     /// reached (docs/theory.md §14.7).
     pub fn modal(modes: usize) -> Self {

@@ -40,7 +40,8 @@ pub struct Energies {
     /// Work done on the model by loads, drivers and prescribed motions
     /// since the start of the motion.
     pub external_work: f64,
-    /// Energy dissipated by dampers since the start of the motion.
+    /// Energy dissipated by dampers and impacts (latches locking) since the
+    /// start of the motion.
     pub dissipated: f64,
     /// `(T + V) − (T₀ + V₀) − W + D`.
     pub balance_error: f64,
@@ -148,6 +149,12 @@ impl EnergyBalance {
     /// A balance that starts at the first state it is given.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Counts `energy` as dissipated at the current instant (the loss of an
+    /// impact, docs/theory.md §16).
+    pub fn dissipate(&mut self, energy: f64) {
+        self.dissipated += energy;
     }
 
     /// Adds `state` (the next state of the motion) and returns its

@@ -766,7 +766,7 @@ fn constraint_residual(model: &Model, solver: &mut NewtonSolver, state: &State) 
 /// First and second derivatives of the residual of the multiplier rows
 /// along the motion (`−k Φ̇` and `−k Φ̈` at `v̇ = 0`), by Richardson
 /// extrapolation of central differences (D9–D10).
-fn constraint_rates(
+pub(super) fn constraint_rates(
     model: &Model,
     solver: &mut NewtonSolver,
     state: &State,
@@ -1575,6 +1575,7 @@ impl Stepper for Dynamics<'_> {
             &run.accepted,
             &mut run.state,
             info.increment,
+            self.settings.end_time,
         )? {
             Some(i) => {
                 run.lock_rank_analyses += 1;
@@ -1588,7 +1589,9 @@ impl Stepper for Dynamics<'_> {
                 run.last_step = None;
                 run.a_before.clear();
                 run.a_before_coordinates.clear();
-                run.balance.dissipate(i.locks[0].kinetic_energy_drop);
+                let l = &i.locks[0];
+                run.balance
+                    .impact(l.energy_lost, l.energy_lost - l.kinetic_energy_drop);
                 i.locks
             }
             None => Vec::new(),

@@ -151,10 +151,12 @@ impl EnergyBalance {
         Self::default()
     }
 
-    /// Counts `energy` as dissipated at the current instant (the loss of an
-    /// impact, docs/theory.md §16).
-    pub fn dissipate(&mut self, energy: f64) {
-        self.dissipated += energy;
+    /// Adds an impact at the current instant (a latch locking,
+    /// docs/theory.md §16): the energy it dissipates, and the work its
+    /// impulses do through drivers and prescribed motions.
+    pub fn impact(&mut self, dissipated: f64, work: f64) {
+        self.dissipated += dissipated;
+        self.work += work;
     }
 
     /// Adds `state` (the next state of the motion) and returns its

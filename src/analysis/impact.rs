@@ -10,22 +10,21 @@
 //! velocity jump computed explicitly; Pfeiffer & Glocker 1996, ch. 5):
 //!
 //! ```text
-//! [ M   −kBᵀ ] [ Δv ]   [ 0        ]
-//! [ −kB   0  ] [ π  ] = [ −k B_N Δv ]   with  B_L Δv = −ċ⁻ = −B_L v⁻,
-//!                                              B_O Δv = 0,
+//! [ M   −kBᵀ ] [ Δv ]   [ 0      ]
+//! [ −kB   0  ] [ π  ] = [ k Φ̇⁻  ],      Φ̇⁻ = B v⁻ + ∂Φ/∂t,
 //! ```
 //!
-//! `M` the assembled mass matrix, `B_L` the gradient of the newly locked
-//! coordinate, `B_O` those of the constraints already active (whose rates
-//! the impulse leaves as they are: zero, or a driver's rate), `kπ` the
-//! impulses. Then `v⁺ = v⁻ + Δv`, the energy lost is
-//! `½ Δvᵀ M Δv = T⁻ − T⁺` (since `B v⁺ = 0`, eq. I1 of docs/theory.md
+//! `M` the assembled mass matrix, `B` the gradients of the newly locked
+//! coordinate (`Φ̇⁻ = ċ⁻`) and of the constraints already active, `kπ` the
+//! impulses: after the impact every constraint holds at velocity level,
+//! `Φ̇⁺ = 0`. Then `v⁺ = v⁻ + Δv`, the energy lost is `½ Δvᵀ M Δv`, equal
+//! to `T⁻ − T⁺` when no constraint depends on time (I3 of docs/theory.md
 //! §16), momentum is conserved (the impulses are internal), and the
 //! integrator restarts from the post-impact state with consistent
 //! accelerations (D9).
 
 use super::control::EventFunction;
-use super::dynamics::DynamicError;
+use super::dynamics::{constraint_rates, DynamicError};
 use super::energy;
 use super::newton::{NewtonSolver, SINGULAR_PIVOT};
 use crate::dofs::{DofKind, NO_EQUATION};
@@ -151,6 +150,7 @@ pub fn lock_latches(
     before: &State,
     state: &mut State,
     increment: usize,
+    end_time: f64,
 ) -> Result<Option<Impact>, DynamicError> {
     // the latches reached, with ċ⁻ and B_L
     let mut reached: Vec<(&Latch, f64, Vec<f64>)> = Vec::new();
@@ -186,6 +186,9 @@ pub fn lock_latches(
     for &k in &rank.redundant {
         state.multipliers[k] = 0.0;
     }
+    // −k Φ̇⁻ of every constraint (drivers' and prescribed motions' rates
+    // included)
+    let (rates, _) = constraint_rates(model, solver, state, end_time);
 
     // the mass matrix M and the constraint rows −kB at the lock
     let (dofs, assembler, lu) = solver.system();
@@ -279,8 +282,16 @@ pub fn lock_latches(
             values[i] = v * s_eq[row] * s_eq[col];
         }
     }
-    // −k B_L Δv = k ċ⁻ on the latch rows, zero elsewhere
-    let mut rhs = vec![0.0; n];
+    // −k B Δv = k Φ̇⁻ on the constraint rows (the latches' ċ⁻ exact)
+    let mut rhs: Vec<f64> = (0..n)
+        .map(|eq| {
+            if is_multiplier[eq] {
+                -rates[dofs.dof(eq)] * s_eq[eq]
+            } else {
+                0.0
+            }
+        })
+        .collect();
     let mut latch_rows = Vec::with_capacity(reached.len());
     for (l, rate, _) in &reached {
         let eq = dofs.equation(dofs.first_multiplier() + l.multiplier());

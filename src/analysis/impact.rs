@@ -224,7 +224,25 @@ pub fn lock_latches(
         })
         .collect();
 
-    // an impulse on an unknown without mass has no finite answer
+    // the latches' multiplier equations (NO_EQUATION if redundant)
+    let latch_rows: Vec<usize> = reached
+        .iter()
+        .map(|(l, ..)| dofs.equation(dofs.first_multiplier() + l.multiplier()))
+        .collect();
+    let is_multiplier: Vec<bool> = (0..n)
+        .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
+        .collect();
+    // unknowns without mass held by a constraint other than the new locks
+    // (a hinge node glued to its body): the constraints carry the impulse
+    let mut held = vec![false; n];
+    for (row, col, v) in stiffness.entries() {
+        if v != 0.0 && light[row] && is_multiplier[col] && !latch_rows.contains(&col) {
+            held[row] = true;
+        }
+    }
+
+    // an impulse on an unknown without mass that nothing else holds has no
+    // finite answer
     for (l, _, grad) in &reached {
         let largest = grad.iter().fold(0.0f64, |a, g| a.max(g.abs()));
         for (k, &node) in l.pair_nodes().iter().enumerate() {
@@ -232,13 +250,14 @@ pub fn lock_latches(
                 let eq = dofs.equation(6 * node + c);
                 if eq != NO_EQUATION
                     && light[eq]
+                    && !held[eq]
                     && grad[6 * k + c].abs() > NEGLIGIBLE_GRADIENT * largest
                 {
                     return Err(DynamicError::Impact {
                         latches: names(),
                         time,
                         reason: format!(
-                            "the impulse of the lock acts on node {} ({}) which has no mass in that direction, so the velocity jump is not defined; give the bodies the latch joins their mass (rigid bodies, point masses or beams at the joint's nodes)",
+                            "the impulse of the lock acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies the latch joins their mass (rigid bodies, point masses or beams at the joint's nodes, or nodes glued to them)",
                             model.node_ids[node],
                             crate::model::COMPONENT_NAMES[c]
                         ),
@@ -249,10 +268,8 @@ pub fn lock_latches(
     }
 
     // the impact system, multiplier rows and columns scaled to the mass
-    // (as D9), massless rows taking their stiffness row (as D9)
-    let is_multiplier: Vec<bool> = (0..n)
-        .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
-        .collect();
+    // (as D9); massless rows that no constraint holds take their stiffness
+    // row (as D9: they follow quasi-statically)
     let k_of = |kind: ConstraintKind| model.scaling.of(kind).0;
     let s_eq: Vec<f64> = (0..n)
         .map(|eq| match dofs.equation_kind(eq) {
@@ -274,7 +291,7 @@ pub fn lock_latches(
         let values = assembler.matrix.values_mut();
         let (k, m) = (stiffness.values(), mass.values());
         for (i, (row, col, _)) in stiffness.entries().enumerate() {
-            let v = if is_multiplier[row] || is_multiplier[col] || light[row] {
+            let v = if is_multiplier[row] || is_multiplier[col] || (light[row] && !held[row]) {
                 k[i] + m[i]
             } else {
                 m[i]
@@ -292,14 +309,11 @@ pub fn lock_latches(
             }
         })
         .collect();
-    let mut latch_rows = Vec::with_capacity(reached.len());
-    for (l, rate, _) in &reached {
-        let eq = dofs.equation(dofs.first_multiplier() + l.multiplier());
+    for ((l, rate, _), &eq) in reached.iter().zip(&latch_rows) {
         if eq != NO_EQUATION {
             let k = l.scaling(&ctx).0;
             rhs[eq] = k * rate * s_eq[eq];
         }
-        latch_rows.push(eq);
     }
     let solved = (|| {
         if lu.is_none() {

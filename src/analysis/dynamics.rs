@@ -199,7 +199,7 @@ pub struct DynamicOutcome {
     pub rank_analyses: usize,
     /// Steps retried shortened to land on an event.
     pub event_retries: usize,
-    /// The latches that locked, in order (docs/joints.md §7).
+    /// The latches that locked, in order (docs/joints.md §6.2).
     pub locks: Vec<LockInfo>,
     /// Time reached.
     pub time: f64,
@@ -427,7 +427,7 @@ impl DynamicAnalysis {
             error: None,
         };
 
-        // latches at their value lock, without impact (docs/joints.md §7)
+        // latches at their value lock, without impact (docs/joints.md §6.2)
         impact::lock_at_start(model, &mut run.state);
 
         // rank of the constraints: redundant ones out

@@ -1,5 +1,5 @@
 //! Latches locking during a dynamic analysis (docs/theory.md §16,
-//! docs/joints.md §7): the events that land a time step on a lock, and the
+//! docs/joints.md §6.2): the events that land a time step on a lock, and the
 //! impact of the lock.
 //!
 //! A latch is watched through its event function `g = s (c − c_L)`

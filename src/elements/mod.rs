@@ -286,7 +286,7 @@ pub trait Element: Send + Sync {
     }
 
     /// The element as a latch, for the analyses that lock latches
-    /// (docs/joints.md §7).
+    /// (docs/joints.md §6.2).
     fn as_latch(&self) -> Option<&crate::joints::Latch> {
         None
     }

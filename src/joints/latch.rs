@@ -1,7 +1,7 @@
 //! Latches: a joint coordinate `c` that locks when it reaches its locking
 //! value `c_L` moving in the direction of approach (the lock at the end of
 //! a hinge's travel of the reference paper, section 6.2; docs/joints.md
-//! §7).
+//! §6.2).
 //!
 //! Until it locks a latch applies nothing: its one multiplier equation is
 //! `k λ = 0`, as a released driver's. A dynamic analysis watches the event

@@ -343,7 +343,7 @@ pub struct DriverInput {
     pub active: Option<[f64; 2]>,
 }
 
-/// A latch on a joint coordinate (docs/joints.md §7): the coordinate locks
+/// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
 /// when it reaches `value` moving in the direction of approach, and stays
 /// locked.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]

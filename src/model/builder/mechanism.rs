@@ -411,7 +411,7 @@ impl Entity for Driver {
     }
 }
 
-/// A latch on a joint coordinate (docs/joints.md §7): the coordinate locks
+/// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
 /// when it reaches its locking value moving in the direction of approach,
 /// and stays locked (in dynamic analyses, with the impact of the lock).
 #[derive(Clone, Debug, PartialEq)]

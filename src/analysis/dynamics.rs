@@ -1589,9 +1589,7 @@ impl Stepper for Dynamics<'_> {
                 run.last_step = None;
                 run.a_before.clear();
                 run.a_before_coordinates.clear();
-                let l = &i.locks[0];
-                run.balance
-                    .impact(l.energy_lost, l.energy_lost - l.kinetic_energy_drop);
+                run.balance.impact(i.locks[0].energy_lost, i.work);
                 i.locks
             }
             None => Vec::new(),

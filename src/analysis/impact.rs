@@ -56,7 +56,8 @@ pub struct LockInfo {
     pub joint: Id,
     /// The coordinate at the lock (within the event tolerance of `c_L`).
     pub coordinate: f64,
-    /// `ċ⁻`: the coordinate's rate just before the lock.
+    /// `ċ⁻`: the coordinate's rate just before the lock (with the
+    /// velocities consistent with the other constraints).
     pub rate_before: f64,
     /// `kπ`: the impulse of the lock along the coordinate (N·m·s for an
     /// angle, N·s for a length), opposed to the approach.
@@ -64,9 +65,15 @@ pub struct LockInfo {
     /// `½ Δvᵀ M Δv`: the energy the impact dissipates. Latches that lock
     /// in the same step share one impact and report its whole loss.
     pub energy_lost: f64,
-    /// `T⁻ − T⁺`, the drop of the kinetic energy (equal to
-    /// [`Self::energy_lost`] up to round-off).
+    /// `T⁻ − T⁺`, the drop of the kinetic energy: the energy lost plus
+    /// [`Self::velocity_correction`] (when no constraint depends on time),
+    /// up to round-off.
     pub kinetic_energy_drop: f64,
+    /// `T⁻ − T₁`: the kinetic energy of the joints' velocity error at the
+    /// lock (index-3 integration satisfies the constraints at position
+    /// level only), removed before the impact; an error of the
+    /// integration, left in the energy balance's error.
+    pub velocity_correction: f64,
 }
 
 /// `|g|` at or below which a step has landed on `latch`'s lock.
@@ -136,61 +143,41 @@ pub struct Impact {
     /// Constraint equations found redundant by the rank analysis that
     /// followed the change of the active set.
     pub redundant: usize,
+    /// Work of the impulses through drivers and prescribed motions (zero
+    /// when no constraint depends on time).
+    pub work: f64,
 }
 
-/// Locks the open latches that the step from `before` to `state` brought
-/// to their value from the side of approach (`g` from below `−tol` to at
-/// least `−tol`), runs the rank analysis of the constraints again, and
-/// applies the impact (see the module documentation) to the velocities of
-/// `state`. `None` if no latch locked. The accelerations are left to the
-/// caller (D9 at the post-impact state).
-pub fn lock_latches(
+/// The velocity jump of one impact system (see the module documentation).
+struct Jump {
+    /// The solution by equation: `Δv`, then `π` (unscaled) at the
+    /// multiplier equations.
+    solution: Vec<f64>,
+    /// `½ Δvᵀ M Δv`.
+    energy: f64,
+}
+
+/// Why an impact system has no answer.
+enum Singular {
+    /// An unknown without mass that nothing holds is struck: node,
+    /// component.
+    Massless(usize, usize),
+    /// The system is singular (at this unknown, if found).
+    System(String),
+}
+
+/// Solves the impact system at `state` with the solver's numbering:
+/// `rhs(eq)` on the multiplier equations (`k Φ̇⁻` to cancel), `struck` the
+/// multiplier equations of the latches locking (which hold nothing else)
+/// with their gradients; applies `Δv` to the velocities of `state`.
+fn jump(
     model: &Model,
     solver: &mut NewtonSolver,
-    before: &State,
     state: &mut State,
-    increment: usize,
-    end_time: f64,
-) -> Result<Option<Impact>, DynamicError> {
-    // the latches reached, with ċ⁻ and B_L
-    let mut reached: Vec<(&Latch, f64, Vec<f64>)> = Vec::new();
-    for e in &model.elements {
-        let Some(l) = e.as_latch() else { continue };
-        if l.is_locked(state) {
-            continue;
-        }
-        let tol = event_tolerance(model, l);
-        if l.gap(before) < -tol && l.gap(state) >= -tol {
-            let (rate, grad) = l.rate(state);
-            reached.push((l, rate, grad));
-        }
-    }
-    if reached.is_empty() {
-        return Ok(None);
-    }
+    rhs_of: &dyn Fn(usize, usize) -> f64,
+    struck: &[(usize, &Latch, &[f64])],
+) -> Result<Jump, Singular> {
     let time = state.time;
-    let names = || {
-        reached
-            .iter()
-            .map(|(l, ..)| format!("latch {}", l.id()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let kinetic_before = energy::energies(model, state).kinetic;
-    for (l, ..) in &reached {
-        l.lock(state);
-    }
-
-    // the active set changed: rank analysis again
-    let rank = solver.constraint_rank(model, state, time);
-    for &k in &rank.redundant {
-        state.multipliers[k] = 0.0;
-    }
-    // −k Φ̇⁻ of every constraint (drivers' and prescribed motions' rates
-    // included)
-    let (rates, _) = constraint_rates(model, solver, state, end_time);
-
-    // the mass matrix M and the constraint rows −kB at the lock
     let (dofs, assembler, lu) = solver.system();
     let mut stiffness = assembler.matrix.clone();
     let mut mass = assembler.matrix.clone();
@@ -223,27 +210,21 @@ pub fn lock_latches(
             DofKind::Multiplier(_) => false,
         })
         .collect();
-
-    // the latches' multiplier equations (NO_EQUATION if redundant)
-    let latch_rows: Vec<usize> = reached
-        .iter()
-        .map(|(l, ..)| dofs.equation(dofs.first_multiplier() + l.multiplier()))
-        .collect();
     let is_multiplier: Vec<bool> = (0..n)
         .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
         .collect();
+    let struck_rows: Vec<usize> = struck.iter().map(|s| s.0).collect();
     // unknowns without mass held by a constraint other than the new locks
     // (a hinge node glued to its body): the constraints carry the impulse
     let mut held = vec![false; n];
     for (row, col, v) in stiffness.entries() {
-        if v != 0.0 && light[row] && is_multiplier[col] && !latch_rows.contains(&col) {
+        if v != 0.0 && light[row] && is_multiplier[col] && !struck_rows.contains(&col) {
             held[row] = true;
         }
     }
-
     // an impulse on an unknown without mass that nothing else holds has no
     // finite answer
-    for (l, _, grad) in &reached {
+    for &(_, l, grad) in struck {
         let largest = grad.iter().fold(0.0f64, |a, g| a.max(g.abs()));
         for (k, &node) in l.pair_nodes().iter().enumerate() {
             for c in 0..6 {
@@ -253,23 +234,15 @@ pub fn lock_latches(
                     && !held[eq]
                     && grad[6 * k + c].abs() > NEGLIGIBLE_GRADIENT * largest
                 {
-                    return Err(DynamicError::Impact {
-                        latches: names(),
-                        time,
-                        reason: format!(
-                            "the impulse of the lock acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies the latch joins their mass (rigid bodies, point masses or beams at the joint's nodes, or nodes glued to them)",
-                            model.node_ids[node],
-                            crate::model::COMPONENT_NAMES[c]
-                        ),
-                    });
+                    return Err(Singular::Massless(node, c));
                 }
             }
         }
     }
 
-    // the impact system, multiplier rows and columns scaled to the mass
-    // (as D9); massless rows that no constraint holds take their stiffness
-    // row (as D9: they follow quasi-statically)
+    // multiplier rows and columns scaled to the mass (as D9); massless
+    // rows that no constraint holds take their stiffness row (as D9: they
+    // follow quasi-statically)
     let k_of = |kind: ConstraintKind| model.scaling.of(kind).0;
     let s_eq: Vec<f64> = (0..n)
         .map(|eq| match dofs.equation_kind(eq) {
@@ -299,22 +272,15 @@ pub fn lock_latches(
             values[i] = v * s_eq[row] * s_eq[col];
         }
     }
-    // −k B Δv = k Φ̇⁻ on the constraint rows (the latches' ċ⁻ exact)
     let mut rhs: Vec<f64> = (0..n)
         .map(|eq| {
             if is_multiplier[eq] {
-                -rates[dofs.dof(eq)] * s_eq[eq]
+                rhs_of(eq, dofs.dof(eq)) * s_eq[eq]
             } else {
                 0.0
             }
         })
         .collect();
-    for ((l, rate, _), &eq) in reached.iter().zip(&latch_rows) {
-        if eq != NO_EQUATION {
-            let k = l.scaling(&ctx).0;
-            rhs[eq] = k * rate * s_eq[eq];
-        }
-    }
     let solved = (|| {
         if lu.is_none() {
             *lu = Some(SparseLu::analyze(&assembler.matrix)?);
@@ -324,42 +290,147 @@ pub fn lock_latches(
         lu.solve_in_place(&mut rhs)
     })();
     if solved.is_err() || !rhs.iter().all(|v| v.is_finite()) {
-        let what = match smallest_relative_pivot(&assembler.matrix) {
+        let at = match smallest_relative_pivot(&assembler.matrix) {
             Ok((eq, pivot)) if pivot < SINGULAR_PIVOT => {
                 format!(" (at {})", solver.dof_label(model, solver.dofs.dof(eq)))
             }
             _ => String::new(),
         };
-        return Err(DynamicError::Impact {
-            latches: names(),
-            time,
-            reason: format!(
-                "the impact equations are singular{what}: the mass matrix is singular on the motion the lock's impulse excites (an unknown without mass that no constraint holds); give the bodies mass"
-            ),
-        });
+        return Err(Singular::System(at));
     }
 
-    // v⁺ = v⁻ + Δv; ½ ΔvᵀMΔv
+    // v⁺ = v⁻ + Δv; ½ ΔvᵀMΔv; π unscaled
     let dofs = &solver.dofs;
-    let mut lost = 0.0;
+    let mut energy = 0.0;
     for (row, col, m) in mass.entries() {
         if !is_multiplier[row] && !is_multiplier[col] {
-            lost += 0.5 * rhs[row] * m * rhs[col];
+            energy += 0.5 * rhs[row] * m * rhs[col];
         }
     }
-    for (eq, &dv) in rhs.iter().enumerate() {
+    for (eq, dv) in rhs.iter_mut().enumerate() {
         let d = dofs.dof(eq);
         if let Some((node, c)) = dofs.node_component(d) {
-            state.velocity[node][c] += dv;
+            state.velocity[node][c] += *dv;
         } else if d < dofs.first_multiplier() {
-            state.coordinate_rates[d - dofs.first_coordinate()] += dv;
+            state.coordinate_rates[d - dofs.first_coordinate()] += *dv;
+        } else {
+            *dv *= s_eq[eq];
         }
     }
+    Ok(Jump {
+        solution: rhs,
+        energy,
+    })
+}
+
+/// Locks the open latches that the step from `before` to `state` brought
+/// to their value from the side of approach (`g` from below `−tol` to at
+/// least `−tol`), runs the rank analysis of the constraints again, and
+/// applies the impact to the velocities of `state` (see the module
+/// documentation), in two stages:
+///
+/// 1. the velocities are made consistent with the constraints already
+///    active (`Φ̇ = 0`; index-3 integration satisfies them at position
+///    level only), the latches still open: an M-orthogonal projection whose
+///    energy, `T⁻ − T₁`, is an error of the integration, reported apart;
+/// 2. the impact of the locks from those velocities, `B_L Δv = −ċ`, the
+///    other constraints keeping their rates: its `½ ΔvᵀMΔv` is the energy
+///    lost (Carnot's, exactly, for the velocities of stage 1).
+///
+/// `None` if no latch locked. The accelerations are left to the caller
+/// (D9 at the post-impact state).
+pub fn lock_latches(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    before: &State,
+    state: &mut State,
+    increment: usize,
+    end_time: f64,
+) -> Result<Option<Impact>, DynamicError> {
+    let reached: Vec<&Latch> = model
+        .elements
+        .iter()
+        .filter_map(|e| e.as_latch())
+        .filter(|l| {
+            let tol = event_tolerance(model, l);
+            !l.is_locked(state) && l.gap(before) < -tol && l.gap(state) >= -tol
+        })
+        .collect();
+    if reached.is_empty() {
+        return Ok(None);
+    }
+    let time = state.time;
+    let failed = |why: Singular| {
+        let latches = reached
+            .iter()
+            .map(|l| format!("latch {}", l.id()))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let reason = match why {
+            Singular::Massless(node, c) => format!(
+                "the impulse of the lock acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies the latch joins their mass (rigid bodies, point masses or beams at the joint's nodes, or nodes glued to them)",
+                model.node_ids[node],
+                crate::model::COMPONENT_NAMES[c]
+            ),
+            Singular::System(at) => format!(
+                "the impact equations are singular{at}: the mass matrix is singular on the motion the impulse excites (an unknown without mass that no constraint holds); give the bodies mass"
+            ),
+        };
+        DynamicError::Impact {
+            latches,
+            time,
+            reason,
+        }
+    };
+    let kinetic_before = energy::energies(model, state).kinetic;
+
+    // 1. velocities consistent with the constraints already active
+    let correction = if solver.dofs.first_multiplier() < solver.dofs.n_dofs() {
+        let (rates, _) = constraint_rates(model, solver, state, end_time);
+        jump(model, solver, state, &|_, d| -rates[d], &[])
+            .map_err(failed)?
+            .energy
+    } else {
+        0.0
+    };
+    let kinetic_consistent = energy::energies(model, state).kinetic;
+
+    // 2. the locks: the active set changes, rank analysis again
+    let struck: Vec<(f64, Vec<f64>)> = reached.iter().map(|l| l.rate(state)).collect();
+    for l in &reached {
+        l.lock(state);
+    }
+    let rank = solver.constraint_rank(model, state, time);
+    for &k in &rank.redundant {
+        state.multipliers[k] = 0.0;
+    }
+    let first = solver.dofs.first_multiplier();
+    let rows: Vec<usize> = reached
+        .iter()
+        .map(|l| solver.dofs.equation(first + l.multiplier()))
+        .collect();
+    let ctx = model.context(time, Need::RESIDUAL);
+    // −k B_L Δv = k ċ on the latch rows, zero elsewhere
+    let rhs_of = |eq: usize, _: usize| {
+        rows.iter()
+            .zip(&reached)
+            .zip(&struck)
+            .find(|((&r, _), _)| r == eq)
+            .map_or(0.0, |((_, l), (rate, _))| l.scaling(&ctx).0 * rate)
+    };
+    let hit: Vec<(usize, &Latch, &[f64])> = rows
+        .iter()
+        .zip(&reached)
+        .zip(&struck)
+        .map(|((&r, &l), (_, g))| (r, l, g.as_slice()))
+        .collect();
+    let j = jump(model, solver, state, &rhs_of, &hit).map_err(failed)?;
     let kinetic_after = energy::energies(model, state).kinetic;
     let locks = reached
         .iter()
-        .zip(&latch_rows)
-        .map(|((l, rate, _), &eq)| LockInfo {
+        .zip(&rows)
+        .zip(&struck)
+        .map(|((l, &eq), (rate, _))| LockInfo {
             increment,
             time,
             latch: l.id(),
@@ -369,14 +440,17 @@ pub fn lock_latches(
             impulse: if eq == NO_EQUATION {
                 0.0
             } else {
-                l.scaling(&ctx).0 * rhs[eq] * s_eq[eq]
+                l.scaling(&ctx).0 * j.solution[eq]
             },
-            energy_lost: lost,
+            energy_lost: j.energy,
             kinetic_energy_drop: kinetic_before - kinetic_after,
+            velocity_correction: correction,
         })
         .collect();
     Ok(Some(Impact {
         locks,
         redundant: rank.redundant.len(),
+        // T⁺ − T₁ = W − ½ΔvᵀMΔv
+        work: kinetic_after - kinetic_consistent + j.energy,
     }))
 }

@@ -6,22 +6,23 @@
 //! ([`LatchEvent`]); the step controller lands a step on `g = 0`. When an
 //! accepted step has brought an open latch from `g < 0` to `g ≥ −tol`, the
 //! latch locks, and the velocities jump as in a perfectly plastic impact
-//! (the reference paper's treatment of a lock: momentum conserved, the
-//! velocity jump computed explicitly; Pfeiffer & Glocker 1996, ch. 5):
+//! (the reference paper's treatment of a lock, §6.2: momentum conserved,
+//! the velocity jump computed explicitly; Pfeiffer & Glocker 1996, ch. 5):
 //!
 //! ```text
-//! [ M   −kBᵀ ] [ Δv ]   [ 0      ]
-//! [ −kB   0  ] [ π  ] = [ k Φ̇⁻  ],      Φ̇⁻ = B v⁻ + ∂Φ/∂t,
+//! [ M   −kBᵀ ] [ Δv ]   [ 0     ]
+//! [ −kB   0  ] [ π  ] = [ k Φ̇⁻ ],      v⁺ = v⁻ + Δv,
 //! ```
 //!
-//! `M` the assembled mass matrix, `B` the gradients of the newly locked
-//! coordinate (`Φ̇⁻ = ċ⁻`) and of the constraints already active, `kπ` the
-//! impulses: after the impact every constraint holds at velocity level,
-//! `Φ̇⁺ = 0`. Then `v⁺ = v⁻ + Δv`, the energy lost is `½ Δvᵀ M Δv`, equal
-//! to `T⁻ − T⁺` when no constraint depends on time (I3 of docs/theory.md
-//! §16), momentum is conserved (the impulses are internal), and the
-//! integrator restarts from the post-impact state with consistent
-//! accelerations (D9).
+//! `M` the assembled mass matrix, `B` the gradients of the constraints,
+//! `kπ` the impulses, so that `Φ̇⁺ = 0`. It is solved in two stages
+//! ([`lock_latches`]): the velocities made consistent with the constraints
+//! already active (their rates `Φ̇⁻`, which index-3 integration leaves
+//! slightly off zero), then the lock (`Φ̇⁻ = ċ⁻` on the latch's row, the
+//! others kept). The energy lost is the second stage's `½ Δvᵀ M Δv`
+//! (Carnot's loss, docs/theory.md §16, LK3), momentum is conserved (the
+//! impulses are internal), and the integrator restarts from the
+//! post-impact state with consistent accelerations (D9).
 
 use super::control::EventFunction;
 use super::dynamics::{constraint_rates, DynamicError};

@@ -763,3 +763,22 @@ fn a_latch_locked_in_dynamics_holds_in_the_static_analysis_after() {
     // the latch pushes the angle down against the spring
     assert!((r[3] + held).abs() <= 1e-9 * held, "{} vs {}", r[3], -held);
 }
+
+/// A latch at its value at the start of a dynamic analysis is locked
+/// there (docs/joints.md §6.2): the spring cannot open the panels (the
+/// angle stays 0 within the constraint tolerance, 1e-6 rad), and no lock
+/// is reported.
+#[test]
+fn a_latch_at_its_value_at_the_start_is_locked() {
+    let (_, out, rec) = run(&panels(
+        "[[latches]]\nid = 20\njoint = 10\nvalue = 0.0\napproach = \"increasing\"\n",
+    ));
+    assert!(out.locks.is_empty() && rec.locks.is_empty());
+    let largest = rec
+        .steps
+        .iter()
+        .map(|(_, s)| angle(s).abs())
+        .fold(0.0, f64::max);
+    eprintln!("largest |θ| {largest:.3e} rad");
+    assert!(largest <= 1e-6, "{largest:.3e}");
+}

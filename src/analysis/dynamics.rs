@@ -42,6 +42,7 @@ use super::control::{
     Advance, Attempt, ControlStop, EventFunction, StepBounds, StepController, Stepper,
 };
 use super::energy::{Energies, EnergyBalance};
+use super::impact::{self, LockInfo};
 use super::newton::{non_finite_origin, NewtonFailure, NewtonSolver, SINGULAR_PIVOT};
 use super::settings::DynamicSettings;
 use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer};
@@ -159,6 +160,16 @@ pub enum DynamicError {
         /// Why.
         failure: NewtonFailure,
     },
+    /// The impact of a latch locking could not be computed.
+    #[error("at t = {time}: the lock of {latches}: {reason}")]
+    Impact {
+        /// The latches locking (`latch 4`).
+        latches: String,
+        /// Time of the lock.
+        time: f64,
+        /// Why.
+        reason: String,
+    },
     /// A result file could not be written.
     #[error("writing results: {0}")]
     Output(#[from] std::io::Error),
@@ -188,6 +199,8 @@ pub struct DynamicOutcome {
     pub rank_analyses: usize,
     /// Steps retried shortened to land on an event.
     pub event_retries: usize,
+    /// The latches that locked, in order (docs/joints.md §6.2).
+    pub locks: Vec<LockInfo>,
     /// Time reached.
     pub time: f64,
     /// Energies at the last converged state.
@@ -236,6 +249,9 @@ struct Run {
     redundant: usize,
     /// The unknown with the largest residual at the last failed attempt.
     location: String,
+    /// The latches locked so far, and the rank analyses their locks ran.
+    locks: Vec<LockInfo>,
+    lock_rank_analyses: usize,
     started: Instant,
     finished: bool,
     error: Option<DynamicError>,
@@ -408,10 +424,15 @@ impl DynamicAnalysis {
             mass_scale: [0.0; 2],
             redundant: 0,
             location: String::new(),
+            locks: Vec::new(),
+            lock_rank_analyses: 0,
             started,
             finished: false,
             error: None,
         };
+
+        // latches at their value lock, without impact (docs/joints.md §6.2)
+        impact::lock_at_start(model, &mut run.state);
 
         // rank of the constraints: redundant ones out
         let rank = self.solver.constraint_rank(model, &run.state, t0);
@@ -465,7 +486,12 @@ impl DynamicAnalysis {
             StepController::new(bounds, s.end_time)
                 .with_output_times(&s.output_times)
                 .with_output_every(s.output_every)
-                .with_events(std::mem::take(&mut self.events)),
+                .with_events(
+                    impact::latch_events(model)
+                        .into_iter()
+                        .chain(std::mem::take(&mut self.events))
+                        .collect(),
+                ),
         );
         let stopped = written.is_err();
         if let Err(e) = written {
@@ -596,20 +622,26 @@ impl DynamicAnalysis {
         let wall_time = run
             .as_ref()
             .map_or(0.0, |r| r.started.elapsed().as_secs_f64());
-        let (state, counts, redundant, energies, error) = match run {
-            Some(r) => (
-                r.accepted,
-                r.controller.map(|c| c.counts()).unwrap_or_default(),
-                r.redundant,
-                r.energies,
-                r.error,
-            ),
+        let (state, counts, redundant, energies, error, locks) = match run {
+            Some(r) => {
+                let mut counts = r.controller.map(|c| c.counts()).unwrap_or_default();
+                counts.rank_analyses += r.lock_rank_analyses;
+                (
+                    r.accepted,
+                    counts,
+                    r.redundant,
+                    r.energies,
+                    r.error,
+                    r.locks,
+                )
+            }
             None => (
                 State::default(),
                 Default::default(),
                 0,
                 Energies::default(),
                 None,
+                Vec::new(),
             ),
         };
         DynamicOutcome {
@@ -624,6 +656,7 @@ impl DynamicAnalysis {
             redundant_constraints: redundant.max(self.solver.redundant_count()),
             rank_analyses: counts.rank_analyses,
             event_retries: counts.event_retries,
+            locks,
             energies,
             wall_time,
             error,
@@ -737,7 +770,7 @@ fn constraint_residual(model: &Model, solver: &mut NewtonSolver, state: &State) 
 /// First and second derivatives of the residual of the multiplier rows
 /// along the motion (`−k Φ̇` and `−k Φ̈` at `v̇ = 0`), by Richardson
 /// extrapolation of central differences (D9–D10).
-fn constraint_rates(
+pub(super) fn constraint_rates(
     model: &Model,
     solver: &mut NewtonSolver,
     state: &State,
@@ -1576,10 +1609,40 @@ impl Stepper for Dynamics<'_> {
         run.a_before_coordinates
             .clone_from(&run.accepted.coordinate_pseudo_accelerations);
         model.update_internal(&mut run.state);
+        // latches reached lock: impact, then a restart (docs/theory.md §16)
+        let locks = match impact::lock_latches(
+            model,
+            self.solver,
+            &run.accepted,
+            &mut run.state,
+            info.increment,
+            self.settings.end_time,
+        )? {
+            Some(i) => {
+                run.lock_rank_analyses += 1;
+                run.redundant = run.redundant.max(i.redundant);
+                initial_accelerations(model, self.solver, run, self.settings.end_time).map_err(
+                    |failure| DynamicError::Initial {
+                        time: info.time,
+                        failure,
+                    },
+                )?;
+                run.last_step = None;
+                run.a_before.clear();
+                run.a_before_coordinates.clear();
+                run.balance.impact(i.locks[0].energy_lost, i.work);
+                i.locks
+            }
+            None => Vec::new(),
+        };
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual();
         run.energies = run.balance.record(model, &run.state, Some(residual));
         observer.increment(info, model, &run.state, residual)?;
+        for l in &locks {
+            observer.lock(l);
+        }
+        run.locks.extend(locks);
         Ok(())
     }
 }

@@ -40,7 +40,8 @@ pub struct Energies {
     /// Work done on the model by loads, drivers and prescribed motions
     /// since the start of the motion.
     pub external_work: f64,
-    /// Energy dissipated by dampers since the start of the motion.
+    /// Energy dissipated by dampers and impacts (latches locking) since the
+    /// start of the motion.
     pub dissipated: f64,
     /// `(T + V) − (T₀ + V₀) − W + D`.
     pub balance_error: f64,
@@ -148,6 +149,14 @@ impl EnergyBalance {
     /// A balance that starts at the first state it is given.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Adds an impact at the current instant (a latch locking,
+    /// docs/theory.md §16): the energy it dissipates, and the work its
+    /// impulses do through drivers and prescribed motions.
+    pub fn impact(&mut self, dissipated: f64, work: f64) {
+        self.dissipated += dissipated;
+        self.work += work;
     }
 
     /// Adds `state` (the next state of the motion) and returns its

@@ -18,6 +18,7 @@ pub mod constraints;
 pub mod control;
 pub mod dynamics;
 pub mod energy;
+pub mod impact;
 pub mod modal;
 pub mod newton;
 pub mod observers;
@@ -28,6 +29,7 @@ pub mod statics;
 pub use control::EventFunction;
 pub use dynamics::{DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
 pub use energy::{Energies, EnergyBalance};
+pub use impact::LockInfo;
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
 pub use settings::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
@@ -120,6 +122,10 @@ pub trait Observer {
     /// After the increment that landed on an event (reported to
     /// [`Observer::increment`] first).
     fn event(&mut self, _info: &EventInfo) {}
+
+    /// After the step on which a latch locked (reported to
+    /// [`Observer::increment`], with the post-impact state, first).
+    fn lock(&mut self, _info: &LockInfo) {}
 
     /// A remark worth showing the user (redundant constraints removed).
     fn note(&mut self, _text: &str) {}

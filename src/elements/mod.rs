@@ -285,6 +285,12 @@ pub trait Element: Send + Sync {
         true
     }
 
+    /// The element as a latch, for the analyses that lock latches
+    /// (docs/joints.md §6.2).
+    fn as_latch(&self) -> Option<&crate::joints::Latch> {
+        None
+    }
+
     /// New values of the internal variables after the state has converged
     /// (unwrapped joint angles, hysteresis); `internal` holds the old ones.
     fn update_internal(&self, _ctx: &EvalContext, _state: &State, _internal: &mut [f64]) {}

@@ -44,7 +44,7 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 20] = [
+pub const TOP_LEVEL_KEYS: [&str; 21] = [
     "title",
     "analysis",
     "nodes",
@@ -63,6 +63,7 @@ pub const TOP_LEVEL_KEYS: [&str; 20] = [
     "joint_springs",
     "hinge_laws",
     "drivers",
+    "latches",
     "initial_motion",
     "output",
 ];
@@ -127,6 +128,9 @@ pub struct ModelInput {
     /// Prescribed histories of joint coordinates or node components.
     #[serde(default)]
     pub drivers: Vec<DriverInput>,
+    /// Locks of joint coordinates at the end of their travel.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub latches: Vec<LatchInput>,
     /// Rigid motions of sets of nodes at the start (dynamic analyses).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial_motion: Vec<InitialMotionInput>,
@@ -337,6 +341,53 @@ pub struct DriverInput {
     /// takes over the coordinate where it is then. Default: always.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub active: Option<[f64; 2]>,
+}
+
+/// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
+/// when it reaches `value` moving in the direction of approach, and stays
+/// locked.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LatchInput {
+    /// Element id.
+    pub id: Id,
+    /// The joint.
+    pub joint: Id,
+    /// Which coordinate (`angle`, `slide`, `angle1`...), default the joint's
+    /// first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Locking value `c_L` (m, or rad unless `unit` says otherwise).
+    pub value: f64,
+    /// Unit of `value` for an angle coordinate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+    /// `increasing` or `decreasing`: how the coordinate reaches `value`
+    /// (default: away from the reference configuration, where it is 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub approach: Option<Approach>,
+    /// `rigid` (default): once locked, `c = c_L` is a constraint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode: Option<LatchMode>,
+}
+
+/// How a latch's coordinate reaches its locking value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Approach {
+    /// With the coordinate increasing.
+    Increasing,
+    /// With the coordinate decreasing.
+    Decreasing,
+}
+
+/// What a latch does once locked.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LatchMode {
+    /// `c − c_L = 0` is a constraint with a multiplier.
+    #[default]
+    Rigid,
 }
 
 /// The analyses of a model: one (`[analysis]`, the default static analysis

@@ -33,8 +33,8 @@ pub use build::{
 pub use builder::ModelBuilder;
 pub use handles::{
     BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
-    JointHandle, JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle,
-    SpringHandle,
+    JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
+    RigidBodyHandle, SpringHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.

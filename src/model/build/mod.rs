@@ -17,6 +17,7 @@ mod hinge_laws;
 mod initial;
 mod joint_springs;
 mod joints;
+mod latches;
 mod loads;
 mod masses;
 mod nodes;
@@ -272,6 +273,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.joint_springs.len(),
         input.hinge_laws.len(),
         input.drivers.len(),
+        input.latches.len(),
         generated,
     ]
     .into_iter()

@@ -43,15 +43,15 @@ mod structure;
 pub use loading::{
     Analysis, Component, CurveHandle, Dofs, Gravity, Load, LoadCurve, PrescribedMotion,
 };
-pub use mechanism::{Driver, HingeLaw, Joint, JointSpring};
+pub use mechanism::{Driver, HingeLaw, Joint, JointSpring, Latch};
 pub use structure::{Beam, BeamLine, Node, PointMass, RigidBody, Section, SectionHandle, Spring};
 
 pub use super::handles::{
     BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
-    JointHandle, JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle,
-    SpringHandle,
+    JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
+    RigidBodyHandle, SpringHandle,
 };
-pub use super::input::{AngleUnit, StartBranch, TapeSpringInput as TapeSpring};
+pub use super::input::{AngleUnit, Approach, StartBranch, TapeSpringInput as TapeSpring};
 pub use super::{Id, Model, ModelErrors};
 pub use crate::joints::{Coordinate, JointType};
 

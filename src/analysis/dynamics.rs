@@ -207,6 +207,9 @@ pub struct DynamicAnalysis {
     scheme: GeneralizedAlpha,
     solver: NewtonSolver,
     events: Vec<Box<dyn EventFunction>>,
+    /// The start state is a converged step of this analysis (a restart):
+    /// its velocities, accelerations and multipliers are kept.
+    continued: bool,
     run: Option<Run>,
 }
 
@@ -331,8 +334,20 @@ impl DynamicAnalysis {
             settings,
             solver,
             events: Vec::new(),
+            continued: false,
             run: None,
         }
+    }
+
+    /// Starts from a converged step of this analysis (a restart file's
+    /// state) rather than from rest or the end of another analysis: the
+    /// start keeps the state's velocities, accelerations,
+    /// pseudo-accelerations and multipliers instead of solving for
+    /// consistent ones (D9–D10), so that the steps repeat those of the
+    /// run that wrote the state. Work and dissipation count from there.
+    pub fn continued(mut self) -> Self {
+        self.continued = true;
+        self
     }
 
     /// Watches `event` during the analysis ([`super::control`]).
@@ -422,14 +437,20 @@ impl DynamicAnalysis {
             ));
         }
 
-        // initial velocities against the constraints, D10
-        if let Err(e) = check_velocities(model, &mut self.solver, &run.state, s.end_time) {
-            run.error = Some(e);
-            self.run = Some(run);
-            return Step::Stopped;
+        // initial velocities against the constraints, D10 (a continued
+        // run's were checked when it started)
+        if !self.continued {
+            if let Err(e) = check_velocities(model, &mut self.solver, &run.state, s.end_time) {
+                run.error = Some(e);
+                self.run = Some(run);
+                return Step::Stopped;
+            }
         }
 
-        // consistent initial accelerations and multipliers, D9
+        // consistent initial accelerations and multipliers, D9; a
+        // continued run keeps its own (the solve still gives the mass
+        // scales of D8)
+        let kept = self.continued.then(|| run.state.clone());
         match initial_accelerations(model, &mut self.solver, &mut run, s.end_time) {
             Ok(()) => {}
             Err(failure) => {
@@ -438,10 +459,20 @@ impl DynamicAnalysis {
                 return Step::Stopped;
             }
         }
+        if let Some(kept) = kept {
+            run.state = kept;
+            let (_, assembler, _) = self.solver.system();
+            let ctx = EvalContext {
+                dynamics: true,
+                ..model.context(t0, Need::RESIDUAL)
+            };
+            assembler.assemble(model, &ctx, &run.state);
+        }
         model.update_internal(&mut run.state);
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual().to_vec();
         run.energies = run.balance.record(model, &run.state, Some(&residual));
+        observer.energies(&run.energies);
         let info = IncrementInfo {
             increment: 0,
             time: t0,
@@ -1538,6 +1569,7 @@ impl Stepper for Dynamics<'_> {
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual();
         run.energies = run.balance.record(model, &run.state, Some(residual));
+        observer.energies(&run.energies);
         observer.increment(info, model, &run.state, residual)?;
         Ok(())
     }

@@ -114,6 +114,10 @@ pub trait Observer {
         Ok(())
     }
 
+    /// The energies of a dynamic analysis at its converged step, just
+    /// before that step is reported to [`Observer::increment`].
+    fn energies(&mut self, _energies: &energy::Energies) {}
+
     /// When an increment is cut back.
     fn cutback(&mut self, _info: &CutbackInfo) {}
 

@@ -172,6 +172,11 @@ pub struct Resume {
     pub analysis: usize,
     /// Its start state.
     pub state: State,
+    /// The state is a converged step inside that analysis (not the end of
+    /// the one before): a dynamic analysis continues with the state's
+    /// velocities and accelerations
+    /// ([`crate::analysis::DynamicAnalysis::continued`]).
+    pub continues: bool,
 }
 
 /// The fingerprint of a model input: the 64-bit FNV-1a hash of its JSON
@@ -374,6 +379,7 @@ impl Restart {
         Ok(Resume {
             analysis,
             state: self.state.clone(),
+            continues: analysis == self.analysis,
         })
     }
 }

@@ -432,9 +432,13 @@ fn run(
         return ExitCode::from(EXIT_INPUT);
     }
     // a restart: the analysis it continues and its start state
-    let (first, start, continues) = match restart.map(|r| resume(r, &input, &model, &plan)) {
-        None => (0, model.initial_state(), false),
-        Some(Ok(resume)) => (resume.analysis, resume.state, resume.continues),
+    let (first, start, continued) = match restart.map(|r| resume(r, &input, &model, &plan)) {
+        None => (0, model.initial_state(), None),
+        Some(Ok(resume)) => (
+            resume.analysis,
+            resume.state,
+            resume.continues.then_some(resume.energies),
+        ),
         Some(Err(e)) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
@@ -461,10 +465,9 @@ fn run(
             let analysis = DynamicAnalysis::new(model.clone(), d.clone());
             // a restart inside this analysis keeps its velocities and
             // accelerations
-            Some(Planned::Dynamic(Box::new(if k == 0 && continues {
-                analysis.continued()
-            } else {
-                analysis
+            Some(Planned::Dynamic(Box::new(match continued {
+                Some(energies) if k == 0 => analysis.continued(energies),
+                _ => analysis,
             })))
         } else {
             a.as_modal()

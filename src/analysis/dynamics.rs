@@ -210,6 +210,8 @@ pub struct DynamicAnalysis {
     /// The start state is a converged step of this analysis (a restart):
     /// its velocities, accelerations and multipliers are kept.
     continued: bool,
+    /// The energies of that step, if known: the balance goes on from them.
+    continued_energies: Option<Energies>,
     run: Option<Run>,
 }
 
@@ -335,6 +337,7 @@ impl DynamicAnalysis {
             solver,
             events: Vec::new(),
             continued: false,
+            continued_energies: None,
             run: None,
         }
     }
@@ -344,9 +347,12 @@ impl DynamicAnalysis {
     /// start keeps the state's velocities, accelerations,
     /// pseudo-accelerations and multipliers instead of solving for
     /// consistent ones (D9–D10), so that the steps repeat those of the
-    /// run that wrote the state. Work and dissipation count from there.
-    pub fn continued(mut self) -> Self {
+    /// run that wrote the state. The energy balance goes on from
+    /// `energies`, those of the state in that run, if given; otherwise
+    /// work and dissipation count from there.
+    pub fn continued(mut self, energies: Option<Energies>) -> Self {
         self.continued = true;
+        self.continued_energies = energies;
         self
     }
 
@@ -414,7 +420,10 @@ impl DynamicAnalysis {
             state,
             controller: None,
             work: Work::default(),
-            balance: EnergyBalance::new(),
+            balance: self
+                .continued_energies
+                .as_ref()
+                .map_or_else(EnergyBalance::new, EnergyBalance::continuing),
             energies: Energies::default(),
             mass_scale: [0.0; 2],
             redundant: 0,

@@ -19,7 +19,12 @@
 //! `state` is the whole [`State`] (positions, orientations, coordinates,
 //! multipliers, internal variables, velocities, accelerations and
 //! pseudo-accelerations), every number written to its last bit, so a
-//! continued run repeats the arithmetic of an uninterrupted one.
+//! continued run repeats the arithmetic of an uninterrupted one. A file
+//! written in a dynamic analysis also has `energies`, the energy balance at
+//! that step ([`crate::analysis::Energies`]), from which the balance of the
+//! continued run goes on; a dynamic analysis continued from a step inside
+//! it keeps the state's velocities and accelerations
+//! ([`crate::analysis::DynamicAnalysis::continued`]).
 //! `analysis` (from 1) is the analysis of the model's sequence that was
 //! running. A restart continues that analysis from `time` when `time` is
 //! before its `end_time`, else the next one, and runs the rest of the
@@ -38,7 +43,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::AnalysisSettings;
+use crate::analysis::{AnalysisSettings, Energies};
 use crate::model::input::ModelInput;
 use crate::model::Model;
 use crate::state::State;
@@ -66,6 +71,8 @@ pub struct Restart {
     pub analysis_type: String,
     /// The state.
     pub state: State,
+    /// The energy balance at the state, in a dynamic analysis.
+    pub energies: Option<Energies>,
 }
 
 /// The file as written.
@@ -80,6 +87,8 @@ struct RestartFile {
     analysis_type: String,
     time: f64,
     state: State,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    energies: Option<Energies>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -177,6 +186,9 @@ pub struct Resume {
     /// velocities and accelerations
     /// ([`crate::analysis::DynamicAnalysis::continued`]).
     pub continues: bool,
+    /// The energy balance at the state, if the restart is inside a
+    /// dynamic analysis.
+    pub energies: Option<Energies>,
 }
 
 /// The fingerprint of a model input: the 64-bit FNV-1a hash of its JSON
@@ -239,6 +251,7 @@ impl Restart {
             analysis_type: self.analysis_type.clone(),
             time: self.state.time,
             state: self.state.clone(),
+            energies: self.energies,
         };
         let err = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
         let text = serde_json::to_vec(&file).map_err(|e| err(e.into()))?;
@@ -291,6 +304,7 @@ impl Restart {
             analysis: file.analysis - 1,
             analysis_type: file.analysis_type,
             state: file.state,
+            energies: file.energies,
         })
     }
 
@@ -380,6 +394,7 @@ impl Restart {
             analysis,
             state: self.state.clone(),
             continues: analysis == self.analysis,
+            energies: self.energies.filter(|_| analysis == self.analysis),
         })
     }
 }
@@ -432,25 +447,34 @@ impl RestartWriter {
         self.dir.join(LAST)
     }
 
-    fn restart(&self, analysis: usize, analysis_type: &str, state: &State) -> Restart {
+    fn restart(
+        &self,
+        analysis: usize,
+        analysis_type: &str,
+        state: &State,
+        energies: Option<Energies>,
+    ) -> Restart {
         Restart {
             model_title: self.model_title.clone(),
             model_fingerprint: self.model_fingerprint.clone(),
             analysis,
             analysis_type: analysis_type.to_string(),
             state: state.clone(),
+            energies,
         }
     }
 
     /// After a converged step of analysis `analysis` (index in the model's
     /// sequence) at `state.time`: writes `restart-<t>.json` for the
     /// requested time `t` reached (to round-off), or passed, since the last
-    /// step.
+    /// step, with the energy balance there (`energies`, in a dynamic
+    /// analysis).
     pub fn increment(
         &mut self,
         analysis: usize,
         analysis_type: &str,
         state: &State,
+        energies: Option<Energies>,
     ) -> io::Result<()> {
         let mut due = None;
         while let Some(&t) = self.times.get(self.next) {
@@ -462,16 +486,23 @@ impl RestartWriter {
         }
         match due {
             Some(t) => self
-                .restart(analysis, analysis_type, state)
+                .restart(analysis, analysis_type, state, energies)
                 .write(&self.dir.join(format!("restart-{t}.json"))),
             None => Ok(()),
         }
     }
 
     /// At the end of the run: writes `restart.json` with `state`, the last
-    /// converged state of analysis `analysis`.
-    pub fn finish(&self, analysis: usize, analysis_type: &str, state: &State) -> io::Result<()> {
-        self.restart(analysis, analysis_type, state)
+    /// converged state of analysis `analysis` (with the energy balance
+    /// there, in a dynamic analysis).
+    pub fn finish(
+        &self,
+        analysis: usize,
+        analysis_type: &str,
+        state: &State,
+        energies: Option<Energies>,
+    ) -> io::Result<()> {
+        self.restart(analysis, analysis_type, state, energies)
             .write(&self.last_path())
     }
 }

@@ -374,6 +374,8 @@ pub struct Recorder {
     /// Largest absolute energy balance error and kinetic energy over the
     /// steps of the running dynamic analysis.
     energy_extremes: (f64, f64),
+    /// The energies of its last converged step.
+    energies: Option<Energies>,
 }
 
 /// The analysis being recorded.
@@ -483,6 +485,7 @@ impl Recorder {
     fn open_next(&mut self, from: f64) {
         self.open = true;
         self.energy_extremes = (0.0, 0.0);
+        self.energies = None;
         self.writer.set_dynamic(self.current.kind == "dynamic");
         self.line(&format!(
             "analysis {} of {}: {} from t = {} to t = {}",
@@ -533,6 +536,7 @@ impl Recorder {
             violations: Vec::new(),
             restart: None,
             energy_extremes: (0.0, 0.0),
+            energies: None,
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -709,7 +713,9 @@ impl Recorder {
         if let Some((restart, first)) = &self.restart {
             let _writing = self.stop.output();
             let index = first + self.current.index;
-            if let Err(e) = restart.finish(index, self.current.kind, state) {
+            // the energies of the dynamic analysis that ended at `state`
+            let energies = self.energies.filter(|e| e.time == state.time);
+            if let Err(e) = restart.finish(index, self.current.kind, state, energies) {
                 output_errors.push(e);
             }
         }
@@ -791,6 +797,7 @@ impl Observer for Recorder {
         let (error, kinetic) = &mut self.energy_extremes;
         *error = error.max(energies.balance_error.abs());
         *kinetic = kinetic.max(energies.kinetic);
+        self.energies = Some(*energies);
         self.writer.energies(energies);
     }
 
@@ -878,7 +885,12 @@ impl Observer for Recorder {
                 self.writer.increment(info, model, state, residual)?;
             }
             if let Some((restart, first)) = &mut self.restart {
-                restart.increment(*first + self.current.index, self.current.kind, state)?;
+                restart.increment(
+                    *first + self.current.index,
+                    self.current.kind,
+                    state,
+                    self.energies,
+                )?;
             }
         }
         self.log.flush()?;

@@ -437,7 +437,7 @@ fn run(
         Some(Ok(resume)) => (
             resume.analysis,
             resume.state,
-            resume.continues.then_some(resume.energies),
+            resume.continues.then_some(resume.motion),
         ),
         Some(Err(e)) => {
             eprintln!("error: {e}");
@@ -466,7 +466,7 @@ fn run(
             // a restart inside this analysis keeps its velocities and
             // accelerations
             Some(Planned::Dynamic(Box::new(match continued {
-                Some(energies) if k == 0 => analysis.continued(energies),
+                Some(motion) if k == 0 => analysis.continued(motion),
                 _ => analysis,
             })))
         } else {

@@ -200,6 +200,19 @@ pub struct DynamicOutcome {
 
 pub use super::statics::Step;
 
+/// What a motion's state alone does not hold and a dynamic analysis
+/// continued from one of its converged steps needs to go on as if never
+/// stopped ([`DynamicAnalysis::continued`]; kept in restart files).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Continuation {
+    /// The energy balance at the step: work, dissipation and `T₀ + V₀`
+    /// go on from it.
+    pub energies: Energies,
+    /// Size of the step that ended there: the predictor of the next step
+    /// scales `a − v̇` with the ratio of the sizes (D5).
+    pub last_step: Option<f64>,
+}
+
 /// An implicit dynamic analysis of a model (see the module documentation).
 pub struct DynamicAnalysis {
     model: Arc<Model>,
@@ -210,8 +223,8 @@ pub struct DynamicAnalysis {
     /// The start state is a converged step of this analysis (a restart):
     /// its velocities, accelerations and multipliers are kept.
     continued: bool,
-    /// The energies of that step, if known: the balance goes on from them.
-    continued_energies: Option<Energies>,
+    /// What the run that wrote it knew besides, if given.
+    continuation: Option<Continuation>,
     run: Option<Run>,
 }
 
@@ -337,7 +350,7 @@ impl DynamicAnalysis {
             solver,
             events: Vec::new(),
             continued: false,
-            continued_energies: None,
+            continuation: None,
             run: None,
         }
     }
@@ -347,12 +360,13 @@ impl DynamicAnalysis {
     /// start keeps the state's velocities, accelerations,
     /// pseudo-accelerations and multipliers instead of solving for
     /// consistent ones (D9–D10), so that the steps repeat those of the
-    /// run that wrote the state. The energy balance goes on from
-    /// `energies`, those of the state in that run, if given; otherwise
-    /// work and dissipation count from there.
-    pub fn continued(mut self, energies: Option<Energies>) -> Self {
+    /// run that wrote the state. With `from` (what that run knew at the
+    /// state) the energy balance goes on and the first step is predicted
+    /// as it was there; without, work and dissipation count from the
+    /// state.
+    pub fn continued(mut self, from: Option<Continuation>) -> Self {
         self.continued = true;
-        self.continued_energies = energies;
+        self.continuation = from;
         self
     }
 
@@ -414,16 +428,18 @@ impl DynamicAnalysis {
             dq_coordinates: vec![0.0; state.coordinates.len()],
             a_start: vec![[0.0; 6]; model.n_nodes()],
             a_start_coordinates: vec![0.0; state.coordinates.len()],
-            last_step: None,
+            last_step: self.continuation.and_then(|c| c.last_step),
             a_before: Vec::new(),
             a_before_coordinates: Vec::new(),
             state,
             controller: None,
             work: Work::default(),
             balance: self
-                .continued_energies
+                .continuation
                 .as_ref()
-                .map_or_else(EnergyBalance::new, EnergyBalance::continuing),
+                .map_or_else(EnergyBalance::new, |c| {
+                    EnergyBalance::continuing(&c.energies)
+                }),
             energies: Energies::default(),
             mass_scale: [0.0; 2],
             redundant: 0,

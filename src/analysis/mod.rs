@@ -26,7 +26,7 @@ pub mod settings;
 pub mod statics;
 
 pub use control::EventFunction;
-pub use dynamics::{DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
+pub use dynamics::{Continuation, DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
 pub use energy::{Energies, EnergyBalance};
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};

@@ -20,11 +20,11 @@
 //! multipliers, internal variables, velocities, accelerations and
 //! pseudo-accelerations), every number written to its last bit, so a
 //! continued run repeats the arithmetic of an uninterrupted one. A file
-//! written in a dynamic analysis also has `energies`, the energy balance at
-//! that step ([`crate::analysis::Energies`]), from which the balance of the
-//! continued run goes on; a dynamic analysis continued from a step inside
-//! it keeps the state's velocities and accelerations
-//! ([`crate::analysis::DynamicAnalysis::continued`]).
+//! written in a dynamic analysis also has `motion`
+//! ([`crate::analysis::Continuation`]: the energy balance at that step and
+//! the size of the step that ended there); a dynamic analysis continued
+//! from a step inside it keeps the state's velocities and accelerations
+//! and goes on with these ([`crate::analysis::DynamicAnalysis::continued`]).
 //! `analysis` (from 1) is the analysis of the model's sequence that was
 //! running. A restart continues that analysis from `time` when `time` is
 //! before its `end_time`, else the next one, and runs the rest of the
@@ -43,7 +43,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::{AnalysisSettings, Energies};
+use crate::analysis::{AnalysisSettings, Continuation};
 use crate::model::input::ModelInput;
 use crate::model::Model;
 use crate::state::State;
@@ -71,8 +71,8 @@ pub struct Restart {
     pub analysis_type: String,
     /// The state.
     pub state: State,
-    /// The energy balance at the state, in a dynamic analysis.
-    pub energies: Option<Energies>,
+    /// What a dynamic analysis needs besides the state to go on.
+    pub motion: Option<Continuation>,
 }
 
 /// The file as written.
@@ -88,7 +88,7 @@ struct RestartFile {
     time: f64,
     state: State,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    energies: Option<Energies>,
+    motion: Option<Continuation>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -186,9 +186,9 @@ pub struct Resume {
     /// velocities and accelerations
     /// ([`crate::analysis::DynamicAnalysis::continued`]).
     pub continues: bool,
-    /// The energy balance at the state, if the restart is inside a
-    /// dynamic analysis.
-    pub energies: Option<Energies>,
+    /// What a dynamic analysis needs besides the state to go on, if the
+    /// restart is inside one.
+    pub motion: Option<Continuation>,
 }
 
 /// The fingerprint of a model input: the 64-bit FNV-1a hash of its JSON
@@ -251,7 +251,7 @@ impl Restart {
             analysis_type: self.analysis_type.clone(),
             time: self.state.time,
             state: self.state.clone(),
-            energies: self.energies,
+            motion: self.motion,
         };
         let err = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
         let text = serde_json::to_vec(&file).map_err(|e| err(e.into()))?;
@@ -304,7 +304,7 @@ impl Restart {
             analysis: file.analysis - 1,
             analysis_type: file.analysis_type,
             state: file.state,
-            energies: file.energies,
+            motion: file.motion,
         })
     }
 
@@ -394,7 +394,7 @@ impl Restart {
             analysis,
             state: self.state.clone(),
             continues: analysis == self.analysis,
-            energies: self.energies.filter(|_| analysis == self.analysis),
+            motion: self.motion.filter(|_| analysis == self.analysis),
         })
     }
 }
@@ -452,7 +452,7 @@ impl RestartWriter {
         analysis: usize,
         analysis_type: &str,
         state: &State,
-        energies: Option<Energies>,
+        motion: Option<Continuation>,
     ) -> Restart {
         Restart {
             model_title: self.model_title.clone(),
@@ -460,21 +460,21 @@ impl RestartWriter {
             analysis,
             analysis_type: analysis_type.to_string(),
             state: state.clone(),
-            energies,
+            motion,
         }
     }
 
     /// After a converged step of analysis `analysis` (index in the model's
     /// sequence) at `state.time`: writes `restart-<t>.json` for the
     /// requested time `t` reached (to round-off), or passed, since the last
-    /// step, with the energy balance there (`energies`, in a dynamic
-    /// analysis).
+    /// step, with what a dynamic analysis needs besides to go on
+    /// (`motion`).
     pub fn increment(
         &mut self,
         analysis: usize,
         analysis_type: &str,
         state: &State,
-        energies: Option<Energies>,
+        motion: Option<Continuation>,
     ) -> io::Result<()> {
         let mut due = None;
         while let Some(&t) = self.times.get(self.next) {
@@ -486,23 +486,23 @@ impl RestartWriter {
         }
         match due {
             Some(t) => self
-                .restart(analysis, analysis_type, state, energies)
+                .restart(analysis, analysis_type, state, motion)
                 .write(&self.dir.join(format!("restart-{t}.json"))),
             None => Ok(()),
         }
     }
 
     /// At the end of the run: writes `restart.json` with `state`, the last
-    /// converged state of analysis `analysis` (with the energy balance
-    /// there, in a dynamic analysis).
+    /// converged state of analysis `analysis` (with `motion` in a dynamic
+    /// analysis).
     pub fn finish(
         &self,
         analysis: usize,
         analysis_type: &str,
         state: &State,
-        energies: Option<Energies>,
+        motion: Option<Continuation>,
     ) -> io::Result<()> {
-        self.restart(analysis, analysis_type, state, energies)
+        self.restart(analysis, analysis_type, state, motion)
             .write(&self.last_path())
     }
 }

@@ -1000,18 +1000,30 @@ impl ResultWriter {
                     model.node_ids[i], v[0], v[1], v[2], w.x, w.y, w.z, a[0], a[1], a[2], dw.x, dw.y, dw.z
                 );
             }
-            if let (true, Some(e)) = (self.moving, &self.energies) {
-                let _ = writeln!(
-                    m.energies.pending,
-                    "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e}",
-                    e.kinetic,
-                    e.strain,
-                    e.gravity,
-                    e.spring,
-                    e.external_work,
-                    e.dissipated,
-                    e.balance_error
-                );
+            match (self.moving, &self.energies) {
+                (true, Some(e)) => {
+                    let _ = writeln!(
+                        m.energies.pending,
+                        "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e}",
+                        e.kinetic,
+                        e.strain,
+                        e.gravity,
+                        e.spring,
+                        e.external_work,
+                        e.dissipated,
+                        e.balance_error
+                    );
+                }
+                _ => {
+                    // at rest (a static step): the stored energies; work,
+                    // dissipation and balance belong to motions
+                    let e = crate::analysis::energy::energies(model, state);
+                    let _ = writeln!(
+                        m.energies.pending,
+                        "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},,,",
+                        0.0, e.strain, e.gravity, e.spring
+                    );
+                }
             }
         }
         if let Some(file) = self.reactions.as_mut() {

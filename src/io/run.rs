@@ -52,8 +52,8 @@ use super::results::{file_error, AnalysisEnd, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
-    AnalysisSettings, CutbackInfo, DynamicAnalysis, DynamicError, Energies, EventInfo,
-    IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome, WarningInfo,
+    AnalysisSettings, Continuation, CutbackInfo, DynamicAnalysis, DynamicError, Energies,
+    EventInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
 use crate::model::Model;
@@ -376,6 +376,9 @@ pub struct Recorder {
     energy_extremes: (f64, f64),
     /// The energies of its last converged step.
     energies: Option<Energies>,
+    /// What it needs besides its last converged state to go on (for
+    /// restart files).
+    motion: Option<Continuation>,
 }
 
 /// The analysis being recorded.
@@ -486,6 +489,7 @@ impl Recorder {
         self.open = true;
         self.energy_extremes = (0.0, 0.0);
         self.energies = None;
+        self.motion = None;
         self.writer.set_dynamic(self.current.kind == "dynamic");
         self.line(&format!(
             "analysis {} of {}: {} from t = {} to t = {}",
@@ -537,6 +541,7 @@ impl Recorder {
             restart: None,
             energy_extremes: (0.0, 0.0),
             energies: None,
+            motion: None,
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -713,9 +718,9 @@ impl Recorder {
         if let Some((restart, first)) = &self.restart {
             let _writing = self.stop.output();
             let index = first + self.current.index;
-            // the energies of the dynamic analysis that ended at `state`
-            let energies = self.energies.filter(|e| e.time == state.time);
-            if let Err(e) = restart.finish(index, self.current.kind, state, energies) {
+            // the dynamic analysis that ended at `state`
+            let motion = self.motion.filter(|m| m.energies.time == state.time);
+            if let Err(e) = restart.finish(index, self.current.kind, state, motion) {
                 output_errors.push(e);
             }
         }
@@ -843,6 +848,14 @@ impl Observer for Recorder {
         // written already: its equilibrium there is logged, not written
         let restart =
             info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
+        if self.current.kind == "dynamic" {
+            // the step that ended here (none at the start: a restart there
+            // predicts its first step as the analysis's first)
+            self.motion = self.energies.map(|energies| Continuation {
+                energies,
+                last_step: (info.step > 0.0).then_some(info.step),
+            });
+        }
         let info = &self.renumbered(info);
         // a kinematic analysis has no loads: its residual is all constraint
         // violation, measured against the tolerance of each constraint
@@ -889,7 +902,7 @@ impl Observer for Recorder {
                     *first + self.current.index,
                     self.current.kind,
                     state,
-                    self.energies,
+                    self.motion,
                 )?;
             }
         }

@@ -452,7 +452,7 @@ fn a_restarted_dynamic_run_repeats_the_uninterrupted_one() {
 #[test]
 fn bad_dynamic_input_is_refused_with_exit_2() {
     let dir = scratch("bad");
-    let cases: [(&str, String, &[&str]); 5] = [
+    let cases: [(&str, String, &[&str]); 6] = [
         (
             "rho",
             pendulum(
@@ -487,6 +487,18 @@ fn bad_dynamic_input_is_refused_with_exit_2() {
                 "[[initial_motion]]\nnodes = [2, 99]\nangular_velocity = [0.0, 0.0, 1.0]\n",
             ),
             &["initial_motion[1]", "node 99 does not exist"],
+        ),
+        (
+            "support",
+            // the hinge node is clamped: it cannot turn with the body
+            pendulum(
+                FIXED,
+                "[[initial_motion]]\nnodes = [1, 2]\nangular_velocity = [0.0, 0.0, 1.0]\n",
+            ),
+            &[
+                "initial_motion[1]",
+                "node 1 is supported in rz but is given an angular velocity",
+            ],
         ),
         (
             "joint",

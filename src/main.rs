@@ -207,6 +207,11 @@ fn check(path: &Path) -> ExitCode {
             describe(&model),
             ModalAnalysis::new(model.clone(), ModalSettings::lowest(1)).n_equations()
         );
+        if analyses.iter().any(|a| a.as_dynamic().is_some()) {
+            for line in model.load_history() {
+                println!("load history: {line}");
+            }
+        }
         print_plan(&analyses);
         return ExitCode::SUCCESS;
     };
@@ -263,15 +268,15 @@ fn print_plan(plan: &[AnalysisSettings]) {
             println!(
                 "analysis {}: dynamic to t = {}: time step {} ({}), min_step {}, max_step {}, rho_infinity {}",
                 k + 1,
-                d.end_time,
-                d.time_step,
+                format_time(d.end_time),
+                format_time(d.time_step),
                 if d.adaptive {
                     format!("adaptive, error tolerance {}", d.error_tolerance)
                 } else {
                     "fixed".to_string()
                 },
-                d.min_step,
-                d.max_step,
+                format_time(d.min_step),
+                format_time(d.max_step),
                 d.rho_infinity
             );
         }

@@ -268,7 +268,7 @@ fn static_dynamic_modal_sequence_in_one_record() {
         .collect();
     assert_eq!(kinds, ["static", "dynamic", "modal"]);
     assert!(s["analyses"][0].get("dynamic").is_none());
-    assert_eq!(s["analyses"][1]["dynamic"]["steps"], 240);
+    assert_eq!(s["analyses"][1]["dynamic"]["steps"], 600);
     let steps = same_steps(&out);
     assert_eq!(steps, (0..steps.len()).collect::<Vec<_>>());
 
@@ -290,7 +290,7 @@ fn static_dynamic_modal_sequence_in_one_record() {
     let preload = num(&energies[first_dynamic - 1], "strain");
     assert!((preload - 0.9701).abs() < 0.01, "{preload}");
     // released: its energy swings between strain and kinetic; the release
-    // excites the higher bending modes, whose energy (a few 1e-3 of it)
+    // excites the higher bending modes, whose energy (3.3e-3 of it, measured)
     // the numerical dissipation of ρ∞ = 0.9 takes out in the first steps
     for r in &energies[first_dynamic..] {
         let total = num(r, "kinetic") + num(r, "strain");
@@ -298,26 +298,36 @@ fn static_dynamic_modal_sequence_in_one_record() {
         assert!(num(r, "balance_error").abs() < 5e-3 * preload);
     }
 
-    // the tip's free vibration: its period between upward zero crossings
-    // against 1/f₁ of the modal analysis about the final state; the
-    // residue of the higher modes shifts single crossings (measured
-    // 0.75 %), 1 % bounds it
+    // the tip's free vibration: its period, from the first to the last
+    // zero crossing upwards and downwards (five periods), against 1/f₁ of
+    // the modal analysis about the final state (measured 0.12 %); a single
+    // period is off by up to 0.9 %, its crossings shifted by the higher
+    // bending modes the release excites: over five, 0.5 % bounds it
     let tip: Vec<(f64, f64)> = table(&out.join("nodes.csv"))
         .iter()
         .filter(|r| r["node"] == "11" && num(r, "time") > 1.0)
         .map(|r| (num(r, "time"), num(r, "uz")))
         .collect();
-    let crossings: Vec<f64> = tip
-        .windows(2)
-        .filter(|w| w[0].1 < 0.0 && w[1].1 >= 0.0)
-        .map(|w| w[0].0 + (w[1].0 - w[0].0) * (-w[0].1) / (w[1].1 - w[0].1))
-        .collect();
-    assert!(crossings.len() >= 2, "{crossings:?}");
-    let period = crossings[1] - crossings[0];
+    let crossings = |up: bool| -> Vec<f64> {
+        tip.windows(2)
+            .filter(|w| {
+                if up {
+                    w[0].1 < 0.0 && w[1].1 >= 0.0
+                } else {
+                    w[0].1 > 0.0 && w[1].1 <= 0.0
+                }
+            })
+            .map(|w| w[0].0 + (w[1].0 - w[0].0) * (-w[0].1) / (w[1].1 - w[0].1))
+            .collect()
+    };
+    let mean_period = |c: Vec<f64>| (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64;
+    let (up, down) = (crossings(true), crossings(false));
+    assert!(up.len() >= 5 && down.len() >= 5, "{up:?} {down:?}");
+    let period = 0.5 * (mean_period(up) + mean_period(down));
     let modes = table(&out.join("modes.csv"));
     let f1: f64 = num(&modes[0], "frequency_hz");
     assert!(
-        (period * f1 - 1.0).abs() < 0.01,
+        (period * f1 - 1.0).abs() < 5e-3,
         "period {period} s, 1/f1 = {}",
         1.0 / f1
     );

@@ -11,7 +11,8 @@
 //! printed on stderr. A dynamic analysis (`type = "dynamic"`) integrates
 //! the motion from the state it is given (with the velocities it has) and
 //! adds velocities and energies to the results; its last line gives its
-//! steps and its energy balance error. Every run writes `restart.json` (the state at its
+//! steps and its energy balance error. A static analysis after a dynamic
+//! one seeks an equilibrium at rest: it starts with zero velocities. Every run writes `restart.json` (the state at its
 //! last converged step) into its output directory; `--restart FILE`
 //! continues a run from such a file (docs/results.md, "Restart files").
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
@@ -459,6 +460,10 @@ fn run(
             plan.len()
         )
     });
+    // whether a dynamic analysis comes before each analysis of the run
+    let after_motion: Vec<bool> = (first..plan.len())
+        .map(|k| plan[..k].iter().any(|a| a.as_dynamic().is_some()))
+        .collect();
     let plan = &plan[first..];
     let mut analyses = plan.iter().enumerate().filter_map(|(k, a)| {
         if let Some(s) = a.as_static() {
@@ -524,6 +529,11 @@ fn run(
             Planned::Static(mut analysis) => {
                 if k > 0 {
                     recorder.open_static(&analysis, state.time);
+                }
+                // an equilibrium after a motion is at rest: the velocities
+                // a later dynamic analysis starts with are zero
+                if after_motion[k] {
+                    bring_to_rest(&mut state);
                 }
                 let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
                 state = std::mem::take(&mut outcome.state);
@@ -642,6 +652,24 @@ fn run(
         return ExitCode::from(EXIT_FAILED);
     }
     ExitCode::SUCCESS
+}
+
+/// Sets the velocities and accelerations of `state` to zero.
+fn bring_to_rest(state: &mut unfold::state::State) {
+    for v in [
+        &mut state.velocity,
+        &mut state.acceleration,
+        &mut state.pseudo_acceleration,
+    ] {
+        v.fill([0.0; 6]);
+    }
+    for v in [
+        &mut state.coordinate_rates,
+        &mut state.coordinate_accelerations,
+        &mut state.coordinate_pseudo_accelerations,
+    ] {
+        v.fill(0.0);
+    }
 }
 
 /// Why the static or dynamic analysis of a run stopped early.

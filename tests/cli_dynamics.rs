@@ -336,6 +336,47 @@ fn static_dynamic_modal_sequence_in_one_record() {
     assert!((f1 / 3.5616 - 1.0).abs() < 3e-3, "{f1}");
 }
 
+/// Dynamic, static, dynamic: the equilibrium after the swing is at rest,
+/// and the motion after it starts from rest (the pendulum hangs still).
+#[test]
+fn an_equilibrium_after_a_motion_is_at_rest() {
+    let dir = scratch("rest");
+    let model = dir.join("rest.toml");
+    let analyses = "[[analysis]]
+type = \"dynamic\"
+end_time = 0.3
+time_step = 0.01
+adaptive = false
+
+[[analysis]]
+type = \"static\"
+end_time = 0.4
+
+[[analysis]]
+type = \"dynamic\"
+end_time = 0.6
+time_step = 0.01
+adaptive = false
+";
+    std::fs::write(&model, pendulum(analyses, "")).unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = summary(&out);
+    assert_eq!(s["analyses"][2]["dynamic"]["steps"], 20);
+    // hanging at rest in the last analysis: no kinetic energy beyond
+    // round-off (m g d = 9.81 J)
+    let energies = table(&out.join("energies.csv"));
+    let last: Vec<_> = energies
+        .iter()
+        .filter(|r| num(r, "time") > 0.4 + 1e-9)
+        .collect();
+    assert_eq!(last.len(), 20);
+    for r in last {
+        assert!(num(r, "kinetic") < 1e-12 * M * G * D, "{r:?}");
+    }
+}
+
 /// A moment of 1e5 N·m applied at once at t = 0.3 that Newton cannot
 /// follow in 4 iterations, with no smaller step allowed: the run stops at
 /// the last converged step, keeps every file with the same steps, says

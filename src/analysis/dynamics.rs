@@ -213,6 +213,19 @@ pub struct DynamicOutcome {
 
 pub use super::statics::Step;
 
+/// What a motion's state alone does not hold and a dynamic analysis
+/// continued from one of its converged steps needs to go on as if never
+/// stopped ([`DynamicAnalysis::continued`]; kept in restart files).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Continuation {
+    /// The energy balance at the step: work, dissipation and `T₀ + V₀`
+    /// go on from it.
+    pub energies: Energies,
+    /// Size of the step that ended there: the predictor of the next step
+    /// scales `a − v̇` with the ratio of the sizes (D5).
+    pub last_step: Option<f64>,
+}
+
 /// An implicit dynamic analysis of a model (see the module documentation).
 pub struct DynamicAnalysis {
     model: Arc<Model>,
@@ -220,6 +233,11 @@ pub struct DynamicAnalysis {
     scheme: GeneralizedAlpha,
     solver: NewtonSolver,
     events: Vec<Box<dyn EventFunction>>,
+    /// The start state is a converged step of this analysis (a restart):
+    /// its velocities, accelerations and multipliers are kept.
+    continued: bool,
+    /// What the run that wrote it knew besides, if given.
+    continuation: Option<Continuation>,
     run: Option<Run>,
 }
 
@@ -351,8 +369,25 @@ impl DynamicAnalysis {
             settings,
             solver,
             events: Vec::new(),
+            continued: false,
+            continuation: None,
             run: None,
         }
+    }
+
+    /// Starts from a converged step of this analysis (a restart file's
+    /// state) rather than from rest or the end of another analysis: the
+    /// start keeps the state's velocities, accelerations,
+    /// pseudo-accelerations and multipliers instead of solving for
+    /// consistent ones (D9–D10), so that the steps repeat those of the
+    /// run that wrote the state. With `from` (what that run knew at the
+    /// state) the energy balance goes on and the first step is predicted
+    /// as it was there; without, work and dissipation count from the
+    /// state.
+    pub fn continued(mut self, from: Option<Continuation>) -> Self {
+        self.continued = true;
+        self.continuation = from;
+        self
     }
 
     /// Watches `event` during the analysis ([`super::control`]).
@@ -413,13 +448,18 @@ impl DynamicAnalysis {
             dq_coordinates: vec![0.0; state.coordinates.len()],
             a_start: vec![[0.0; 6]; model.n_nodes()],
             a_start_coordinates: vec![0.0; state.coordinates.len()],
-            last_step: None,
+            last_step: self.continuation.and_then(|c| c.last_step),
             a_before: Vec::new(),
             a_before_coordinates: Vec::new(),
             state,
             controller: None,
             work: Work::default(),
-            balance: EnergyBalance::new(),
+            balance: self
+                .continuation
+                .as_ref()
+                .map_or_else(EnergyBalance::new, |c| {
+                    EnergyBalance::continuing(&c.energies)
+                }),
             energies: Energies::default(),
             mass_scale: [0.0; 2],
             redundant: 0,
@@ -447,14 +487,20 @@ impl DynamicAnalysis {
             ));
         }
 
-        // initial velocities against the constraints, D10
-        if let Err(e) = check_velocities(model, &mut self.solver, &run.state, s.end_time) {
-            run.error = Some(e);
-            self.run = Some(run);
-            return Step::Stopped;
+        // initial velocities against the constraints, D10 (a continued
+        // run's were checked when it started)
+        if !self.continued {
+            if let Err(e) = check_velocities(model, &mut self.solver, &run.state, s.end_time) {
+                run.error = Some(e);
+                self.run = Some(run);
+                return Step::Stopped;
+            }
         }
 
-        // consistent initial accelerations and multipliers, D9
+        // consistent initial accelerations and multipliers, D9; a
+        // continued run keeps its own (the solve still gives the mass
+        // scales of D8)
+        let kept = self.continued.then(|| run.state.clone());
         match initial_accelerations(model, &mut self.solver, &mut run, s.end_time) {
             Ok(()) => {}
             Err(failure) => {
@@ -463,10 +509,20 @@ impl DynamicAnalysis {
                 return Step::Stopped;
             }
         }
+        if let Some(kept) = kept {
+            run.state = kept;
+            let (_, assembler, _) = self.solver.system();
+            let ctx = EvalContext {
+                dynamics: true,
+                ..model.context(t0, Need::RESIDUAL)
+            };
+            assembler.assemble(model, &ctx, &run.state);
+        }
         model.update_internal(&mut run.state);
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual().to_vec();
         run.energies = run.balance.record(model, &run.state, Some(&residual));
+        observer.energies(&run.energies);
         let info = IncrementInfo {
             increment: 0,
             time: t0,
@@ -1638,6 +1694,7 @@ impl Stepper for Dynamics<'_> {
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual();
         run.energies = run.balance.record(model, &run.state, Some(residual));
+        observer.energies(&run.energies);
         observer.increment(info, model, &run.state, residual)?;
         for l in &locks {
             observer.lock(l);

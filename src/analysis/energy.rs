@@ -24,7 +24,7 @@ use crate::model::Model;
 use crate::state::State;
 
 /// Energies at one state of a motion.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Energies {
     /// Time.
     pub time: f64,
@@ -157,6 +157,18 @@ impl EnergyBalance {
     pub fn impact(&mut self, dissipated: f64, work: f64) {
         self.dissipated += dissipated;
         self.work += work;
+    }
+
+    /// A balance that goes on from a state of a motion whose energies were
+    /// `at` (the first state it is given): its work, dissipation and
+    /// `T₀ + V₀ = T + V − W + D − E` carry on.
+    pub fn continuing(at: &Energies) -> Self {
+        Self {
+            initial: Some(at.total() - at.external_work + at.dissipated - at.balance_error),
+            last: None,
+            work: at.external_work,
+            dissipated: at.dissipated,
+        }
     }
 
     /// Adds `state` (the next state of the motion) and returns its

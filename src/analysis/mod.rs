@@ -27,7 +27,7 @@ pub mod settings;
 pub mod statics;
 
 pub use control::EventFunction;
-pub use dynamics::{DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
+pub use dynamics::{Continuation, DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
 pub use energy::{Energies, EnergyBalance};
 pub use impact::LockInfo;
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
@@ -115,6 +115,10 @@ pub trait Observer {
     ) -> std::io::Result<()> {
         Ok(())
     }
+
+    /// The energies of a dynamic analysis at its converged step, just
+    /// before that step is reported to [`Observer::increment`].
+    fn energies(&mut self, _energies: &energy::Energies) {}
 
     /// When an increment is cut back.
     fn cutback(&mut self, _info: &CutbackInfo) {}

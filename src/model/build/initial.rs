@@ -72,6 +72,41 @@ impl Builder<'_> {
                 }
             }
         }
+        // a supported component does not move: its velocity must be zero
+        // (rotations are fixed about the node's material axes)
+        const AXES: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+        for (i, entity) in given.iter().enumerate() {
+            let (Some(entity), Some(fixed)) = (entity, self.fixed.get(i)) else {
+                continue;
+            };
+            let v = &out[i];
+            let w = Vec3::new(v[3], v[4], v[5]);
+            let w_material = self.nodes[i].q.inverse() * w;
+            let scale = w.norm();
+            for (c, &f) in fixed.iter().enumerate() {
+                let moving = if c < 3 {
+                    v[c] != 0.0
+                } else {
+                    w_material[c - 3].abs() > 1e-12 * scale
+                };
+                if f && moving {
+                    self.ck.push(
+                        ModelErrorKind::Invalid,
+                        entity,
+                        format!(
+                            "node {} is supported in {} but is given {} there; a supported component does not move",
+                            self.node_ids[i],
+                            AXES[c],
+                            if c < 3 {
+                                "a velocity"
+                            } else {
+                                "an angular velocity"
+                            }
+                        ),
+                    );
+                }
+            }
+        }
         out
     }
 }

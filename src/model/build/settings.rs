@@ -23,18 +23,16 @@ impl ModelInput {
             let mut start = 0.0;
             // (a modal analysis has no increments: it neither moves `t`
             // nor writes restart files)
-            for s in all.iter_mut().filter_map(|a| match a {
-                AnalysisSettings::Static(s) => Some(s),
+            for (end, times) in all.iter_mut().filter_map(|a| match a {
+                AnalysisSettings::Static(s) => Some((s.end_time, &mut s.output_times)),
+                AnalysisSettings::Dynamic(s) => Some((s.end_time, &mut s.output_times)),
                 _ => None,
             }) {
-                let within = o
-                    .restart_times
-                    .iter()
-                    .filter(|&&t| t > start && t <= s.end_time);
-                s.output_times.extend(within);
-                s.output_times.sort_by(f64::total_cmp);
-                s.output_times.dedup();
-                start = s.end_time;
+                let within = o.restart_times.iter().filter(|&&t| t > start && t <= end);
+                times.extend(within);
+                times.sort_by(f64::total_cmp);
+                times.dedup();
+                start = end;
             }
         }
         if ck.errors.is_empty() {

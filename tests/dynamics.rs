@@ -23,7 +23,10 @@ struct Trace {
 impl Observer for Trace {
     fn iteration(&mut self, info: &IterationInfo) {
         if std::env::var("TRACE2").is_ok() {
-            eprintln!("  it {} t {:.6} {:?}", info.iteration, info.time, info.norms);
+            eprintln!(
+                "  it {} t {:.6} {:?}",
+                info.iteration, info.time, info.norms
+            );
         }
         self.iterations.push(info.clone());
     }
@@ -35,7 +38,10 @@ impl Observer for Trace {
         _: &[f64],
     ) -> std::io::Result<()> {
         if std::env::var("TRACE").is_ok() {
-            eprintln!("step {} t {:.6} h {:.3e} it {} {:?}", info.increment, info.time, info.step, info.iterations, info.residuals);
+            eprintln!(
+                "step {} t {:.6} h {:.3e} it {} {:?}",
+                info.increment, info.time, info.step, info.iterations, info.residuals
+            );
         }
         self.steps.push((info.clone(), state.clone()));
         Ok(())

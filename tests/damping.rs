@@ -8,6 +8,7 @@ use std::sync::Arc;
 use unfold::analysis::{
     AnalysisSettings, DynamicAnalysis, Energies, ModalAnalysis, ModalSettings, Observer, Step,
 };
+use unfold::elements::beam::RayleighDamping;
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::state::State;
@@ -211,7 +212,7 @@ fn logarithmic_decrement_matches_the_modal_damping_ratio() {
             ((omega - omega_eb) / omega_eb).abs() < 1e-3,
             "{omega} {omega_eb}"
         );
-        let expected = a / (2.0 * omega) + 0.5 * b * omega;
+        let expected = RayleighDamping { alpha: a, beta: b }.damping_ratio(omega);
         let (zeta, n) = measured_ratio(&motion);
         let error = (zeta - expected).abs() / expected;
         let wh = omega * motion.times[1];

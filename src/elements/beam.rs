@@ -418,10 +418,10 @@ impl Beam {
     }
 
     /// The Rayleigh damping matrix `C_R = α M + β K_mat` (I10) in the node
-    /// variables, with `K_mat = L₀ Bᵀ C B` (B7) at the current state.
-    fn damping_matrix(&self, k: &Kinematics, ops: &Operators, q: &[Mat3; 2]) -> Mat12 {
+    /// variables, with `K_mat = L₀ Bᵀ C B` (B7) from the strain–displacement
+    /// matrix `b` of the current state.
+    fn damping_matrix(&self, b: &Mat6x12, q: &[Mat3; 2]) -> Mat12 {
         let RayleighDamping { alpha, beta } = self.section.damping;
-        let b = self.strain_matrix(k, ops);
         let k_mat = b.transpose() * (self.section.stiffness * b) * self.length;
         rayleigh_damping(
             alpha,
@@ -447,7 +447,8 @@ impl Beam {
         damping_weight: f64,
         out: &mut ElementOutput,
     ) {
-        let c_r = self.damping_matrix(k, ops, q);
+        let b = self.strain_matrix(k, ops);
+        let c_r = self.damping_matrix(&b, q);
         if let (true, Some(d)) = (damping_weight != 0.0, out.inertia.as_deref_mut()) {
             add_scaled(d, 12, 0, damping_weight, &c_r);
         }
@@ -473,7 +474,6 @@ impl Beam {
                 .copy_from(&(q[i].transpose() * w));
         }
         let c = &self.section.stiffness;
-        let b = self.strain_matrix(k, ops);
         let sigma_d = c * (b * vs) * beta;
         let mut kq = b.transpose()
             * (c * self.strain_rate_derivative(k, ops, &b, &vs))
@@ -661,7 +661,8 @@ impl Element for Beam {
         let ops = Operators::new(&k.phi);
         let q = self.offset_matrices();
         let v = self.velocities(state);
-        v.dot(&(self.damping_matrix(&k, &ops, &q) * v))
+        let b = self.strain_matrix(&k, &ops);
+        v.dot(&(self.damping_matrix(&b, &q) * v))
     }
 
     fn kinetic_energy(&self, state: &State) -> f64 {

@@ -291,6 +291,21 @@ impl BeamInertia {
         }
     }
 
+    /// The mass matrix `M` of I8, constant: `[Mᵢⱼ] I₃` on the
+    /// translations (global), `Jᵢ` on the rotations (material).
+    pub fn mass_matrix(&self) -> SMatrix<f64, 12, 12> {
+        let mut m = SMatrix::<f64, 12, 12>::zeros();
+        for i in 0..2 {
+            m.fixed_view_mut::<3, 3>(6 * i + 3, 6 * i + 3)
+                .copy_from(self.rotary[i].inertia_at_node());
+            for j in 0..2 {
+                m.fixed_view_mut::<3, 3>(6 * i, 6 * j)
+                    .copy_from(&(Mat3::identity() * self.translational(i, j)));
+            }
+        }
+        m
+    }
+
     /// Inertia residual, eq. I8: `r_xᵢ = Σⱼ Mᵢⱼ ẍⱼ`,
     /// `r_Θᵢ = Jᵢ Ω̇ᵢ + Ωᵢ × Jᵢ Ωᵢ`.
     pub fn residual(&self, n: &[NodeMotion; 2]) -> Vec12 {
@@ -472,6 +487,7 @@ mod tests {
             stiffness: SectionStiffness::identity(),
             mass_per_length: rho_a,
             inertia_per_length: Vec3::new(0.01, 0.01, 0.01) + i.abs() * 0.19,
+            damping: Default::default(),
         })
     }
 
@@ -830,6 +846,7 @@ mod tests {
             stiffness: SectionStiffness::identity(),
             mass_per_length: 3.0,
             inertia_per_length: Vec3::new(0.2, 0.1, 0.05),
+            damping: Default::default(),
         };
         let (l, w) = (2.0, 5.0);
         let beam = BeamInertia::new(l, &s, [Rotation::identity(); 2]);
@@ -905,6 +922,7 @@ mod tests {
             )),
             mass_per_length: 2.0,
             inertia_per_length: Vec3::new(0.02, 0.01, 0.01),
+            damping: Default::default(),
         };
         let ctx = EvalContext {
             time: 1.0,

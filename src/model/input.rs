@@ -695,6 +695,14 @@ pub struct SectionInput {
     /// (ρJ, ρI₂, ρI₃), default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inertia_per_length: Option<[f64; 3]>,
+    /// Rayleigh damping, mass-proportional coefficient `α` (1/s), default
+    /// 0 (docs/theory.md §11.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh_alpha: Option<f64>,
+    /// Rayleigh damping, stiffness-proportional coefficient `β` (s),
+    /// default 0 (docs/theory.md §11.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh_beta: Option<f64>,
 }
 
 impl SectionInput {

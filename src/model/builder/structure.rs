@@ -120,6 +120,14 @@ impl Section {
         self
     }
 
+    /// Its Rayleigh damping `C_R = α M + β K_mat` (docs/theory.md §11.5):
+    /// `alpha` in 1/s, `beta` in s.
+    pub fn rayleigh_damping(mut self, alpha: f64, beta: f64) -> Self {
+        self.input.rayleigh_alpha = Some(alpha);
+        self.input.rayleigh_beta = Some(beta);
+        self
+    }
+
     /// Its name in the model file (default `section_N`, N its position).
     pub fn named(mut self, name: impl Into<String>) -> Self {
         self.input.name = name.into();

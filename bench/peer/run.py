@@ -199,6 +199,7 @@ def equal_accuracy(label, run_at, reference, first_step, tolerance, halvings, re
                 "newton_iterations": run.newton_iterations,
                 "jacobians": run.jacobians,
                 "final": run.positions[-1].tolist(),
+                "energy_final": float(run.energy[-1]) if getattr(run, "energy", np.zeros(0)).size else None,
                 "tried": tried,
             }
     return {"ok": False, "tried": tried}
@@ -259,7 +260,7 @@ def main():
         except unfold_side.ModelError as e:
             raise SystemExit(f"error: {e}")
         if unfold_ok:
-            log(f"  unfold: {unfold_side.binary()} ({unfold_side.version()})")
+            log(f"  unfold: {unfold_side.describe()}")
         else:
             log("  unfold: dynamic analysis not available")
             log(f"    ({why})")
@@ -310,6 +311,13 @@ def main():
                 else:
                     case["references_differ"] = max_distance(uref.positions, exu_refs[n])
                     log(f"    references of the two codes differ by {case['references_differ']:.2e} m")
+                    case["unfold_reference_final"] = uref.positions[-1].tolist()
+                    if uref.energy.size:
+                        case["unfold_reference_energy"] = float(uref.energy[-1])
+                        log(
+                            f"    unfold reference at t = {P.end_time:g} s: tip {uref.positions[-1].tolist()}, "
+                            f"T + V = {uref.energy[-1]:.3e} J (0 at the start)"
+                        )
                     case["unfold"] = equal_accuracy(
                         "unfold",
                         lambda h, n=n: unfold_side.run_pendulum(n, h, threads=args.threads),
@@ -319,6 +327,12 @@ def main():
                         args.halvings,
                         args.repeat,
                     )
+            u = case["unfold"]
+            if u and u.get("ok") and u.get("energy_final") is not None and "unfold_reference_energy" in case:
+                log(
+                    f"    unfold at the equal-accuracy step: T + V = {u['energy_final']:.3e} J at t = {P.end_time:g} s "
+                    f"(reference {case['unfold_reference_energy']:.3e} J; m g L/2 = {P.rho_A * P.length * 9.81 / 2:.3f} J)"
+                )
             results["cases"].append(case)
             rows.append((f"pendulum {n}", case))
 
@@ -351,6 +365,12 @@ def main():
                 args.halvings,
                 args.repeat,
             )
+        for side in ("exudyn", "unfold"):
+            r = case[side]
+            if r and r["ok"]:
+                d = float(np.linalg.norm(np.array(r["final"]) - ref[-1]))
+                r["final_error"] = d
+                log(f"    {side}: centre of mass at t = {T.end_time:g} s {r['final']} ({d:.2e} m from the reference)")
         results["cases"].append(case)
         rows.append(("heavy top", case))
 

@@ -235,8 +235,15 @@ def main():
     ap.add_argument("--halvings", type=int, default=10, help="most halvings of the step")
     ap.add_argument("--recompute-references", action="store_true", help="ignore the cached references")
     ap.add_argument("--no-unfold", action="store_true", help="run Exudyn only")
+    ap.add_argument(
+        "--unfold-residual-tolerance",
+        type=float,
+        default=unfold_side.RESIDUAL_TOLERANCE,
+        help=f"unfold's Newton residual tolerance (default {unfold_side.RESIDUAL_TOLERANCE:g}, as Exudyn's; 0: unfold's own default)",
+    )
     args = ap.parse_args()
 
+    unfold_side.RESIDUAL_TOLERANCE = args.unfold_residual_tolerance or None
     problems = [p.strip() for p in args.problems.split(",") if p.strip()]
     sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
     for p in problems:
@@ -249,6 +256,11 @@ def main():
         f"exudyn {exudyn_side.version()}; {os.cpu_count()} cores; {args.threads} thread(s) per code"
     )
     log(f"  generalized-alpha, rho_inf = {RHO_INFINITY}; outputs every {OUTPUT_PERIOD} s")
+    rt = unfold_side.RESIDUAL_TOLERANCE
+    log(
+        f"  Newton relative tolerance: Exudyn {exudyn_side.NEWTON_RELATIVE_TOLERANCE:g}, "
+        f"unfold {rt:g}" + (" (residual relative to the force flux)" if rt else " (its default)")
+    )
 
     log(f"  load average at the start: {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
     if args.no_unfold:
@@ -272,6 +284,7 @@ def main():
         "exudyn": exudyn_side.version(),
         "threads": args.threads,
         "rho_infinity": RHO_INFINITY,
+        "unfold_residual_tolerance": unfold_side.RESIDUAL_TOLERANCE,
         "unfold_available": unfold_ok,
         "unfold_unavailable_because": why,
         "load_average_start": os.getloadavg(),
@@ -304,7 +317,9 @@ def main():
             )
             case["unfold"] = None
             if unfold_ok:
-                uref = unfold_side.run_pendulum(n, P.reference_step, threads=args.threads)
+                uref = unfold_side.run_pendulum(n, P.reference_step, threads=args.threads, reference=True)
+                if uref.ok and uref.cutbacks:
+                    log(f"    unfold: reference run (h = {P.reference_step:g} s): {uref.message}")
                 if not uref.ok:
                     log(f"    unfold: reference run (h = {P.reference_step:g} s) failed: {uref.message}")
                     case["unfold"] = {"ok": False, "tried": [], "message": uref.message}

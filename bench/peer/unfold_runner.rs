@@ -10,7 +10,7 @@
 //! node `NODE_ID` at every output step: position, total energy `T + V` and
 //! the energy balance error of the analysis) and `OUT_DIR/summary.json`
 //! (`wall_time_s` of the analysis alone, `increments`, `iterations`,
-//! `cutbacks`, `rejected_steps`, `error`). The exit code is 0 when the
+//! `cutbacks`, `rejected_steps`, `first_cutbacks`, `error`). The exit code is 0 when the
 //! analysis reaches its end time, 1 when it stops early, 2 for bad input.
 //!
 //! It stands in for `unfold run` until the command-line tool runs dynamic
@@ -23,15 +23,27 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 
-use unfold::analysis::{DynamicAnalysis, Observer, Step};
+use unfold::analysis::{CutbackInfo, DynamicAnalysis, Observer, Step};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 
-/// The analysis reports nothing on the way: the state is read between
-/// steps.
-struct Silent;
+/// The analysis's cut-backs (the state is read between steps): how many,
+/// and the first few with their reason.
+#[derive(Default)]
+struct Cutbacks {
+    first: Vec<String>,
+}
 
-impl Observer for Silent {}
+impl Observer for Cutbacks {
+    fn cutback(&mut self, info: &CutbackInfo) {
+        if self.first.len() < 5 {
+            self.first.push(format!(
+                "t = {:.6}, h = {:.3e}: {}",
+                info.time, info.failed_step, info.reason
+            ));
+        }
+    }
+}
 
 struct Args {
     model: PathBuf,
@@ -119,7 +131,7 @@ fn run(args: &Args) -> Result<bool, String> {
     let model = Arc::new(model);
 
     let mut analysis = DynamicAnalysis::new(model.clone(), settings);
-    let mut observer = Silent;
+    let mut observer = Cutbacks::default();
     // time, position, T + V, energy balance error at the output steps
     let mut rows: Vec<(f64, [f64; 3], f64, f64)> = Vec::new();
     let mut step = analysis.start(model.initial_state(), &mut observer);
@@ -150,6 +162,7 @@ fn run(args: &Args) -> Result<bool, String> {
         "iterations": outcome.iterations,
         "cutbacks": outcome.cutbacks,
         "rejected_steps": outcome.rejected_steps,
+        "first_cutbacks": observer.first,
         "time": outcome.time,
         "error": outcome.error.as_ref().map(|e| e.to_string()),
     });

@@ -4,7 +4,7 @@
 //! kernels of its Newton iterations against those of a static one.
 //!
 //! Run with `cargo bench --bench dynamics` (add `-- 1000 10000 100000` to
-//! choose sizes). The model: a 10 m steel-like beam (the section of
+//! choose sizes, `-- clamped` for a clamped end instead of the joint). The model: a 10 m steel-like beam (the section of
 //! benches/newton_iteration.rs, with mass), pinned at one end by a revolute
 //! joint to the ground, released from the horizontal under gravity, fixed
 //! steps of 1 ms. For each size it reports
@@ -87,9 +87,15 @@ const RESIDUAL_TOLERANCE: f64 = 1e-3;
 /// The beam pendulum of `n` elements: 10 m along x, section of
 /// benches/newton_iteration.rs (EA = 2.1e8 N, EI = 2.1e5 N·m²: a steel
 /// tube of A = 1e-3 m², I = 1e-6 m⁴) with ρA = 7.85 kg/m, ρI = 7.85e-3
-/// kg·m, ρJ = 2ρI; a revolute joint about y to the ground at x = 0;
-/// constant gravity −9.81 z.
-fn beam_pendulum(n: usize, steps: usize) -> (Model, DynamicSettings) {
+/// kg·m, ρJ = 2ρI; a revolute joint about y to the ground at x = 0
+/// (`clamped`: a clamped end instead, no constraint equation); constant
+/// gravity −9.81 z.
+fn beam_pendulum(n: usize, steps: usize, clamped: bool) -> (Model, DynamicSettings) {
+    let support = if clamped {
+        "[[supports]]\nnode = 1\nfixed = [\"all\"]\n"
+    } else {
+        "[[joints]]\nid = 1\ntype = \"revolute\"\nnodes = [1]\naxis = [0.0, 1.0, 0.0]\n"
+    };
     let text = format!(
         r#"
 title = "beam pendulum of {n} elements"
@@ -130,12 +136,7 @@ orientation = [0.0, 0.0, 1.0]
 first_node = 3
 first_element = 2
 
-[[joints]]
-id = 1
-type = "revolute"
-nodes = [1]
-axis = [0.0, 1.0, 0.0]
-
+{support}
 [[curves]]
 name = "constant"
 function = "linear"
@@ -229,13 +230,19 @@ struct Row {
 
 fn main() {
     let sizes = sizes(&[1_000, 10_000]);
+    let clamped = std::env::args().any(|a| a == "clamped");
     println!(
-        "threads: {}; step h = {H} s, ρ∞ = 0.9, fixed steps; times in ms",
-        rayon::current_num_threads()
+        "threads: {}; step h = {H} s, ρ∞ = 0.9, fixed steps; {}; times in ms",
+        rayon::current_num_threads(),
+        if clamped {
+            "clamped beam"
+        } else {
+            "beam pinned by a revolute joint"
+        }
     );
     let mut rows = Vec::new();
     for &n in &sizes {
-        rows.push(measure(n));
+        rows.push(measure(n, clamped));
     }
 
     println!();
@@ -307,9 +314,9 @@ fn main() {
     }
 }
 
-fn measure(n: usize) -> Row {
+fn measure(n: usize, clamped: bool) -> Row {
     let steps = if n >= 100_000 { 8 } else { 30 };
-    let (model, settings) = beam_pendulum(n, steps);
+    let (model, settings) = beam_pendulum(n, steps, clamped);
     let model = Arc::new(model);
 
     // the analysis, step by step

@@ -64,7 +64,11 @@ def _vec(v):
 RESIDUAL_TOLERANCE = 1.0e-6
 
 
-def _analysis(end_time, h, dynamic=True):
+def _analysis(end_time, h, dynamic=True, cutbacks=False):
+    """The [analysis] table: fixed steps h; with `cutbacks` False also
+    min_step = h, so that a step that fails stops the run, as Exudyn's
+    (otherwise unfold cuts the step back, down to 1e-6 h, and may take
+    minutes before it gives up)."""
     if not dynamic:  # the same model as a static analysis, to check the rest of it
         return f'[analysis]\ntype = "static"\nend_time = {end_time!r}\n'
     every = max(1, round(OUTPUT_PERIOD / h))
@@ -76,6 +80,7 @@ def _analysis(end_time, h, dynamic=True):
         f"rho_infinity = {RHO_INFINITY!r}\n"
         + (f"residual_tolerance = {RESIDUAL_TOLERANCE!r}\n" if RESIDUAL_TOLERANCE else "")
         + "adaptive = false        # fixed steps, as Exudyn's (its step reduction is off)\n"
+        + ("" if cutbacks else f"min_step = {h!r}        # no cut-back: a failed step stops the run\n")
         + f"output_every = {every}   # results every {OUTPUT_PERIOD} s\n"
     )
 
@@ -93,13 +98,14 @@ def _node(nid, x, velocity=None, angular_velocity=None, dynamic=True):
 _CONSTANT_CURVE = '[[curves]]\nname = "constant"\nfunction = "linear"\noffset = 1.0\nslope = 0.0\n'
 
 
-def pendulum_toml(n, h, p=Pendulum, dynamic=True):
+def pendulum_toml(n, h, p=Pendulum, dynamic=True, cutbacks=False):
     """Model file of the flexible pendulum with n elements and step h
-    (dynamic=False: the same model as a static analysis)."""
+    (dynamic=False: the same model as a static analysis; cutbacks: steps may
+    be cut back)."""
     return "\n".join(
         [
             f'title = "Flexible beam pendulum falling from the horizontal, {n} elements"\n',
-            _analysis(p.end_time, h, dynamic),
+            _analysis(p.end_time, h, dynamic, cutbacks),
             "[[sections]]\n"
             'name = "beam"\n'
             f"EA = {p.EA!r}\nGA2 = {p.GA!r}\nGA3 = {p.GA!r}\nGJ = {p.GJ!r}\n"
@@ -296,7 +302,7 @@ def _run(text, node, end_time, h, threads, allow_cutbacks=False):
 def run_pendulum(n, h, threads=1, reference=False):
     """reference=True: the fine-step reference, whose steps may be cut back
     (it lands on the output times all the same)."""
-    return _run(pendulum_toml(n, h), TIP_NODE, Pendulum.end_time, h, threads, allow_cutbacks=reference)
+    return _run(pendulum_toml(n, h, cutbacks=reference), TIP_NODE, Pendulum.end_time, h, threads, allow_cutbacks=reference)
 
 
 def run_top(h, threads=1):

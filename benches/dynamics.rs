@@ -18,6 +18,10 @@
 //!   numeric LU factorisation, the triangular solves, and the static Newton
 //!   iteration as benches/newton_iteration.rs times it
 //!   (`NewtonSolver::assemble` + `solve_linear_system`);
+//! - from the times of the iteration reports: the time of a step up to its
+//!   first residual (predictor, first assembly), per correction (solve,
+//!   update, assembly, convergence measures) and after its last residual
+//!   (convergence test, acceptance);
 //! - the split of a step: `(k + 1)` dynamic assemblies and `k`
 //!   factorisations and solves for `k` corrections, the energy balance of
 //!   the accepted step, and the rest (norms, predictor, updates, step
@@ -162,8 +166,8 @@ curve = "constant"
 /// accepted step.
 #[derive(Default)]
 struct Probe {
-    /// (step, iteration, allocations so far)
-    reports: Vec<(usize, usize, usize)>,
+    /// (step, iteration, allocations so far, time)
+    reports: Vec<(usize, usize, usize, Instant)>,
     iterations: Vec<usize>,
     /// The first cut-back: the benchmark motion must run at its step.
     cutback: Option<String>,
@@ -178,8 +182,12 @@ impl Observer for Probe {
     fn iteration(&mut self, info: &IterationInfo) {
         // reserved beforehand: recording does not allocate
         if self.reports.len() < self.reports.capacity() {
-            self.reports
-                .push((info.increment, info.iteration, allocations()));
+            self.reports.push((
+                info.increment,
+                info.iteration,
+                allocations(),
+                Instant::now(),
+            ));
         }
     }
     fn increment(
@@ -332,11 +340,17 @@ fn measure(n: usize, clamped: bool) -> Row {
     let t2 = Instant::now();
     let mut times = Vec::with_capacity(steps);
     let mut step_allocations = Vec::with_capacity(steps);
+    // (increment, start, end) of every accepted step
+    let mut spans = Vec::with_capacity(steps);
     while let Step::Increment(_) = step {
         let a0 = allocations();
         let ts = Instant::now();
         step = analysis.advance(&mut probe);
-        let dt = ts.elapsed().as_secs_f64();
+        let te = Instant::now();
+        let dt = (te - ts).as_secs_f64();
+        if let Step::Increment(info) = &step {
+            spans.push((info.increment, ts, te));
+        }
         if let Some(why) = &probe.cutback {
             panic!("{n} elements: {why}");
         }
@@ -346,6 +360,22 @@ fn measure(n: usize, clamped: bool) -> Row {
         }
     }
     let state = analysis.state().expect("started").clone();
+    // the iteration matrix of the analysis itself, with and without the
+    // scaling of its constraint rows and multiplier columns (D8)
+    let factor_time = |a: &unfold::linalg::SparseMatrix| {
+        let mut lu = SparseLu::analyze(a).expect("symbolic analysis");
+        let mut t = vec![];
+        for _ in 0..5 {
+            let ts = Instant::now();
+            lu.factor(a).expect("factorisation");
+            t.push(ts.elapsed().as_secs_f64());
+        }
+        median(t)
+    };
+    let scaled = analysis.iteration_matrix(H, true).expect("started");
+    let unscaled = analysis.iteration_matrix(H, false).expect("started");
+    let (f_scaled, f_unscaled) = (factor_time(&scaled), factor_time(&unscaled));
+    drop((scaled, unscaled));
     let outcome = analysis.finish();
     assert!(
         outcome.error.is_none() && outcome.cutbacks == 0,
@@ -359,6 +389,26 @@ fn measure(n: usize, clamped: bool) -> Row {
         .filter(|w| w[0].0 == w[1].0 && w[0].0 > 0)
         .map(|w| w[1].2 - w[0].2)
         .collect();
+    // where a step's time goes, from the iteration reports: up to the
+    // first residual (predictor, first assembly), per correction (solve,
+    // update, assembly, convergence measures), after the last residual
+    // (convergence test, acceptance: state copies, energy balance, output)
+    let (mut lead, mut per_correction, mut tail) = (vec![], vec![], vec![]);
+    for &(i, ts, te) in &spans {
+        let mine: Vec<Instant> = probe
+            .reports
+            .iter()
+            .filter(|r| r.0 == i)
+            .map(|r| r.3)
+            .collect();
+        if let (Some(&first), Some(&last)) = (mine.first(), mine.last()) {
+            lead.push((first - ts).as_secs_f64());
+            tail.push((te - last).as_secs_f64());
+            if mine.len() > 1 {
+                per_correction.push((last - first).as_secs_f64() / (mine.len() - 1) as f64);
+            }
+        }
+    }
     let iterations = probe.iterations.iter().sum::<usize>() as f64 / probe.iterations.len() as f64;
     let step_time = median(times);
     let unknowns = analysis.n_equations();
@@ -379,6 +429,17 @@ fn measure(n: usize, clamped: bool) -> Row {
         step_allocations.iter().max().unwrap_or(&0),
         within.iter().min().unwrap_or(&0),
         within.iter().max().unwrap_or(&0),
+    );
+    println!(
+        "  LU factorisation of the analysis's iteration matrix: {:.2} ms scaled (as solved), {:.2} ms unscaled",
+        1e3 * f_scaled,
+        1e3 * f_unscaled
+    );
+    println!(
+        "  in a step (medians): up to the first residual {:.2} ms, per correction {:.2} ms, after the last residual {:.2} ms",
+        1e3 * median(lead),
+        1e3 * median(per_correction),
+        1e3 * median(tail)
     );
 
     // kernels on the state reached

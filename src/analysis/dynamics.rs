@@ -287,8 +287,9 @@ struct Work {
     /// Matrix entries in a constraint row or multiplier column, with the
     /// kinds of their row and column (0 none, 1 distance, 2 angle).
     scaled: Vec<(usize, u8, u8)>,
-    /// Equations numbered when `scaled` was built.
-    n_equations: usize,
+    /// Equations numbered when `scaled` was built (`None` before; a model
+    /// without constraints leaves `scaled` empty once built).
+    n_equations: Option<usize>,
 }
 
 impl Work {
@@ -297,7 +298,7 @@ impl Work {
     fn prepare(&mut self, dofs: &DofMap, matrix: &SparseMatrix, n_nodes: usize) {
         self.factors.resize(n_nodes, Mat3::identity());
         self.flux.resize(6 * n_nodes, 0.0);
-        if self.n_equations == dofs.n_equations() && !self.scaled.is_empty() {
+        if self.n_equations == Some(dofs.n_equations()) {
             return;
         }
         let code = |eq: usize| match dofs.equation_kind(eq) {
@@ -312,7 +313,7 @@ impl Work {
                 self.scaled.push((k, a, b));
             }
         }
-        self.n_equations = dofs.n_equations();
+        self.n_equations = Some(dofs.n_equations());
         self.rhs.clear();
         self.rhs.resize(dofs.n_equations(), 0.0);
     }

@@ -8,7 +8,11 @@
 //! order, each from the final state of the one before, into one set of
 //! result files. A modal analysis (`type = "modal"`) linearises about the
 //! state it is given and leaves it unchanged; its first frequencies are
-//! printed on stderr. Every run writes `restart.json` (the state at its
+//! printed on stderr. A dynamic analysis (`type = "dynamic"`) integrates
+//! the motion from the state it is given (with the velocities it has) and
+//! adds velocities and energies to the results; its last line gives its
+//! steps and its energy balance error. A static analysis after a dynamic
+//! one seeks an equilibrium at rest: it starts with zero velocities. Every run writes `restart.json` (the state at its
 //! last converged step) into its output directory; `--restart FILE`
 //! continues a run from such a file (docs/results.md, "Restart files").
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
@@ -16,7 +20,8 @@
 //! names its file; the output directory in use by another run); 2 the
 //! command line or the model file is invalid, including a model whose
 //! tangent is singular from the start (a mechanism or an unrestrained
-//! structure) and a modal analysis of a model without mass; 128 + the signal number (130 SIGINT, 143 SIGTERM, 129
+//! structure), a modal analysis of a model without mass and initial
+//! velocities that the joints do not allow; 128 + the signal number (130 SIGINT, 143 SIGTERM, 129
 //! SIGHUP) the run was interrupted, with consistent results up to the last
 //! converged increment and `summary.json` saying `interrupted`.
 
@@ -30,11 +35,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use unfold::analysis::preflight;
 use unfold::analysis::statics::StaticError;
 use unfold::analysis::{
-    AnalysisSettings, IncrementInfo, ModalAnalysis, ModalError, ModalOutcome, ModalSettings,
-    NewtonFailure, StaticAnalysis, StaticOutcome,
+    AnalysisSettings, DynamicAnalysis, DynamicError, IncrementInfo, ModalAnalysis, ModalError,
+    ModalOutcome, ModalSettings, NewtonFailure, StaticAnalysis,
 };
 use unfold::io::model_file::read_model;
 use unfold::io::restart::{fingerprint, Restart, RestartError, RestartWriter, Resume};
+use unfold::io::results::AnalysisEnd;
 use unfold::io::run::{
     format_time, signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest,
 };
@@ -202,7 +208,12 @@ fn check(path: &Path) -> ExitCode {
             describe(&model),
             ModalAnalysis::new(model.clone(), ModalSettings::lowest(1)).n_equations()
         );
-        print_modal_plan(&analyses);
+        if analyses.iter().any(|a| a.as_dynamic().is_some()) {
+            for line in model.load_history() {
+                println!("load history: {line}");
+            }
+        }
+        print_plan(&analyses);
         return ExitCode::SUCCESS;
     };
     match preflight::check(&model, first_static) {
@@ -225,7 +236,7 @@ fn check(path: &Path) -> ExitCode {
                     report.redundant_constraints
                 );
             }
-            print_modal_plan(&analyses);
+            print_plan(&analyses);
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -236,12 +247,12 @@ fn check(path: &Path) -> ExitCode {
 }
 
 /// Whether every analysis of `plan` is one this tool runs (static,
-/// kinematic, modal); if not, after an error message.
+/// kinematic, dynamic, modal); if not, after an error message.
 fn supported(path: &Path, plan: &[AnalysisSettings]) -> bool {
     let all = !plan.is_empty()
         && plan
             .iter()
-            .all(|a| a.as_static().is_some() || a.as_modal().is_some());
+            .all(|a| a.as_static().is_some() || a.as_modal().is_some() || a.as_dynamic().is_some());
     if !all {
         eprintln!(
             "error: {}: an analysis of this model is not one this version runs",
@@ -251,9 +262,25 @@ fn supported(path: &Path, plan: &[AnalysisSettings]) -> bool {
     all
 }
 
-/// One line per modal analysis of `plan`, for `unfold check`.
-fn print_modal_plan(plan: &[AnalysisSettings]) {
+/// One line per modal and dynamic analysis of `plan`, for `unfold check`.
+fn print_plan(plan: &[AnalysisSettings]) {
     for (k, a) in plan.iter().enumerate() {
+        if let Some(d) = a.as_dynamic() {
+            println!(
+                "analysis {}: dynamic to t = {}: time step {} ({}), min_step {}, max_step {}, rho_infinity {}",
+                k + 1,
+                format_time(d.end_time),
+                format_time(d.time_step),
+                if d.adaptive {
+                    format!("adaptive, error tolerance {}", d.error_tolerance)
+                } else {
+                    "fixed".to_string()
+                },
+                format_time(d.min_step),
+                format_time(d.max_step),
+                d.rho_infinity
+            );
+        }
         if let Some(m) = a.as_modal() {
             let mut what = format!("{} modes", m.modes);
             if let Some(f) = m.shift {
@@ -300,6 +327,7 @@ fn print_modes(outcome: &ModalOutcome) {
 /// An analysis of the plan, ready to run.
 enum Planned {
     Static(Box<StaticAnalysis>),
+    Dynamic(Box<DynamicAnalysis>),
     Modal(Box<ModalAnalysis>),
 }
 
@@ -327,7 +355,11 @@ impl Console for Terminal {
     fn progress(&mut self, info: &IncrementInfo) {
         self.bar
             .set_position((1000.0 * info.time / self.end_time).round() as u64);
-        self.bar.set_message(format!("t = {:.4}", info.time));
+        self.bar.set_message(format!(
+            "t = {:.4} / {}",
+            info.time,
+            format_time(self.end_time)
+        ));
     }
 
     fn finish(&mut self, text: &str) {
@@ -406,9 +438,13 @@ fn run(
         return ExitCode::from(EXIT_INPUT);
     }
     // a restart: the analysis it continues and its start state
-    let (first, start) = match restart.map(|r| resume(r, &input, &model, &plan)) {
-        None => (0, model.initial_state()),
-        Some(Ok(resume)) => (resume.analysis, resume.state),
+    let (first, start, continued) = match restart.map(|r| resume(r, &input, &model, &plan)) {
+        None => (0, model.initial_state(), None),
+        Some(Ok(resume)) => (
+            resume.analysis,
+            resume.state,
+            resume.continues.then_some(resume.motion),
+        ),
         Some(Err(e)) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
@@ -424,20 +460,30 @@ fn run(
             plan.len()
         )
     });
+    // whether a dynamic analysis comes before each analysis of the run
+    let after_motion: Vec<bool> = (first..plan.len())
+        .map(|k| plan[..k].iter().any(|a| a.as_dynamic().is_some()))
+        .collect();
     let plan = &plan[first..];
-    let mut analyses = plan
-        .iter()
-        .filter_map(|a| match (a.as_static(), a.as_modal()) {
-            (Some(s), _) => Some(Planned::Static(Box::new(StaticAnalysis::new(
+    let mut analyses = plan.iter().enumerate().filter_map(|(k, a)| {
+        if let Some(s) = a.as_static() {
+            Some(Planned::Static(Box::new(StaticAnalysis::new(
                 model.clone(),
                 s.clone(),
-            )))),
-            (_, Some(m)) => Some(Planned::Modal(Box::new(ModalAnalysis::new(
-                model.clone(),
-                m.clone(),
-            )))),
-            _ => None,
-        });
+            ))))
+        } else if let Some(d) = a.as_dynamic() {
+            let analysis = DynamicAnalysis::new(model.clone(), d.clone());
+            // a restart inside this analysis keeps its velocities and
+            // accelerations
+            Some(Planned::Dynamic(Box::new(match continued {
+                Some(motion) if k == 0 => analysis.continued(motion),
+                _ => analysis,
+            })))
+        } else {
+            a.as_modal()
+                .map(|m| Planned::Modal(Box::new(ModalAnalysis::new(model.clone(), m.clone()))))
+        }
+    });
     let Some(first_planned) = analyses.next() else {
         return ExitCode::SUCCESS;
     };
@@ -454,6 +500,7 @@ fn run(
     };
     let recorder = match &first_planned {
         Planned::Static(a) => Recorder::create_sequence(out, &label, a, plan, terminal),
+        Planned::Dynamic(a) => Recorder::create_dynamic_first(out, &label, a, plan, terminal),
         Planned::Modal(a) => Recorder::create_modal_first(out, &label, a, plan, terminal),
     };
     let mut recorder = match recorder {
@@ -472,35 +519,53 @@ fn run(
     // the analyses in order, each from the final state of the one before;
     // none after one that failed
     let mut state = start;
-    let mut last_static: Option<StaticOutcome> = None;
-    let mut after_modal = false;
+    // the last static or dynamic analysis: how it ended, and its error
+    let mut last: Option<AnalysisEnd> = None;
+    let mut failure: Option<Failure> = None;
     let mut modal_error: Option<ModalError> = None;
     let mut modal_output_error = false;
     for (k, planned) in std::iter::once(first_planned).chain(analyses).enumerate() {
         match planned {
             Planned::Static(mut analysis) => {
-                match (&last_static, after_modal) {
-                    (Some(previous), false) => recorder.next_analysis(previous, &analysis),
-                    _ if k > 0 => recorder.open_static(&analysis, state.time),
-                    _ => {}
+                if k > 0 {
+                    recorder.open_static(&analysis, state.time);
+                }
+                // an equilibrium after a motion is at rest: the velocities
+                // a later dynamic analysis starts with are zero
+                if after_motion[k] {
+                    bring_to_rest(&mut state);
                 }
                 let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
                 state = std::mem::take(&mut outcome.state);
-                let failed = outcome.error.is_some();
-                last_static = Some(outcome);
-                after_modal = false;
-                if failed {
+                let end = AnalysisEnd::from(&outcome);
+                recorder.end_analysis(&end);
+                last = Some(end);
+                if let Some(e) = outcome.error.take() {
+                    failure = Some(Failure::Static(e));
+                    break;
+                }
+            }
+            Planned::Dynamic(mut analysis) => {
+                if k > 0 {
+                    recorder.open_dynamic(&analysis, state.time);
+                }
+                let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
+                state = std::mem::take(&mut outcome.state);
+                let end = AnalysisEnd::from(&outcome);
+                recorder.end_analysis(&end);
+                last = Some(end);
+                if let Some(e) = outcome.error.take() {
+                    failure = Some(Failure::Dynamic(e));
                     break;
                 }
             }
             Planned::Modal(mut analysis) => {
                 let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
-                if let Err(e) = recorder.record_modal(last_static.as_ref(), &analysis, &outcome) {
+                if let Err(e) = recorder.record_modal(None, &analysis, &outcome) {
                     eprintln!("error: cannot write results: {e}");
                     modal_output_error = true;
                 }
                 state = std::mem::take(&mut outcome.state);
-                after_modal = true;
                 if let Some(e) = outcome.error.take() {
                     eprintln!(
                         "error: {}: modal analysis at t = {}: {e}",
@@ -517,7 +582,7 @@ fn run(
             }
         }
     }
-    let report = recorder.finish_with(last_static.as_ref(), &state);
+    let report = recorder.finish_after(last.as_ref(), &state);
 
     for e in &report.output_errors {
         eprintln!("error: cannot write results: {e}");
@@ -547,31 +612,70 @@ fn run(
     if modal_output_error {
         return ExitCode::from(EXIT_FAILED);
     }
-    let Some(outcome) = &last_static else {
-        return if report.output_errors.is_empty() {
-            ExitCode::SUCCESS
-        } else {
-            ExitCode::from(EXIT_FAILED)
-        };
-    };
-    if let Some(e) = &outcome.error {
-        eprintln!("error: {}: {e}", path.display());
-        // a model that is singular from the start is invalid input
-        if let StaticError::Initial {
-            failure: NewtonFailure::Singular { .. },
-            ..
+    match &failure {
+        Some(Failure::Static(e)) => {
+            eprintln!("error: {}: {e}", path.display());
+            // a model that is singular from the start is invalid input
+            if let StaticError::Initial {
+                failure: NewtonFailure::Singular { .. },
+                ..
+            }
+            | StaticError::Indeterminate { .. } = e
+            {
+                return ExitCode::from(EXIT_INPUT);
+            }
+            eprintln!("note: {kept}");
+            return ExitCode::from(EXIT_FAILED);
         }
-        | StaticError::Indeterminate { .. } = e
-        {
-            return ExitCode::from(EXIT_INPUT);
+        Some(Failure::Dynamic(e)) => {
+            eprintln!(
+                "error: {}: dynamic analysis at t = {}: {e}",
+                path.display(),
+                format_time(state.time)
+            );
+            // initial velocities the joints forbid, or a model without
+            // mass or stiffness somewhere, are invalid input
+            if let DynamicError::InconsistentVelocity { .. }
+            | DynamicError::Initial {
+                failure: NewtonFailure::Singular { .. },
+                ..
+            } = e
+            {
+                return ExitCode::from(EXIT_INPUT);
+            }
+            eprintln!("note: {kept}");
+            return ExitCode::from(EXIT_FAILED);
         }
-        eprintln!("note: {kept}");
-        return ExitCode::from(EXIT_FAILED);
+        None => {}
     }
     if !report.output_errors.is_empty() {
         return ExitCode::from(EXIT_FAILED);
     }
     ExitCode::SUCCESS
+}
+
+/// Sets the velocities and accelerations of `state` to zero.
+fn bring_to_rest(state: &mut unfold::state::State) {
+    for v in [
+        &mut state.velocity,
+        &mut state.acceleration,
+        &mut state.pseudo_acceleration,
+    ] {
+        v.fill([0.0; 6]);
+    }
+    for v in [
+        &mut state.coordinate_rates,
+        &mut state.coordinate_accelerations,
+        &mut state.coordinate_pseudo_accelerations,
+    ] {
+        v.fill(0.0);
+    }
+}
+
+/// Why the static or dynamic analysis of a run stopped early.
+enum Failure {
+    Static(StaticError),
+    Dynamic(DynamicError),
 }
 
 /// Reads the restart file `path` and finds where the run of `model`

@@ -242,13 +242,13 @@ fn mechanism_is_reported_as_singular_with_its_dof() {
 
 #[test]
 fn bad_values_in_analysis_and_supports() {
-    let text = format!("{CANTILEVER}\n[analysis]\ntype = \"dynamic\"\nend_time = -1.0\n");
+    let text = format!("{CANTILEVER}\n[analysis]\ntype = \"transient\"\nend_time = -1.0\n");
     assert_rejected(
         "bad_analysis",
         &text,
         &[
             "analysis",
-            "unknown analysis type \"dynamic\"",
+            "unknown analysis type \"transient\"",
             "end_time must be positive",
         ],
     );

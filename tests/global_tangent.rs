@@ -130,7 +130,8 @@ fn assembled_tangent_matches_finite_differences() {
 }
 
 /// The bend of the test above with inertia on every element that has it:
-/// beams with mass and rotational inertia per length, a rigid body with
+/// beams with mass and rotational inertia per length and Rayleigh damping
+/// (docs/theory.md §11.5), a rigid body with
 /// its centre of mass off its node, a point mass, the springs, and a link
 /// (a second beam) hinged to the tip by a revolute joint carrying a spring
 /// and a damper, driven by a driver on the same hinge.
@@ -138,6 +139,8 @@ fn dynamic_model() -> Model {
     let mut m = common::example("bend_45.toml");
     m.sections[0].mass_per_length = Some(0.3);
     m.sections[0].inertia_per_length = Some([0.02, 0.01, 0.015]);
+    m.sections[0].rayleigh_alpha = Some(0.5);
+    m.sections[0].rayleigh_beta = Some(2e-3);
     m.rigid_bodies.push(RigidBodyInput {
         id: 100,
         node: 9,

@@ -310,6 +310,7 @@ fn restart_files_keep_every_number_to_the_last_bit() {
         analysis: 0,
         analysis_type: "static".into(),
         state: s.clone(),
+        motion: None,
     };
     let dir = scratch("bits");
     let path = dir.join("restart.json");

@@ -16,6 +16,9 @@
 
 pub mod constraints;
 pub mod control;
+pub mod dynamics;
+pub mod energy;
+pub mod impact;
 pub mod modal;
 pub mod newton;
 pub mod observers;
@@ -24,9 +27,12 @@ pub mod settings;
 pub mod statics;
 
 pub use control::EventFunction;
+pub use dynamics::{Continuation, DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
+pub use energy::{Energies, EnergyBalance};
+pub use impact::LockInfo;
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
-pub use settings::{AnalysisSettings, ModalSettings, StaticSettings};
+pub use settings::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
 pub use statics::{StaticAnalysis, StaticOutcome, Step, LIMIT_POINT_WARNING};
 
 use crate::model::Model;
@@ -110,12 +116,20 @@ pub trait Observer {
         Ok(())
     }
 
+    /// The energies of a dynamic analysis at its converged step, just
+    /// before that step is reported to [`Observer::increment`].
+    fn energies(&mut self, _energies: &energy::Energies) {}
+
     /// When an increment is cut back.
     fn cutback(&mut self, _info: &CutbackInfo) {}
 
     /// After the increment that landed on an event (reported to
     /// [`Observer::increment`] first).
     fn event(&mut self, _info: &EventInfo) {}
+
+    /// After the step on which a latch locked (reported to
+    /// [`Observer::increment`], with the post-impact state, first).
+    fn lock(&mut self, _info: &LockInfo) {}
 
     /// A remark worth showing the user (redundant constraints removed).
     fn note(&mut self, _text: &str) {}

@@ -463,6 +463,20 @@ impl NewtonSolver {
         self.closest_approach_count
     }
 
+    /// The numbering, the assembler and the sparse LU of the current
+    /// numbering, for an analysis that forms its own iteration matrix on
+    /// the same pattern (dynamics). The LU's symbolic analysis is kept
+    /// between calls and dropped when the numbering changes.
+    pub(crate) fn system(&mut self) -> (&DofMap, &mut Assembler, &mut Option<SparseLu>) {
+        self.fresh = false;
+        (&self.dofs, &mut self.assembler, &mut self.lu)
+    }
+
+    /// The assembler (its last residual, flux and matrix).
+    pub(crate) fn assembler(&self) -> &Assembler {
+        &self.assembler
+    }
+
     /// Number of stored entries of the system matrix.
     pub fn nnz(&self) -> usize {
         self.assembler.matrix.nnz()

@@ -29,6 +29,8 @@ pub enum ElementKind {
     HingeLaw,
     /// Prescribed history of a joint coordinate or node component.
     Driver,
+    /// Lock of a joint coordinate at the end of its travel.
+    Latch,
 }
 
 /// A cell data array of the VTK files filled from an element's results:
@@ -56,7 +58,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 10] = [
+    pub const ALL: [ElementKind; 11] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -67,6 +69,7 @@ impl ElementKind {
         Self::JointSpring,
         Self::HingeLaw,
         Self::Driver,
+        Self::Latch,
     ];
 
     /// Lower-case name used in messages and output file names.
@@ -82,6 +85,7 @@ impl ElementKind {
             Self::JointSpring => "joint spring",
             Self::HingeLaw => "hinge law",
             Self::Driver => "driver",
+            Self::Latch => "latch",
         }
     }
 
@@ -98,6 +102,7 @@ impl ElementKind {
             Self::JointSpring => 8,
             Self::Driver => 9,
             Self::HingeLaw => 10,
+            Self::Latch => 11,
         }
     }
 
@@ -112,7 +117,11 @@ impl ElementKind {
             Self::Driver => Some("drivers.csv"),
             Self::JointSpring => Some("joint_springs.csv"),
             Self::HingeLaw => Some("hinge_laws.csv"),
-            Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
+            Self::RigidBody
+            | Self::PointMass
+            | Self::NodalLoad
+            | Self::Constraint
+            | Self::Latch => None,
         }
     }
 

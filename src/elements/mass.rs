@@ -126,6 +126,21 @@ impl Element for RigidBody {
         }
     }
 
+    fn kinetic_energy(&self, state: &State) -> f64 {
+        self.kernel
+            .kinetic_energy(&node_motion(state, self.node[0]))
+    }
+
+    fn momenta(&self, state: &State) -> super::inertia::Momenta {
+        self.kernel.momenta(&node_motion(state, self.node[0]))
+    }
+
+    fn weight_potential(&self, ctx: &EvalContext, state: &State) -> f64 {
+        let node = self.node[0];
+        let centre = state.x[node] + state.q[node] * self.offset;
+        -self.mass * ctx.gravity.dot(&centre)
+    }
+
     fn cell_shape(&self) -> CellShape {
         CellShape::Vertex
     }

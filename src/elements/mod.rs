@@ -285,6 +285,12 @@ pub trait Element: Send + Sync {
         true
     }
 
+    /// The element as a latch, for the analyses that lock latches
+    /// (docs/joints.md §6.2).
+    fn as_latch(&self) -> Option<&crate::joints::Latch> {
+        None
+    }
+
     /// New values of the internal variables after the state has converged
     /// (unwrapped joint angles, hysteresis); `internal` holds the old ones.
     fn update_internal(&self, _ctx: &EvalContext, _state: &State, _internal: &mut [f64]) {}
@@ -328,6 +334,30 @@ pub trait Element: Send + Sync {
 
     /// Elastic energy stored in the element (beams, springs).
     fn strain_energy(&self, _ctx: &EvalContext, _state: &State) -> f64 {
+        0.0
+    }
+
+    /// Kinetic energy of the element's inertia (docs/theory.md I1, I7).
+    fn kinetic_energy(&self, _state: &State) -> f64 {
+        0.0
+    }
+
+    /// Linear momentum and angular momentum about the global origin of the
+    /// element's inertia (docs/theory.md I6), global frame; zero without
+    /// inertia.
+    fn momenta(&self, _state: &State) -> inertia::Momenta {
+        inertia::Momenta::default()
+    }
+
+    /// Potential of the weight, `−m g·x_c` with `x_c` the centre of mass
+    /// and `g` the gravity of `ctx`.
+    fn weight_potential(&self, _ctx: &EvalContext, _state: &State) -> f64 {
+        0.0
+    }
+
+    /// Power dissipated by the element's dampers (non-negative), in
+    /// dynamics.
+    fn dissipated_power(&self, _ctx: &EvalContext, _state: &State) -> f64 {
         0.0
     }
 

@@ -19,7 +19,12 @@
 //! `state` is the whole [`State`] (positions, orientations, coordinates,
 //! multipliers, internal variables, velocities, accelerations and
 //! pseudo-accelerations), every number written to its last bit, so a
-//! continued run repeats the arithmetic of an uninterrupted one.
+//! continued run repeats the arithmetic of an uninterrupted one. A file
+//! written in a dynamic analysis also has `motion`
+//! ([`crate::analysis::Continuation`]: the energy balance at that step and
+//! the size of the step that ended there); a dynamic analysis continued
+//! from a step inside it keeps the state's velocities and accelerations
+//! and goes on with these ([`crate::analysis::DynamicAnalysis::continued`]).
 //! `analysis` (from 1) is the analysis of the model's sequence that was
 //! running. A restart continues that analysis from `time` when `time` is
 //! before its `end_time`, else the next one, and runs the rest of the
@@ -38,7 +43,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::AnalysisSettings;
+use crate::analysis::{AnalysisSettings, Continuation};
 use crate::model::input::ModelInput;
 use crate::model::Model;
 use crate::state::State;
@@ -66,6 +71,8 @@ pub struct Restart {
     pub analysis_type: String,
     /// The state.
     pub state: State,
+    /// What a dynamic analysis needs besides the state to go on.
+    pub motion: Option<Continuation>,
 }
 
 /// The file as written.
@@ -80,6 +87,8 @@ struct RestartFile {
     analysis_type: String,
     time: f64,
     state: State,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    motion: Option<Continuation>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -172,6 +181,14 @@ pub struct Resume {
     pub analysis: usize,
     /// Its start state.
     pub state: State,
+    /// The state is a converged step inside that analysis (not the end of
+    /// the one before): a dynamic analysis continues with the state's
+    /// velocities and accelerations
+    /// ([`crate::analysis::DynamicAnalysis::continued`]).
+    pub continues: bool,
+    /// What a dynamic analysis needs besides the state to go on, if the
+    /// restart is inside one.
+    pub motion: Option<Continuation>,
 }
 
 /// The fingerprint of a model input: the 64-bit FNV-1a hash of its JSON
@@ -234,6 +251,7 @@ impl Restart {
             analysis_type: self.analysis_type.clone(),
             time: self.state.time,
             state: self.state.clone(),
+            motion: self.motion,
         };
         let err = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
         let text = serde_json::to_vec(&file).map_err(|e| err(e.into()))?;
@@ -286,6 +304,7 @@ impl Restart {
             analysis: file.analysis - 1,
             analysis_type: file.analysis_type,
             state: file.state,
+            motion: file.motion,
         })
     }
 
@@ -374,6 +393,8 @@ impl Restart {
         Ok(Resume {
             analysis,
             state: self.state.clone(),
+            continues: analysis == self.analysis,
+            motion: self.motion.filter(|_| analysis == self.analysis),
         })
     }
 }
@@ -426,25 +447,34 @@ impl RestartWriter {
         self.dir.join(LAST)
     }
 
-    fn restart(&self, analysis: usize, analysis_type: &str, state: &State) -> Restart {
+    fn restart(
+        &self,
+        analysis: usize,
+        analysis_type: &str,
+        state: &State,
+        motion: Option<Continuation>,
+    ) -> Restart {
         Restart {
             model_title: self.model_title.clone(),
             model_fingerprint: self.model_fingerprint.clone(),
             analysis,
             analysis_type: analysis_type.to_string(),
             state: state.clone(),
+            motion,
         }
     }
 
     /// After a converged step of analysis `analysis` (index in the model's
     /// sequence) at `state.time`: writes `restart-<t>.json` for the
     /// requested time `t` reached (to round-off), or passed, since the last
-    /// step.
+    /// step, with what a dynamic analysis needs besides to go on
+    /// (`motion`).
     pub fn increment(
         &mut self,
         analysis: usize,
         analysis_type: &str,
         state: &State,
+        motion: Option<Continuation>,
     ) -> io::Result<()> {
         let mut due = None;
         while let Some(&t) = self.times.get(self.next) {
@@ -456,16 +486,23 @@ impl RestartWriter {
         }
         match due {
             Some(t) => self
-                .restart(analysis, analysis_type, state)
+                .restart(analysis, analysis_type, state, motion)
                 .write(&self.dir.join(format!("restart-{t}.json"))),
             None => Ok(()),
         }
     }
 
     /// At the end of the run: writes `restart.json` with `state`, the last
-    /// converged state of analysis `analysis`.
-    pub fn finish(&self, analysis: usize, analysis_type: &str, state: &State) -> io::Result<()> {
-        self.restart(analysis, analysis_type, state)
+    /// converged state of analysis `analysis` (with `motion` in a dynamic
+    /// analysis).
+    pub fn finish(
+        &self,
+        analysis: usize,
+        analysis_type: &str,
+        state: &State,
+        motion: Option<Continuation>,
+    ) -> io::Result<()> {
+        self.restart(analysis, analysis_type, state, motion)
             .write(&self.last_path())
     }
 }

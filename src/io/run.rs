@@ -19,6 +19,12 @@
 //! before ([`Recorder::next_analysis`]), the output steps and increments
 //! are numbered on across them, and `summary.json` lists each analysis.
 //!
+//! A dynamic analysis ([`Recorder::create_dynamic_first`],
+//! [`Recorder::open_dynamic`], [`Recorder::end_analysis`]) adds its time
+//! steps, the velocities of its output steps and their energies
+//! (`nodes_velocities.csv`, `energies.csv`) and its energy balance in
+//! `summary.json`.
+//!
 //! Stopping: a [`StopRequest`] shared with the recorder (set by
 //! [`stop_on_signals`] on SIGINT, SIGTERM or SIGHUP) makes it write the
 //! increment that has just converged as an output step, then stop the
@@ -42,12 +48,12 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use super::modes::ModalFiles;
 use super::restart::RestartWriter;
-use super::results::{file_error, ResultWriter, RunStatus, Summary};
+use super::results::{file_error, AnalysisEnd, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
-    AnalysisSettings, CutbackInfo, EventInfo, IncrementInfo, IterationInfo, Observer,
-    StaticAnalysis, StaticOutcome, WarningInfo,
+    AnalysisSettings, Continuation, CutbackInfo, DynamicAnalysis, DynamicError, Energies,
+    EventInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
 use crate::model::Model;
@@ -146,6 +152,14 @@ impl Interrupted {
     pub fn of(error: &StaticError) -> Option<Self> {
         match error {
             StaticError::Output(e) => e.get_ref()?.downcast_ref::<Self>().copied(),
+            _ => None,
+        }
+    }
+
+    /// As [`Interrupted::of`], for a dynamic analysis.
+    pub fn of_dynamic(error: &DynamicError) -> Option<Self> {
+        match error {
+            DynamicError::Output(e) => e.get_ref()?.downcast_ref::<Self>().copied(),
             _ => None,
         }
     }
@@ -357,6 +371,14 @@ pub struct Recorder {
     /// Restart files, and the index in the model's sequence of the first
     /// analysis recorded.
     restart: Option<(RestartWriter, usize)>,
+    /// Largest absolute energy balance error and kinetic energy over the
+    /// steps of the running dynamic analysis.
+    energy_extremes: (f64, f64),
+    /// The energies of its last converged step.
+    energies: Option<Energies>,
+    /// What it needs besides its last converged state to go on (for
+    /// restart files).
+    motion: Option<Continuation>,
 }
 
 /// The analysis being recorded.
@@ -369,6 +391,16 @@ struct Running {
 }
 
 impl Running {
+    fn of_dynamic(index: usize, analysis: &DynamicAnalysis) -> Self {
+        Self {
+            index,
+            kind: "dynamic",
+            start_time: 0.0,
+            end_time: analysis.settings().end_time,
+            initial_iterations: 0,
+        }
+    }
+
     fn of(index: usize, analysis: &StaticAnalysis) -> Self {
         let s = analysis.settings();
         Self {
@@ -415,6 +447,66 @@ impl Recorder {
         )
     }
 
+    /// As [`Recorder::create_sequence`], for a run whose first analysis
+    /// is the dynamic analysis `first`.
+    pub fn create_dynamic_first(
+        dir: &Path,
+        model_file: &str,
+        first: &DynamicAnalysis,
+        plan: &[AnalysisSettings],
+        console: impl Console + 'static,
+    ) -> io::Result<Self> {
+        let model = &**first.model();
+        let end_time = plan
+            .last()
+            .map_or(first.settings().end_time, |a| a.end_time());
+        let unknowns = first.n_equations();
+        let summary = Summary::start_with(model_file, model, unknowns, first.nnz(), end_time);
+        let running = Running::of_dynamic(0, first);
+        let mut recorder = Self::create_with(
+            dir, model_file, model, summary, running, unknowns, plan, console,
+        )?;
+        recorder.writer.set_dynamic(true);
+        Ok(recorder)
+    }
+
+    /// Opens the record of the dynamic analysis `next`, which starts from
+    /// the final state of the analysis before it, at `t = from` (that
+    /// analysis closed with [`Recorder::end_analysis`]).
+    pub fn open_dynamic(&mut self, next: &DynamicAnalysis, from: f64) {
+        self.current = Running::of_dynamic(self.current.index + 1, next);
+        self.open_next(from);
+    }
+
+    /// Opens the record of the static analysis `next` after another
+    /// analysis (closed with [`Recorder::end_analysis`]), from `t = from`.
+    pub fn open_static(&mut self, next: &StaticAnalysis, from: f64) {
+        self.current = Running::of(self.current.index + 1, next);
+        self.open_next(from);
+    }
+
+    fn open_next(&mut self, from: f64) {
+        self.open = true;
+        self.energy_extremes = (0.0, 0.0);
+        self.energies = None;
+        self.motion = None;
+        self.writer.set_dynamic(self.current.kind == "dynamic");
+        self.line(&format!(
+            "analysis {} of {}: {} from t = {} to t = {}",
+            self.current.index + 1,
+            self.analyses,
+            self.current.kind,
+            format_time(from),
+            format_time(self.current.end_time)
+        ));
+    }
+
+    /// Closes the record of the running analysis, which ended as `end`
+    /// says (nothing if it is closed already).
+    pub fn end_analysis(&mut self, end: &AnalysisEnd) {
+        self.close_end(end);
+    }
+
     /// The recorder of a run of `plan` whose first analysis is `running`,
     /// a static one if `running.kind` is not `modal`.
     #[allow(clippy::too_many_arguments)]
@@ -428,7 +520,8 @@ impl Recorder {
         plan: &[AnalysisSettings],
         console: impl Console + 'static,
     ) -> io::Result<Self> {
-        let writer = ResultWriter::create(dir, model)?;
+        let dynamics = plan.iter().any(|a| a.as_dynamic().is_some());
+        let writer = ResultWriter::create_for(dir, model, dynamics)?;
         let log = LogFile::create(dir.join("log.txt"))?;
         let mut recorder = Self {
             writer,
@@ -446,6 +539,9 @@ impl Recorder {
             encoding: Encoding::default(),
             violations: Vec::new(),
             restart: None,
+            energy_extremes: (0.0, 0.0),
+            energies: None,
+            motion: None,
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -502,18 +598,37 @@ impl Recorder {
 
     /// Adds the running analysis's `outcome` to the summary.
     fn close(&mut self, outcome: &StaticOutcome) {
+        self.close_end(&outcome.into());
+    }
+
+    /// Adds the running analysis, which ended as `end` says, to the
+    /// summary.
+    fn close_end(&mut self, end: &AnalysisEnd) {
         if !std::mem::replace(&mut self.open, false) {
             return;
         }
+        let mut end = end.clone();
+        if let Some(d) = end.dynamic.as_mut() {
+            let (error, kinetic) = self.energy_extremes;
+            d.largest_energy_balance_error = d.largest_energy_balance_error.max(error);
+            d.largest_kinetic_energy = d.largest_kinetic_energy.max(kinetic);
+            self.line(&format!(
+                "dynamic analysis to t = {}: {} steps, {} rejected ({} by the error estimate), {} iterations, {:.3} s; energy balance error {:.3e} (largest {:.3e}; largest kinetic energy {:.3e})",
+                format_time(end.time),
+                d.steps,
+                d.rejected_steps,
+                d.error_rejections,
+                d.newton_iterations,
+                d.wall_time_s,
+                d.energy_balance_error,
+                d.largest_energy_balance_error,
+                d.largest_kinetic_energy
+            ));
+        }
         let c = &self.current;
-        self.summary.add(
-            c.kind,
-            c.start_time,
-            c.end_time,
-            outcome,
-            c.initial_iterations,
-        );
-        self.increment_offset += outcome.increments;
+        self.summary
+            .add_end(c.kind, c.start_time, c.end_time, &end, c.initial_iterations);
+        self.increment_offset += end.increments;
     }
 
     /// `info` numbered on across the analyses of the run.
@@ -574,12 +689,19 @@ impl Recorder {
     /// (that of `outcome`, or the state a modal analysis after it was
     /// given and left unchanged), written to `restart.json`; a failed
     /// modal analysis fails the run.
-    pub fn finish_with(mut self, outcome: Option<&StaticOutcome>, state: &State) -> RunReport {
-        let error = outcome.and_then(|o| o.error.as_ref());
-        if let Some(o) = outcome {
-            self.close(o);
+    pub fn finish_with(self, outcome: Option<&StaticOutcome>, state: &State) -> RunReport {
+        let end = outcome.map(AnalysisEnd::from);
+        self.finish_after(end.as_ref(), state)
+    }
+
+    /// As [`Recorder::finish_with`], for a run whose last static or
+    /// dynamic analysis ended as `last` says.
+    pub fn finish_after(mut self, last: Option<&AnalysisEnd>, state: &State) -> RunReport {
+        let error = last.and_then(|o| o.error.as_ref());
+        if let Some(o) = last {
+            self.close_end(o);
         }
-        let interrupted = error.and_then(Interrupted::of);
+        let interrupted = last.and_then(|o| o.interrupted);
         let (status, message) = match (error, interrupted, self.failure.take()) {
             (None, _, None) => (RunStatus::Completed, None),
             (None, _, Some(failure)) => (RunStatus::Failed, Some(failure)),
@@ -590,13 +712,15 @@ impl Recorder {
                     format_time(self.summary.final_time)
                 )),
             ),
-            (Some(e), None, _) => (RunStatus::Failed, Some(e.to_string())),
+            (Some(e), None, _) => (RunStatus::Failed, Some(e.clone())),
         };
         let mut output_errors = Vec::new();
         if let Some((restart, first)) = &self.restart {
             let _writing = self.stop.output();
             let index = first + self.current.index;
-            if let Err(e) = restart.finish(index, self.current.kind, state) {
+            // the dynamic analysis that ended at `state`
+            let motion = self.motion.filter(|m| m.energies.time == state.time);
+            if let Err(e) = restart.finish(index, self.current.kind, state, motion) {
                 output_errors.push(e);
             }
         }
@@ -609,18 +733,48 @@ impl Recorder {
         } else {
             "the initial equilibrium"
         };
-        let last_line = format!(
-            "{}: {} increments, {} iterations ({} for {initial}; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
-            s.status.name(),
-            s.increments,
-            s.iterations,
-            s.initial_iterations(),
-            s.average_iterations,
-            s.cutbacks,
-            format_time(s.final_time),
-            s.wall_time_s,
-            self.writer.dir().display()
-        );
+        let dynamic: Vec<_> = s
+            .analyses
+            .iter()
+            .filter_map(|a| a.dynamic.as_ref())
+            .collect();
+        let last_line = if !dynamic.is_empty()
+            && dynamic.len() == s.analyses.iter().filter(|a| a.kind != "modal").count()
+        {
+            // dynamic analyses only (and modal ones): time steps
+            let steps: usize = dynamic.iter().map(|d| d.steps).sum();
+            let rejected: usize = dynamic.iter().map(|d| d.rejected_steps).sum();
+            let balance = dynamic.last().map_or(0.0, |d| d.energy_balance_error);
+            format!(
+                "{}: {steps} steps, {rejected} rejected, {} iterations ({:.2} per step), t = {}, {:.3} s, energy balance error {balance:.3e}; results in {}",
+                s.status.name(),
+                s.iterations,
+                if steps > 0 { s.iterations as f64 / steps as f64 } else { 0.0 },
+                format_time(s.final_time),
+                s.wall_time_s,
+                self.writer.dir().display()
+            )
+        } else {
+            let steps = if dynamic.is_empty() {
+                String::new()
+            } else {
+                let steps: usize = dynamic.iter().map(|d| d.steps).sum();
+                let rejected: usize = dynamic.iter().map(|d| d.rejected_steps).sum();
+                format!(" (of which {steps} time steps, {rejected} rejected)")
+            };
+            format!(
+                "{}: {} increments{steps}, {} iterations ({} for {initial}; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
+                s.status.name(),
+                s.increments,
+                s.iterations,
+                s.initial_iterations(),
+                s.average_iterations,
+                s.cutbacks,
+                format_time(s.final_time),
+                s.wall_time_s,
+                self.writer.dir().display()
+            )
+        };
         self.log.line(&last_line);
         self.console.finish(&last_line);
         if let Err(e) = self.log.flush() {
@@ -644,6 +798,14 @@ impl Recorder {
 }
 
 impl Observer for Recorder {
+    fn energies(&mut self, energies: &Energies) {
+        let (error, kinetic) = &mut self.energy_extremes;
+        *error = error.max(energies.balance_error.abs());
+        *kinetic = kinetic.max(energies.kinetic);
+        self.energies = Some(*energies);
+        self.writer.energies(energies);
+    }
+
     fn iteration(&mut self, info: &IterationInfo) {
         if info.iteration == 0 {
             self.violations.clear();
@@ -651,7 +813,12 @@ impl Observer for Recorder {
         self.violations.push(info.norms.residual_constraint);
         let n = &info.norms;
         self.log.line(&format!(
-            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+            "    {} {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+            if self.current.kind == "dynamic" {
+                "step"
+            } else {
+                "increment"
+            },
             info.increment + self.increment_offset,
             info.iteration,
             n.residual_force,
@@ -681,6 +848,14 @@ impl Observer for Recorder {
         // written already: its equilibrium there is logged, not written
         let restart =
             info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
+        if self.current.kind == "dynamic" {
+            // the step that ended here (none at the start: a restart there
+            // predicts its first step as the analysis's first)
+            self.motion = self.energies.map(|energies| Continuation {
+                energies,
+                last_step: (info.step > 0.0).then_some(info.step),
+            });
+        }
         let info = &self.renumbered(info);
         // a kinematic analysis has no loads: its residual is all constraint
         // violation, measured against the tolerance of each constraint
@@ -690,8 +865,13 @@ impl Observer for Recorder {
             ("relative residuals", &info.residuals)
         };
         let values: Vec<String> = values.iter().map(|r| format!("{r:.1e}")).collect();
+        let (word, size) = if self.current.kind == "dynamic" {
+            ("step", "h")
+        } else {
+            ("increment", "dt")
+        };
         self.line(&format!(
-            "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  {what}: {}",
+            "{word} {:4}  t = {:.6}  {size} = {:.3e}  iterations {:2}  {what}: {}",
             info.increment,
             info.time,
             info.step,
@@ -718,7 +898,12 @@ impl Observer for Recorder {
                 self.writer.increment(info, model, state, residual)?;
             }
             if let Some((restart, first)) = &mut self.restart {
-                restart.increment(*first + self.current.index, self.current.kind, state)?;
+                restart.increment(
+                    *first + self.current.index,
+                    self.current.kind,
+                    state,
+                    self.motion,
+                )?;
             }
         }
         self.log.flush()?;
@@ -746,8 +931,13 @@ impl Observer for Recorder {
     }
 
     fn cutback(&mut self, info: &CutbackInfo) {
+        let word = if self.current.kind == "dynamic" {
+            "step"
+        } else {
+            "increment"
+        };
         self.line(&format!(
-            "increment {:4}  from t = {:.6}: step {:.3e} failed ({}); retrying with {:.3e}",
+            "{word} {:4}  from t = {:.6}: step {:.3e} failed ({}); retrying with {:.3e}",
             info.increment + self.increment_offset,
             info.time,
             info.failed_step,

@@ -231,7 +231,25 @@ pub fn write_vtu(
     state: &State,
     encoding: Encoding,
 ) -> io::Result<()> {
-    write_grid(path, model, ctx, state, encoding, None)
+    write_grid(path, model, ctx, state, encoding, None, None)
+}
+
+/// Writes the grid of an output step of a run: as [`write_vtu`], with
+/// the point vectors `velocity` and `angular_velocity` (global) if
+/// `velocities` is given: the state's if `Some(true)` (a step of a dynamic
+/// analysis), zeros if `Some(false)` (a step at rest in a run with
+/// dynamics, so that every grid of the run has the same fields). A joint
+/// point moves with its node, `v + ω × (p − x)`, and with the ground not
+/// at all.
+pub fn write_step_vtu(
+    path: &Path,
+    model: &Model,
+    ctx: &EvalContext,
+    state: &State,
+    encoding: Encoding,
+    velocities: Option<bool>,
+) -> io::Result<()> {
+    write_grid(path, model, ctx, state, encoding, None, velocities)
 }
 
 /// A mode shape on the nodes: translation and rotation (global frame) of
@@ -257,7 +275,7 @@ pub fn write_mode_vtu(
     mode: ModeField,
 ) -> io::Result<()> {
     assert!(mode.translation.len() == model.n_nodes() && mode.rotation.len() == model.n_nodes());
-    write_grid(path, model, ctx, state, encoding, Some(mode))
+    write_grid(path, model, ctx, state, encoding, Some(mode), None)
 }
 
 fn write_grid(
@@ -267,6 +285,7 @@ fn write_grid(
     state: &State,
     encoding: Encoding,
     mode: Option<ModeField>,
+    velocities: Option<bool>,
 ) -> io::Result<()> {
     let n_nodes = model.n_nodes();
     let joints = attachments(model, state);
@@ -312,6 +331,32 @@ fn write_grid(
             });
             push3(&mut mode_u, &u);
             push3(&mut mode_theta, &theta);
+        }
+    }
+    // velocities (global) at the nodes, then at the joint points
+    let mut velocity = Vec::new();
+    let mut angular_velocity = Vec::new();
+    if let Some(moving) = velocities {
+        let omega = |i: usize| -> (Vec3, Vec3) {
+            if !moving {
+                return (Vec3::zeros(), Vec3::zeros());
+            }
+            let v = state.velocity[i];
+            let w = so3::matrix(&state.q[i]) * Vec3::new(v[3], v[4], v[5]);
+            (Vec3::new(v[0], v[1], v[2]), w)
+        };
+        for i in 0..n_nodes {
+            let (v, w) = omega(i);
+            push3(&mut velocity, &v);
+            push3(&mut angular_velocity, &w);
+        }
+        for (_, a) in &joints {
+            let (v, w) = a.node.map_or((Vec3::zeros(), Vec3::zeros()), |n| {
+                let (v, w) = omega(n);
+                (v + w.cross(&(a.point - state.x[n])), w)
+            });
+            push3(&mut velocity, &v);
+            push3(&mut angular_velocity, &w);
         }
     }
     for (j, (k, a)) in joints.iter().enumerate() {
@@ -433,6 +478,10 @@ fn write_grid(
     if mode.is_some() {
         doc.array("mode_displacement", 3, &mode_u);
         doc.array("mode_rotation", 3, &mode_theta);
+    }
+    if velocities.is_some() {
+        doc.array("velocity", 3, &velocity);
+        doc.array("angular_velocity", 3, &angular_velocity);
     }
     doc.xml.push_str("      </PointData>\n");
 

@@ -231,6 +231,11 @@ impl Element for JointSpring {
         let c = self.source.value(state, self.reference(state));
         self.spring.as_ref().map_or(0.0, |l| l.energy(c))
     }
+    /// `f_d(ċ) ċ`: the power the damper takes out of the motion.
+    fn dissipated_power(&self, _ctx: &EvalContext, state: &State) -> f64 {
+        let (_, rate, _, fd) = self.forces(state);
+        fd * rate
+    }
     fn cell_shape(&self) -> CellShape {
         CellShape::None
     }

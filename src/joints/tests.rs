@@ -229,6 +229,51 @@ fn driver_and_spring_tangents_match_finite_differences() {
     println!("worst driver and joint-spring tangent error {worst:.2e}");
 }
 
+/// A latch, open (`kλ = 0`) and locked (`Φ = c − c_L`): its tangent, and
+/// the gradient `B` of its coordinate that the impact uses, against
+/// central differences (h = 1e-6; 1e-6 of the largest entry, as above).
+#[test]
+fn latch_tangents_and_gradient_match_finite_differences() {
+    let mut rng = Lcg(11);
+    let coords = [Coordinate::Angle, Coordinate::Slide1, Coordinate::Slide3];
+    let mut worst = 0.0f64;
+    for c in coords {
+        for grounded in [false, true] {
+            for _ in 0..8 {
+                let (src, x, q) = revolute_coordinate(&mut rng, grounded, c);
+                let nn = src.nodes.len();
+                let latch = Latch::new(5, 1, src, 0.3, -1.0);
+                let mut s = moved(&mut rng, &x[..nn], &q[..nn], &latch);
+                let flag = latch.n_internal() - 1;
+                for locked in [0.0, 1.0] {
+                    s.internal[flag] = locked;
+                    assert_eq!(latch.is_locked(&s), locked > 0.5);
+                    let err = tangent_error(&latch, &ctx(), &s, 1e-6);
+                    assert!(err < 1e-6, "latch on {} ({locked}): {err:.3e}", c.name());
+                    worst = worst.max(err);
+                }
+                // B: ∂c/∂q along each local unknown; ċ = B v
+                let (_, grad) = latch.rate(&s);
+                let h = 1e-6;
+                let largest = grad.iter().fold(1e-300f64, |a, g| a.max(g.abs()));
+                for (k, g) in grad.iter().enumerate() {
+                    let cp = latch.coordinate(&crate::elements::testing::moved(&s, &latch, k, h));
+                    let cm = latch.coordinate(&crate::elements::testing::moved(&s, &latch, k, -h));
+                    let fd = (cp - cm) / (2.0 * h);
+                    assert!(
+                        (fd - g).abs() < 1e-6 * largest,
+                        "{}: ∂c/∂q{k} {g} vs {fd}",
+                        c.name()
+                    );
+                    worst = worst.max((fd - g).abs() / largest);
+                }
+                assert!((latch.gap(&s) + (latch.coordinate(&s) - 0.3)).abs() < 1e-15);
+            }
+        }
+    }
+    println!("worst latch tangent and gradient error {worst:.2e}");
+}
+
 /// A node driver measures the node's own motion along a fixed direction.
 #[test]
 fn node_driver_coordinate_is_the_displacement_along_its_direction() {

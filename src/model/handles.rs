@@ -115,6 +115,11 @@ element_handle!(
     DriverHandle,
     ElementKind::Driver
 );
+element_handle!(
+    /// A latch.
+    LatchHandle,
+    ElementKind::Latch
+);
 
 /// The nodes and elements of a beam line.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -44,7 +44,7 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 19] = [
+pub const TOP_LEVEL_KEYS: [&str; 21] = [
     "title",
     "analysis",
     "nodes",
@@ -63,6 +63,8 @@ pub const TOP_LEVEL_KEYS: [&str; 19] = [
     "joint_springs",
     "hinge_laws",
     "drivers",
+    "latches",
+    "initial_motion",
     "output",
 ];
 
@@ -126,6 +128,12 @@ pub struct ModelInput {
     /// Prescribed histories of joint coordinates or node components.
     #[serde(default)]
     pub drivers: Vec<DriverInput>,
+    /// Locks of joint coordinates at the end of their travel.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub latches: Vec<LatchInput>,
+    /// Rigid motions of sets of nodes at the start (dynamic analyses).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub initial_motion: Vec<InitialMotionInput>,
     /// What a run writes besides the result files (`[output]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output: Option<OutputInput>,
@@ -335,6 +343,53 @@ pub struct DriverInput {
     pub active: Option<[f64; 2]>,
 }
 
+/// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
+/// when it reaches `value` moving in the direction of approach, and stays
+/// locked.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LatchInput {
+    /// Element id.
+    pub id: Id,
+    /// The joint.
+    pub joint: Id,
+    /// Which coordinate (`angle`, `slide`, `angle1`...), default the joint's
+    /// first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Locking value `c_L` (m, or rad unless `unit` says otherwise).
+    pub value: f64,
+    /// Unit of `value` for an angle coordinate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+    /// `increasing` or `decreasing`: how the coordinate reaches `value`
+    /// (default: away from the reference configuration, where it is 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub approach: Option<Approach>,
+    /// `rigid` (default): once locked, `c = c_L` is a constraint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode: Option<LatchMode>,
+}
+
+/// How a latch's coordinate reaches its locking value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Approach {
+    /// With the coordinate increasing.
+    Increasing,
+    /// With the coordinate decreasing.
+    Decreasing,
+}
+
+/// What a latch does once locked.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LatchMode {
+    /// `c − c_L = 0` is a constraint with a multiplier.
+    #[default]
+    Rigid,
+}
+
 /// The analyses of a model: one (`[analysis]`, the default static analysis
 /// when the table is absent) or a sequence run in order (`[[analysis]]`),
 /// each starting from the final state of the one before. Never empty.
@@ -486,6 +541,28 @@ pub struct AnalysisInput {
     /// Arc-length control: largest number of increments, default 1000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_increments: Option<usize>,
+    /// Dynamics: first time step, default a hundredth of the span.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_step: Option<f64>,
+    /// Dynamics: smallest time step, default `time_step · 1e-6`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_step: Option<f64>,
+    /// Dynamics: largest time step, default a tenth of the span (adaptive)
+    /// or `time_step` (fixed steps).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_step: Option<f64>,
+    /// Dynamics: spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`,
+    /// default 0.9.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_infinity: Option<f64>,
+    /// Dynamics: relative tolerance of the local error estimate, default
+    /// 1e-4.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error_tolerance: Option<f64>,
+    /// Dynamics: whether the step follows the error estimate (default
+    /// true); `false` for fixed steps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<bool>,
     /// Modal analysis: number of modes, default 10.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub modes: Option<usize>,
@@ -526,6 +603,12 @@ impl Default for AnalysisInput {
             constraint_penalty: None,
             control: None,
             max_increments: None,
+            time_step: None,
+            min_step: None,
+            max_step: None,
+            rho_infinity: None,
+            error_tolerance: None,
+            adaptive: None,
             modes: None,
             shift: None,
             frequency_range: None,
@@ -548,6 +631,30 @@ pub struct NodeInput {
     /// Unit of `rotation` (its length is the angle).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unit: Option<AngleUnit>,
+    /// Initial velocity (global frame), default zero; dynamic analyses.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<[f64; 3]>,
+    /// Initial angular velocity (global frame, rad/s), default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_velocity: Option<[f64; 3]>,
+}
+
+/// `[[initial_motion]]`: a rigid motion given to a set of nodes at the
+/// start, `v(x) = v + ω × (x − about)`, `ω` to every node (global frame).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct InitialMotionInput {
+    /// The nodes that move together.
+    pub nodes: Vec<Id>,
+    /// Velocity of the point `about`, default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<[f64; 3]>,
+    /// Angular velocity (rad/s), default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_velocity: Option<[f64; 3]>,
+    /// The point whose velocity is `velocity`, default the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub about: Option<[f64; 3]>,
 }
 
 /// Cross-section properties of a beam.
@@ -588,6 +695,14 @@ pub struct SectionInput {
     /// (ρJ, ρI₂, ρI₃), default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inertia_per_length: Option<[f64; 3]>,
+    /// Rayleigh damping, mass-proportional coefficient `α` (1/s), default
+    /// 0 (docs/theory.md §11.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh_alpha: Option<f64>,
+    /// Rayleigh damping, stiffness-proportional coefficient `β` (s),
+    /// default 0 (docs/theory.md §11.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh_beta: Option<f64>,
 }
 
 impl SectionInput {
@@ -881,6 +996,8 @@ impl ModelInput {
             x,
             rotation: None,
             unit: None,
+            velocity: None,
+            angular_velocity: None,
         });
         self
     }

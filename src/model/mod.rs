@@ -33,8 +33,8 @@ pub use build::{
 pub use builder::ModelBuilder;
 pub use handles::{
     BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
-    JointHandle, JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle,
-    SpringHandle,
+    JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
+    RigidBodyHandle, SpringHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.
@@ -106,6 +106,9 @@ pub struct Model {
     pub length_scale: f64,
     /// Scaling and penalty of the constraint equations.
     pub scaling: ConstraintScaling,
+    /// Initial velocity of each node: `(ẋ, ω)`, both global (zero unless
+    /// the model gives them, for dynamic analyses).
+    pub initial_velocity: Vec<[f64; 6]>,
     /// Where each element's coordinates, multipliers and internal
     /// variables start in the state.
     offsets: Vec<Offsets>,
@@ -160,11 +163,23 @@ impl Model {
                 &mut coordinates[o.coordinates..o.coordinates + e.n_coordinates()],
             );
         }
-        State::at_rest(0.0, self.reference_x.clone(), self.reference_q.clone()).with_unknowns(
-            coordinates,
-            self.sizes.multipliers,
-            self.sizes.internal,
-        )
+        let mut state = State::at_rest(0.0, self.reference_x.clone(), self.reference_q.clone())
+            .with_unknowns(coordinates, self.sizes.multipliers, self.sizes.internal);
+        // velocities: ẋ global, Ω = Rᵀω material
+        for (i, v) in self.initial_velocity.iter().enumerate() {
+            let w = self.reference_q[i].inverse() * Vec3::new(v[3], v[4], v[5]);
+            state.velocity[i] = [v[0], v[1], v[2], w.x, w.y, w.z];
+        }
+        state
+    }
+
+    /// Sets the initial velocity of node `node` (index): `v` and the
+    /// angular velocity `w`, both global.
+    pub fn set_initial_velocity(&mut self, node: usize, v: Vec3, w: Vec3) {
+        if self.initial_velocity.len() != self.n_nodes() {
+            self.initial_velocity = vec![[0.0; 6]; self.n_nodes()];
+        }
+        self.initial_velocity[node] = [v.x, v.y, v.z, w.x, w.y, w.z];
     }
 
     /// Where the coordinates, multipliers and internal variables of

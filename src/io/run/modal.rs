@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::{Console, Recorder, Running};
 use crate::analysis::AnalysisSettings;
-use crate::analysis::{ModalAnalysis, ModalOutcome, StaticAnalysis, StaticOutcome};
+use crate::analysis::{ModalAnalysis, ModalOutcome, StaticOutcome};
 use crate::io::modes::{solver_name, ModalRecord};
 use crate::io::results::{AnalysisRecord, Summary};
 
@@ -43,20 +43,6 @@ impl Recorder {
         )
     }
 
-    /// Opens the record of the static analysis `next` after a modal one,
-    /// from `t = from`.
-    pub fn open_static(&mut self, next: &StaticAnalysis, from: f64) {
-        self.current = Running::of(self.current.index + 1, next);
-        self.open = true;
-        self.line(&format!(
-            "analysis {} of {}: {} from t = {from} to t = {}",
-            self.current.index + 1,
-            self.analyses,
-            self.current.kind,
-            self.current.end_time
-        ));
-    }
-
     /// Records the modal analysis `analysis`, which returned `outcome`:
     /// closes the static analysis before it (`before`, if it is still
     /// open), writes its result files (docs/results.md, "Modes"), a line
@@ -75,6 +61,7 @@ impl Recorder {
             self.close(b);
         }
         if !first {
+            self.writer.set_dynamic(false);
             self.current = Running {
                 index: self.current.index + 1,
                 kind: "modal",
@@ -104,6 +91,8 @@ impl Recorder {
             iterations: 0,
             cutbacks: 0,
             failed: outcome.error.is_some(),
+            wall_time_s: outcome.wall_time,
+            dynamic: None,
         });
         self.summary.final_time = outcome.time;
         self.summary.wall_time_s += outcome.wall_time;

@@ -89,7 +89,12 @@ impl Builder<'_> {
                     c.name()
                 ),
             );
-        } else if a.norm() > 0.0 && !self.plan.kinematic && has_drivers && g.curve.is_none() {
+        } else if a.norm() > 0.0
+            && !self.plan.kinematic
+            && !self.plan.first_dynamic
+            && has_drivers
+            && g.curve.is_none()
+        {
             self.ck.warn(
                 "gravity",
                 "follows the default ramp f = t while drivers move the model: their loads before the end include only f(t) of the gravity; write curve = \"ramp\" to confirm, or curve = \"constant\" for the full gravity throughout",

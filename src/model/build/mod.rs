@@ -14,8 +14,10 @@ mod checks;
 mod curves;
 mod drivers;
 mod hinge_laws;
+mod initial;
 mod joint_springs;
 mod joints;
+mod latches;
 mod loads;
 mod masses;
 mod nodes;
@@ -238,9 +240,11 @@ impl Builder<'_> {
     /// Default curve of loads and gravity: the ramp in statics (the load
     /// factor), the constant in a kinematic analysis, whose motion the
     /// drivers set and whose loads are those of the real, fully loaded
-    /// mechanism at every instant.
+    /// mechanism at every instant, and in a first dynamic analysis, whose
+    /// loads act from the start (a ramp in time is a loading history of
+    /// its own, to be given as such).
     fn load_default(&self) -> CurveIndex {
-        if self.plan.kinematic {
+        if self.plan.kinematic || self.plan.first_dynamic {
             CONSTANT
         } else {
             RAMP
@@ -269,6 +273,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.joint_springs.len(),
         input.hinge_laws.len(),
         input.drivers.len(),
+        input.latches.len(),
         generated,
     ]
     .into_iter()
@@ -323,6 +328,7 @@ impl Model {
         let gravity = b.gravity();
         b.supports();
         b.prescribed();
+        let initial_velocity = b.initial_velocities();
 
         // ---------- global checks ----------
         let Builder {
@@ -340,9 +346,10 @@ impl Model {
         if ck.errors.is_empty() {
             if elements.iter().all(|e| e.kind() == ElementKind::NodalLoad) {
                 ck.push(ModelErrorKind::Missing, "model", "has no elements");
-            } else if !plan.modal_only {
-                // a free structure has rigid-body modes, but no static
-                // equilibrium
+            } else if !plan.no_statics {
+                // a free part has no static equilibrium; in dynamics its
+                // inertia holds it, a modal analysis gives its rigid-body
+                // modes
                 checks::check_restraint(&mut ck, &node_ids, &elements, &fixed);
             }
         }
@@ -384,6 +391,7 @@ impl Model {
             gravity,
             length_scale,
             scaling: Default::default(),
+            initial_velocity,
             offsets: Vec::new(),
             sizes: Default::default(),
         };

@@ -4,7 +4,8 @@
 use super::{
     num, Checker, LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MIN_RELATIVE_INCREMENT,
 };
-use crate::analysis::{AnalysisSettings, ModalSettings, StaticSettings};
+use crate::analysis::settings::{DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
+use crate::analysis::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
 use crate::eigen::Method;
 use crate::model::input::{Analyses, AnalysisInput, ModelInput};
 use crate::model::{ModelErrorKind, ModelErrors};
@@ -22,18 +23,16 @@ impl ModelInput {
             let mut start = 0.0;
             // (a modal analysis has no increments: it neither moves `t`
             // nor writes restart files)
-            for s in all.iter_mut().filter_map(|a| match a {
-                AnalysisSettings::Static(s) => Some(s),
+            for (end, times) in all.iter_mut().filter_map(|a| match a {
+                AnalysisSettings::Static(s) => Some((s.end_time, &mut s.output_times)),
+                AnalysisSettings::Dynamic(s) => Some((s.end_time, &mut s.output_times)),
                 _ => None,
             }) {
-                let within = o
-                    .restart_times
-                    .iter()
-                    .filter(|&&t| t > start && t <= s.end_time);
-                s.output_times.extend(within);
-                s.output_times.sort_by(f64::total_cmp);
-                s.output_times.dedup();
-                start = s.end_time;
+                let within = o.restart_times.iter().filter(|&&t| t > start && t <= end);
+                times.extend(within);
+                times.sort_by(f64::total_cmp);
+                times.dedup();
+                start = end;
             }
         }
         if ck.errors.is_empty() {
@@ -57,20 +56,29 @@ pub(super) struct Plan {
     pub end_time: f64,
     /// Largest `max_increment` of the load-controlled analyses.
     pub max_increment: Option<f64>,
-    /// Every analysis is modal (a free structure is then allowed).
-    pub modal_only: bool,
+    /// No analysis seeks a static equilibrium (dynamic and modal analyses
+    /// only): parts free to move as rigid bodies are allowed (their inertia
+    /// holds them; a modal analysis reports their rigid-body modes).
+    pub no_statics: bool,
+    /// The first analysis is dynamic (loads and gravity act in full from
+    /// the start by default).
+    pub first_dynamic: bool,
 }
 
 impl Plan {
-    pub(super) fn of(all: &[AnalysisSettings]) -> Self {
-        let settings: Vec<&StaticSettings> = all.iter().filter_map(|a| a.as_static()).collect();
-        let load = settings.iter().filter(|s| !s.arc_length);
+    pub(super) fn of(settings: &[AnalysisSettings]) -> Self {
+        let statics = || settings.iter().filter_map(AnalysisSettings::as_static);
+        let load = statics().filter(|s| !s.arc_length);
         Self {
-            kinematic: settings.first().is_some_and(|s| s.kinematic),
-            arc_length: settings.iter().any(|s| s.arc_length),
-            end_time: settings.last().map_or(1.0, |s| s.end_time),
+            kinematic: settings
+                .first()
+                .and_then(AnalysisSettings::as_static)
+                .is_some_and(|s| s.kinematic),
+            arc_length: statics().any(|s| s.arc_length),
+            end_time: settings.last().map_or(1.0, |s| s.end_time()),
             max_increment: load.map(|s| s.max_increment).reduce(f64::max),
-            modal_only: settings.is_empty(),
+            no_statics: statics().next().is_none(),
+            first_dynamic: settings.first().is_some_and(|s| s.as_dynamic().is_some()),
         }
     }
 }
@@ -135,11 +143,36 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
                 );
             }
         }
-        let s = settings(ck, &entity, a, start);
-        start = s.end_time;
-        out.push(AnalysisSettings::Static(s));
+        let s = if a.kind == "dynamic" {
+            AnalysisSettings::Dynamic(dynamic_settings(ck, &entity, a, start))
+        } else {
+            for (key, given) in dynamic_keys(a) {
+                if given {
+                    ck.push(
+                        ModelErrorKind::Invalid,
+                        &entity,
+                        format!("{key} belongs to dynamic analyses (type = \"dynamic\"); a {} analysis takes initial_increment, min_increment and max_increment", a.kind),
+                    );
+                }
+            }
+            AnalysisSettings::Static(settings(ck, &entity, a, start))
+        };
+        start = s.end_time();
+        out.push(s);
     }
     out
+}
+
+/// The keys that only dynamic analyses take, and whether each is given.
+fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 6] {
+    [
+        ("time_step", a.time_step.is_some()),
+        ("min_step", a.min_step.is_some()),
+        ("max_step", a.max_step.is_some()),
+        ("rho_infinity", a.rho_infinity.is_some()),
+        ("error_tolerance", a.error_tolerance.is_some()),
+        ("adaptive", a.adaptive.is_some()),
+    ]
 }
 
 /// Largest number of modes a modal analysis may ask for: beyond it the
@@ -162,7 +195,10 @@ fn modal_settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64)
         ("output_times", a.output_times.is_some()),
         ("control", a.control.is_some()),
         ("max_increments", a.max_increments.is_some()),
-    ] {
+    ]
+    .into_iter()
+    .chain(dynamic_keys(a))
+    {
         if given {
             ck.push(
                 ModelErrorKind::Invalid,
@@ -233,7 +269,7 @@ fn settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> St
             ModelErrorKind::Invalid,
             entity,
             format!(
-                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic, modal)",
+                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic, dynamic, modal)",
                 a.kind
             ),
         );
@@ -396,6 +432,171 @@ fn settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> St
                 num(s.initial_increment),
                 num(s.max_increment)
             ),
+        );
+    }
+    for &t in &s.output_times {
+        if !(t.is_finite() && t > start && t <= end) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "output_times must lie after the start of the analysis (t = {}) and not after its end_time ({}), got {}",
+                    num(start),
+                    num(end),
+                    num(t)
+                ),
+            );
+        }
+    }
+    if s.output_times.windows(2).any(|w| w[1] <= w[0]) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            "output_times must be in increasing order",
+        );
+    }
+    s
+}
+
+/// Settings of one dynamic analysis from `start` to its end, with
+/// defaults (docs/model-format.md, dynamic analyses).
+fn dynamic_settings(
+    ck: &mut Checker,
+    entity: &str,
+    a: &AnalysisInput,
+    start: f64,
+) -> DynamicSettings {
+    for (key, given) in [
+        ("initial_increment", a.initial_increment.is_some()),
+        ("min_increment", a.min_increment.is_some()),
+        ("max_increment", a.max_increment.is_some()),
+        ("control", a.control.is_some()),
+        ("max_increments", a.max_increments.is_some()),
+    ] {
+        if given {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("{key} belongs to static analyses; a dynamic analysis takes time_step, min_step and max_step"),
+            );
+        }
+    }
+    let end = a.end_time;
+    ck.positive(entity, "end_time", end);
+    let span = end - start;
+    let time_step = a.time_step.unwrap_or(span / 100.0);
+    let adaptive = a.adaptive.unwrap_or(true);
+    let s = DynamicSettings {
+        end_time: end,
+        time_step,
+        min_step: a.min_step.unwrap_or(time_step * 1e-6),
+        max_step: a
+            .max_step
+            .unwrap_or(if adaptive { span / 10.0 } else { time_step }),
+        rho_infinity: a.rho_infinity.unwrap_or(DEFAULT_RHO_INFINITY),
+        adaptive,
+        error_tolerance: a.error_tolerance.unwrap_or(DEFAULT_ERROR_TOLERANCE),
+        max_iterations: a.max_iterations.unwrap_or(25),
+        residual_tolerance: a.residual_tolerance.unwrap_or(1e-8),
+        displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
+        rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
+        output_every: a.output_every.unwrap_or(1),
+        output_times: a.output_times.clone().unwrap_or_default(),
+    };
+    if !(s.rho_infinity.is_finite() && (0.0..=1.0).contains(&s.rho_infinity)) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "rho_infinity must lie in [0, 1] (1: no numerical dissipation), got {}",
+                num(s.rho_infinity)
+            ),
+        );
+    }
+    let steps_ok = ck.positive(entity, "time_step", s.time_step)
+        & ck.positive(entity, "min_step", s.min_step)
+        & ck.positive(entity, "max_step", s.max_step);
+    if steps_ok && s.min_step > s.max_step {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "min_step ({}) must not exceed max_step ({})",
+                num(s.min_step),
+                num(s.max_step)
+            ),
+        );
+    } else if steps_ok && !(s.min_step <= s.time_step && s.time_step <= s.max_step) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "time steps must satisfy min_step ≤ time_step ≤ max_step, got {} ≤ {} ≤ {}",
+                num(s.min_step),
+                num(s.time_step),
+                num(s.max_step)
+            ),
+        );
+    }
+    if steps_ok && s.min_step < MIN_RELATIVE_INCREMENT * s.end_time.abs() {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "min_step must be at least end_time·{MIN_RELATIVE_INCREMENT:e} = {:e} (smaller steps are lost in the round-off of t), got {}",
+                MIN_RELATIVE_INCREMENT * s.end_time,
+                num(s.min_step)
+            ),
+        );
+    }
+    if steps_ok && span / s.max_step > MAX_INCREMENTS {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "(end_time − start) / max_step = {:.3e}: the analysis would need more than {MAX_INCREMENTS:e} steps",
+                span / s.max_step
+            ),
+        );
+    }
+    if !(s.error_tolerance.is_finite() && s.error_tolerance > 0.0 && s.error_tolerance < 1.0) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "error_tolerance must lie between 0 and 1 (a relative tolerance), got {}",
+                num(s.error_tolerance)
+            ),
+        );
+    }
+    for (name, v) in [
+        ("residual_tolerance", s.residual_tolerance),
+        ("displacement_tolerance", s.displacement_tolerance),
+        ("rotation_tolerance", s.rotation_tolerance),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v < 1.0) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("{name} must lie between 0 and 1, got {}", num(v)),
+            );
+        }
+    }
+    if s.max_iterations == 0 || s.max_iterations > MAX_ITERATIONS {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "max_iterations must be from 1 to {MAX_ITERATIONS}, got {}",
+                s.max_iterations
+            ),
+        );
+    }
+    if s.output_every == 0 {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            "output_every must be at least 1",
         );
     }
     for &t in &s.output_times {

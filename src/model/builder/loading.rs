@@ -417,6 +417,33 @@ impl Analysis {
         Self::of_type("kinematic")
     }
 
+    /// Implicit dynamics (Lie-group generalised-α, docs/theory.md §15)
+    /// from the state reached to `end_time`; a model whose analyses are
+    /// all dynamic or modal may have parts free to move as rigid bodies.
+    pub fn dynamic() -> Self {
+        Self::of_type("dynamic")
+    }
+
+    /// Dynamics: the first time step (default a hundredth of the span).
+    pub fn time_step(mut self, h: f64) -> Self {
+        self.0.time_step = Some(h);
+        self
+    }
+
+    /// Dynamics: the spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`
+    /// (default 0.9).
+    pub fn rho_infinity(mut self, rho: f64) -> Self {
+        self.0.rho_infinity = Some(rho);
+        self
+    }
+
+    /// Dynamics: fixed steps of `time_step` instead of steps sized by the
+    /// error estimate.
+    pub fn fixed_step(mut self) -> Self {
+        self.0.adaptive = Some(false);
+        self
+    }
+
     /// Modal analysis: the `modes` lowest natural modes about the state
     /// reached (docs/theory.md §14.7).
     pub fn modal(modes: usize) -> Self {
@@ -535,18 +562,29 @@ impl Analysis {
     /// The settings of this analysis alone (from `t = 0`), validated as in
     /// a model file.
     pub fn settings(self) -> Result<crate::analysis::StaticSettings, crate::model::ModelErrors> {
+        match self.analysis_settings()? {
+            crate::analysis::AnalysisSettings::Static(s) => Ok(s),
+            other => Err(crate::model::ModelErrors(vec![crate::model::ModelError {
+                kind: crate::model::ModelErrorKind::Invalid,
+                entity: "analysis".into(),
+                message: format!(
+                    "a {} analysis has no static settings: use analysis_settings",
+                    other.name()
+                ),
+            }])),
+        }
+    }
+
+    /// The settings of this analysis alone (from `t = 0`), of whatever
+    /// type, validated as in a model file.
+    pub fn analysis_settings(
+        self,
+    ) -> Result<crate::analysis::AnalysisSettings, crate::model::ModelErrors> {
         let input = crate::model::input::ModelInput {
             analysis: self.0.into(),
             ..crate::model::input::ModelInput::default()
         };
         let mut all = input.analyses()?;
-        match all.remove(0) {
-            crate::analysis::AnalysisSettings::Static(s) => Ok(s),
-            other => Err(crate::model::ModelErrors(vec![crate::model::ModelError {
-                kind: crate::model::ModelErrorKind::Invalid,
-                entity: "analysis".into(),
-                message: format!("a {} analysis has no static settings", other.name()),
-            }])),
-        }
+        Ok(all.remove(0))
     }
 }

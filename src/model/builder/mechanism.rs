@@ -1,13 +1,13 @@
-//! Joints, joint springs and dampers, drivers (docs/joints.md).
+//! Joints, joint springs and dampers, drivers, latches (docs/joints.md).
 
 use super::{Body, CurveHandle, Entity, ModelBuilder};
 use crate::joints::{Coordinate, JointType};
 use crate::model::handles::{
-    DriverHandle, HingeLawHandle, JointHandle, JointSpringHandle, NodeHandle,
+    DriverHandle, HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, NodeHandle,
 };
 use crate::model::input::{
-    AngleUnit, DriverInput, HingeLawInput, JointInput, JointSpringInput, StartBranch,
-    TapeSpringInput,
+    AngleUnit, Approach, DriverInput, HingeLawInput, JointInput, JointSpringInput, LatchInput,
+    StartBranch, TapeSpringInput,
 };
 use crate::model::Id;
 
@@ -407,6 +407,66 @@ impl Entity for Driver {
         self.input.curve = self.curve.map(|c| m.curve_name(c));
         let handle = DriverHandle(self.input.id);
         m.input.drivers.push(self.input);
+        handle
+    }
+}
+
+/// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
+/// when it reaches its locking value moving in the direction of approach,
+/// and stays locked (in dynamic analyses, with the impact of the lock).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Latch {
+    input: LatchInput,
+    id: Option<Id>,
+}
+
+impl Latch {
+    /// Locks the first coordinate of `joint` at `value` (m, or rad; see
+    /// [`Latch::angle`]).
+    pub fn on(joint: JointHandle, value: f64) -> Self {
+        Self {
+            input: LatchInput {
+                joint: joint.0,
+                value,
+                ..LatchInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// The joint coordinate it locks.
+    pub fn coordinate(mut self, coordinate: Coordinate) -> Self {
+        self.input.coordinate = Some(coordinate.name().into());
+        self
+    }
+
+    /// The locking angle, in `unit`.
+    pub fn angle(mut self, value: f64, unit: AngleUnit) -> Self {
+        self.input.value = value;
+        self.input.unit = Some(unit);
+        self
+    }
+
+    /// How the coordinate reaches the locking value (default: away from
+    /// the reference configuration, where it is 0).
+    pub fn approach(mut self, approach: Approach) -> Self {
+        self.input.approach = Some(approach);
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for Latch {
+    type Handle = LatchHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> LatchHandle {
+        self.input.id = m.element_id(self.id, 1);
+        let handle = LatchHandle(self.input.id);
+        m.input.latches.push(self.input);
         handle
     }
 }

@@ -43,15 +43,15 @@ mod structure;
 pub use loading::{
     Analysis, Component, CurveHandle, Dofs, Gravity, Load, LoadCurve, PrescribedMotion,
 };
-pub use mechanism::{Driver, HingeLaw, Joint, JointSpring};
+pub use mechanism::{Driver, HingeLaw, Joint, JointSpring, Latch};
 pub use structure::{Beam, BeamLine, Node, PointMass, RigidBody, Section, SectionHandle, Spring};
 
 pub use super::handles::{
     BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
-    JointHandle, JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle,
-    SpringHandle,
+    JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
+    RigidBodyHandle, SpringHandle,
 };
-pub use super::input::{AngleUnit, StartBranch, TapeSpringInput as TapeSpring};
+pub use super::input::{AngleUnit, Approach, StartBranch, TapeSpringInput as TapeSpring};
 pub use super::{Id, Model, ModelErrors};
 pub use crate::joints::{Coordinate, JointType};
 
@@ -135,6 +135,40 @@ impl ModelBuilder {
     /// Adds a node at `x` with the id `id`.
     pub fn node_with_id(&mut self, id: Id, x: impl Into<[f64; 3]>) -> NodeHandle {
         self.add(Node::at(x).id(id))
+    }
+
+    /// Gives node `node` the initial velocity `v` and angular velocity
+    /// `w` (global frame), for dynamic analyses.
+    pub fn initial_velocity(
+        &mut self,
+        node: NodeHandle,
+        v: impl Into<[f64; 3]>,
+        w: impl Into<[f64; 3]>,
+    ) {
+        if let Some(n) = self.input.nodes.iter_mut().find(|n| n.id == node.0) {
+            n.velocity = Some(v.into());
+            n.angular_velocity = Some(w.into());
+        }
+    }
+
+    /// Gives `nodes` the rigid motion in which the point `about` moves
+    /// with `velocity` and everything turns with `angular_velocity`
+    /// (global frame): `v(x) = velocity + angular_velocity × (x − about)`.
+    pub fn initial_motion(
+        &mut self,
+        nodes: impl IntoIterator<Item = NodeHandle>,
+        velocity: impl Into<[f64; 3]>,
+        angular_velocity: impl Into<[f64; 3]>,
+        about: impl Into<[f64; 3]>,
+    ) {
+        self.input
+            .initial_motion
+            .push(crate::model::input::InitialMotionInput {
+                nodes: nodes.into_iter().map(|n| n.0).collect(),
+                velocity: Some(velocity.into()),
+                angular_velocity: Some(angular_velocity.into()),
+                about: Some(about.into()),
+            });
     }
 
     /// Adds a beam cross-section.

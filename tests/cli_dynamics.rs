@@ -637,3 +637,36 @@ fn sigint_stops_a_dynamic_run_after_a_step() {
     assert_eq!(restart["time"], s["final_time"]);
     assert!(restart["motion"]["energies"].is_object());
 }
+
+/// A latch's results through the command line: `latches.csv` holds the
+/// same steps as `steps.csv`; the latch is open (0) until the step that
+/// lands on the lock and locked (1) from then on; on that step the
+/// coordinate is the locking value, 90°, within the event tolerance of
+/// 1e-8 rad (docs/joints.md §6.2) and stays there.
+#[test]
+fn latch_results_are_written_with_every_step() {
+    let dir = scratch("latch");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/latched_panels.toml");
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let latches = table(&out.join("latches.csv"));
+    let steps = table(&out.join("steps.csv"));
+    assert_eq!(latches.len(), steps.len());
+    let value =
+        |r: &std::collections::HashMap<String, String>, k: &str| -> f64 { r[k].parse().unwrap() };
+    let first = latches
+        .iter()
+        .position(|r| value(r, "locked") == 1.0)
+        .expect("the latch locks within 0.1 s");
+    assert!(first > 0);
+    for r in &latches[..first] {
+        assert_eq!(value(r, "locked"), 0.0);
+        assert!(value(r, "gap") < 0.0);
+    }
+    for r in &latches[first..] {
+        assert_eq!(value(r, "locked"), 1.0);
+        assert!((value(r, "coordinate") - std::f64::consts::FRAC_PI_2).abs() < 1e-8);
+        assert!(value(r, "gap").abs() < 1e-8);
+    }
+}

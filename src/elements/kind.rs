@@ -117,11 +117,8 @@ impl ElementKind {
             Self::Driver => Some("drivers.csv"),
             Self::JointSpring => Some("joint_springs.csv"),
             Self::HingeLaw => Some("hinge_laws.csv"),
-            Self::RigidBody
-            | Self::PointMass
-            | Self::NodalLoad
-            | Self::Constraint
-            | Self::Latch => None,
+            Self::Latch => Some("latches.csv"),
+            Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
     }
 
@@ -130,6 +127,7 @@ impl ElementKind {
         match self {
             Self::Joint => "joint",
             Self::Driver => "driver",
+            Self::Latch => "latch",
             _ => "element",
         }
     }

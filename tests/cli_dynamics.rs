@@ -670,3 +670,72 @@ fn latch_results_are_written_with_every_step() {
         assert!(value(r, "gap").abs() < 1e-8);
     }
 }
+
+/// A modal analysis of a model with nothing left to vibrate (a panel
+/// hinged to the ground whose latch has locked) has no mode: a note, not
+/// an error, and the run completes (exit 0). Before the lock the same
+/// model has one mode, `ω = √(k/J_O) = √(2/(1/3)) = 2.4495 rad/s`.
+#[test]
+fn a_modal_analysis_with_no_mode_left_is_a_note() {
+    let dir = scratch("nomode");
+    let model = dir.join("panel.toml");
+    std::fs::write(
+        &model,
+        r#"
+title = "panel latched to the ground, then its modes"
+[[analysis]]
+type = "modal"
+modes = 3
+[[analysis]]
+type = "dynamic"
+end_time = 0.6
+time_step = 0.001
+max_step = 0.01
+output_every = 10
+[[analysis]]
+type = "modal"
+modes = 3
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+[[nodes]]
+id = 2
+x = [0.5, 0.0, 0.0]
+[[supports]]
+node = 1
+fixed = ["all"]
+[[rigid_bodies]]
+id = 12
+node = 2
+mass = 1.0
+inertia = [0.001, 0.0833333333333333, 0.0833333333333333]
+[[joints]]
+id = 3
+type = "revolute"
+nodes = [1, 2]
+axis = [0.0, 0.0, 1.0]
+position = [0.0, 0.0, 0.0]
+[[joint_springs]]
+id = 4
+joint = 3
+stiffness = 2.0
+free_value = 3.141592653589793
+[[latches]]
+id = 5
+joint = 3
+value = 90.0
+unit = "deg"
+"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    assert!(log.contains("the model has no mode"), "{log}");
+    let modes = table(&out.join("modes.csv"));
+    assert_eq!(modes.len(), 1, "one mode before the lock, none after");
+    // √(k/J_O), J_O = 1/12 + 0.5² = 1/3 kg·m²: to round-off of the solver
+    assert!((num(&modes[0], "omega_rad_s") - 6f64.sqrt()).abs() < 1e-9);
+    assert_eq!(summary(&out)["status"], "completed");
+}

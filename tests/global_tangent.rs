@@ -67,6 +67,8 @@ fn assembled_tangent_matches_finite_differences() {
             kind,
             nodes,
             stiffness: k,
+            damping: None,
+            damping_ratio: None,
         });
     }
     m.loads.push(LoadInput {
@@ -182,6 +184,9 @@ fn dynamic_model() -> Model {
             kind,
             nodes,
             stiffness: k,
+            // dampers in parallel: their K and C blocks are checked too
+            damping: Some(StiffnessInput::Isotropic(1.5)),
+            damping_ratio: None,
         });
     }
     // the link: nodes 20 (at the tip) and 21, hinged to the tip about z

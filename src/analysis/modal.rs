@@ -326,6 +326,7 @@ fn solve(
                     ..eigen
                 },
             )?,
+            Err(EigenError::TooManyModes { .. }) => return Ok(no_modes(pencil, observer)),
             other => other?,
         };
         if range.is_none() {
@@ -370,6 +371,7 @@ fn solve(
                 // every mode is there: keep those in the range
                 return Ok(in_range(all, settings));
             }
+            Err(EigenError::TooManyModes { .. }) => return Ok(no_modes(pencil, observer)),
             other => other?,
         };
         let Some((_, hi)) = range else {
@@ -481,5 +483,24 @@ fn natural_mode(
         shape,
         coordinates,
         residual: mode.residual,
+    }
+}
+
+/// The answer for a model with no motion left to vibrate (every unknown
+/// with mass held by supports, joints, latches or drivers): no mode, said
+/// in a note, as a legitimate result rather than an error.
+fn no_modes(pencil: &Pencil, observer: &mut dyn Observer) -> ModalSolution {
+    observer.note(
+        "the model has no mode: every direction that carries mass is held by supports, joints, latches or drivers",
+    );
+    ModalSolution {
+        modes: Vec::new(),
+        zero_modes: 0,
+        infinite_modes: None,
+        constraint_rank: pencil.multiplier.len(),
+        shift: 0.0,
+        method: Method::Auto,
+        operator_applications: 0,
+        restarts: 0,
     }
 }

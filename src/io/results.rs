@@ -662,6 +662,7 @@ pub struct ResultWriter {
     /// result names of the model.
     values: Vec<f64>,
     pvd: Vec<(f64, String)>,
+    pvd_file: vtk::PvdFile,
     /// Every converged increment, for the summary.
     pub log: Vec<IncrementRecord>,
     /// The files of a run with dynamics.
@@ -849,6 +850,7 @@ impl ResultWriter {
             tables,
             values: vec![0.0; longest],
             pvd: Vec::new(),
+            pvd_file: vtk::PvdFile::new(dir.join("unfold.pvd")),
             log: Vec::new(),
             motion: dynamics
                 .then(|| -> io::Result<MotionFiles> {
@@ -1074,10 +1076,10 @@ impl ResultWriter {
         }
         let mut result = self.csv_files().try_for_each(|f| f.append());
         if result.is_ok() {
-            self.pvd.push((info.time, format!("vtk/{name}")));
-            result = vtk::write_pvd(&self.dir.join("unfold.pvd"), &self.pvd);
-            if result.is_err() {
-                self.pvd.pop();
+            let file = format!("vtk/{name}");
+            result = self.pvd_file.append(info.time, &file);
+            if result.is_ok() {
+                self.pvd.push((info.time, file));
             }
         }
         match result {

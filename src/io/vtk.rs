@@ -34,8 +34,7 @@ use std::fmt::Write as _;
 use std::io::{self, Write as _};
 use std::path::{Path, PathBuf};
 
-use flate2::write::ZlibEncoder;
-use flate2::Compression;
+use flate2::{Compress, Compression, FlushCompress, Status};
 
 use super::results::file_error;
 use crate::elements::{Attachment, CellField, CellShape, ElementKind, EvalContext};
@@ -185,25 +184,44 @@ impl Document {
 /// beams it writes in about the time of the ASCII text, 10 % larger than
 /// level 6 at half its time.
 fn compress_blocks(raw: &[u8], out: &mut Vec<u8>) {
-    let blocks: Vec<Vec<u8>> = raw
-        .chunks(BLOCK_SIZE)
-        .map(|chunk| {
-            let mut z = ZlibEncoder::new(Vec::with_capacity(chunk.len() / 2), Compression::fast());
-            // writing to a Vec cannot fail
-            let _ = z.write_all(chunk);
-            z.finish().unwrap_or_default()
-        })
-        .collect();
+    // One compressor per thread, reset for each block: a new one per block
+    // allocates (and frees) its ~300 kB of state every time, which made
+    // the allocator grow and trim the heap tens of times per output step.
+    thread_local! {
+        static ZLIB: std::cell::RefCell<Compress> =
+            std::cell::RefCell::new(Compress::new(Compression::fast(), true));
+    }
+    let start = out.len();
+    let n_blocks = raw.len().div_ceil(BLOCK_SIZE);
     let last = raw.len() % BLOCK_SIZE;
-    let header = [blocks.len(), BLOCK_SIZE, last]
-        .into_iter()
-        .chain(blocks.iter().map(Vec::len));
-    for h in header {
+    for h in [n_blocks, BLOCK_SIZE, last] {
         out.extend_from_slice(&(h as u64).to_le_bytes());
     }
-    for b in &blocks {
-        out.extend_from_slice(b);
-    }
+    // the compressed sizes, filled in below
+    let sizes_at = out.len();
+    out.resize(sizes_at + 8 * n_blocks, 0);
+    ZLIB.with(|z| {
+        let mut z = z.borrow_mut();
+        for (i, chunk) in raw.chunks(BLOCK_SIZE).enumerate() {
+            z.reset();
+            let before = out.len();
+            loop {
+                out.reserve(chunk.len() / 2 + 64);
+                let read = z.total_in() as usize;
+                // compressing into a Vec with spare room cannot fail
+                let status = z
+                    .compress_vec(&chunk[read..], out, FlushCompress::Finish)
+                    .unwrap_or(Status::StreamEnd);
+                if status == Status::StreamEnd {
+                    break;
+                }
+            }
+            let size = (out.len() - before) as u64;
+            let at = sizes_at + 8 * i;
+            out[at..at + 8].copy_from_slice(&size.to_le_bytes());
+        }
+    });
+    debug_assert!(out.len() >= start + 24);
 }
 
 /// The joint points of every element at `state`, with the element's
@@ -506,6 +524,70 @@ fn write_grid(
     write_atomically(path, &doc.finish())
 }
 
+/// The closing tags of a collection file.
+const PVD_TAIL: &str = "  </Collection>\n</VTKFile>\n";
+
+/// A collection file written as the steps come: each step's entry is
+/// written over the closing tags, which follow it again, so that the file
+/// on disk is complete after every step at a cost independent of the
+/// number of steps before it (rewriting the whole list at every step costs
+/// their square).
+#[derive(Debug)]
+pub struct PvdFile {
+    path: PathBuf,
+    file: Option<std::fs::File>,
+    /// Where the closing tags begin.
+    tail_at: u64,
+}
+
+impl PvdFile {
+    /// The collection file at `path`, created with its first entry.
+    pub fn new(path: PathBuf) -> Self {
+        Self {
+            path,
+            file: None,
+            tail_at: 0,
+        }
+    }
+
+    /// Adds the data set `file` at time `t`. On failure the file keeps
+    /// the entries before (as far as the disk allows) and the error names
+    /// it.
+    pub fn append(&mut self, t: f64, file: &str) -> io::Result<()> {
+        use std::io::{Seek, SeekFrom};
+        let path = self.path.clone();
+        let named = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
+        if self.file.is_none() {
+            let head = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
+            let mut f = std::fs::File::create(&self.path).map_err(named)?;
+            f.write_all(head.as_bytes()).map_err(named)?;
+            self.tail_at = head.len() as u64;
+            self.file = Some(f);
+        }
+        let f = self.file.as_mut().expect("opened above");
+        let entry = format!(
+            "    <DataSet timestep=\"{t:.12e}\" group=\"\" part=\"0\" file=\"{file}\"/>\n{PVD_TAIL}"
+        );
+        let result = f
+            .seek(SeekFrom::Start(self.tail_at))
+            .and_then(|_| f.write_all(entry.as_bytes()));
+        match result {
+            Ok(()) => {
+                self.tail_at += (entry.len() - PVD_TAIL.len()) as u64;
+                Ok(())
+            }
+            Err(e) => {
+                // put the closing tags back after the entries before
+                let _ = f
+                    .set_len(self.tail_at)
+                    .and_then(|()| f.seek(SeekFrom::Start(self.tail_at)))
+                    .and_then(|_| f.write_all(PVD_TAIL.as_bytes()));
+                Err(named(e))
+            }
+        }
+    }
+}
+
 /// Writes the collection file listing `(time, file name)` pairs.
 pub fn write_pvd(path: &Path, entries: &[(f64, String)]) -> io::Result<()> {
     let mut out = String::from(
@@ -517,7 +599,7 @@ pub fn write_pvd(path: &Path, entries: &[(f64, String)]) -> io::Result<()> {
             "    <DataSet timestep=\"{t:.12e}\" group=\"\" part=\"0\" file=\"{file}\"/>"
         );
     }
-    out.push_str("  </Collection>\n</VTKFile>\n");
+    out.push_str(PVD_TAIL);
     write_atomically(path, out.as_bytes())
 }
 

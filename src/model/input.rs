@@ -837,6 +837,15 @@ pub struct SpringInput {
     /// Stiffness: one value (isotropic) or three values along the axes.
     /// Axial springs take one value.
     pub stiffness: StiffnessInput,
+    /// Coefficient of a linear damper in parallel (dynamics only): one
+    /// value or three along the axes (N·s/m, N·m·s/rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<StiffnessInput>,
+    /// Damping ratio `ζ` of the damper in parallel, on each axis
+    /// `c = 2ζ√(k m)` with `m` the mass (or inertia) of the bodies the
+    /// spring connects (docs/model-format.md). Not with `damping`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping_ratio: Option<f64>,
 }
 
 /// A scalar or a 3-vector of spring stiffnesses.

@@ -138,6 +138,23 @@ impl Checker {
         }
     }
 
+    /// Checks that a value is finite and zero or positive.
+    fn non_negative(&mut self, entity: &str, what: &str, value: f64) -> bool {
+        if value.is_finite() && value >= 0.0 {
+            true
+        } else {
+            self.push(
+                ModelErrorKind::NonPositive,
+                entity,
+                format!(
+                    "{what} must be zero or positive and finite, got {}",
+                    num(value)
+                ),
+            );
+            false
+        }
+    }
+
     /// Checks that a value is finite and strictly positive.
     fn positive(&mut self, entity: &str, what: &str, value: f64) -> bool {
         if value.is_finite() && value > 0.0 {

@@ -440,6 +440,8 @@ impl Spring {
                 kind,
                 nodes: b.with_first(a),
                 stiffness,
+                damping: None,
+                damping_ratio: None,
             },
             id: None,
         }
@@ -473,6 +475,21 @@ impl Spring {
             Body::Node(b),
             StiffnessInput::Isotropic(stiffness),
         )
+    }
+
+    /// A linear damper in parallel (dynamics only): one coefficient, or
+    /// one per axis (N·s/m, N·m·s/rad).
+    pub fn damping(mut self, c: impl Into<StiffnessInput>) -> Self {
+        self.input.damping = Some(c.into());
+        self
+    }
+
+    /// A damper in parallel given by its damping ratio `ζ`: `c = 2ζ√(k m)`
+    /// on each axis, `m` the mass (or inertia) of the bodies the spring
+    /// connects (docs/model-format.md, `[[springs]]`).
+    pub fn damping_ratio(mut self, zeta: f64) -> Self {
+        self.input.damping_ratio = Some(zeta);
+        self
     }
 
     /// Its id (default: the next free element id).

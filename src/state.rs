@@ -33,7 +33,7 @@ use crate::so3::{self, Rotation, Vec3};
 /// as `[x, y, z]` and orientations as unit quaternions `[w, x, y, z]`
 /// (the restart files of [`crate::io::restart`]); every number is kept
 /// to the last bit.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct State {
     /// Time, or load parameter in statics.
@@ -65,6 +65,60 @@ pub struct State {
     pub pseudo_acceleration: Vec<[f64; 6]>,
     /// Pseudo-accelerations of the coordinates (generalised-α).
     pub coordinate_pseudo_accelerations: Vec<f64>,
+}
+
+/// `clone_from` copies field by field into the vectors already there, so
+/// that the copies a time step makes (the predictor from the accepted
+/// state, the backup, a rejected step's restore) allocate nothing once the
+/// vectors have their lengths.
+impl Clone for State {
+    fn clone(&self) -> Self {
+        Self {
+            time: self.time,
+            x: self.x.clone(),
+            q: self.q.clone(),
+            coordinates: self.coordinates.clone(),
+            multipliers: self.multipliers.clone(),
+            internal: self.internal.clone(),
+            velocity: self.velocity.clone(),
+            acceleration: self.acceleration.clone(),
+            coordinate_rates: self.coordinate_rates.clone(),
+            coordinate_accelerations: self.coordinate_accelerations.clone(),
+            pseudo_acceleration: self.pseudo_acceleration.clone(),
+            coordinate_pseudo_accelerations: self.coordinate_pseudo_accelerations.clone(),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        // destructured so that a field added to `State` and not copied
+        // here does not compile
+        let Self {
+            time,
+            x,
+            q,
+            coordinates,
+            multipliers,
+            internal,
+            velocity,
+            acceleration,
+            coordinate_rates,
+            coordinate_accelerations,
+            pseudo_acceleration,
+            coordinate_pseudo_accelerations,
+        } = self;
+        *time = source.time;
+        x.clone_from(&source.x);
+        q.clone_from(&source.q);
+        coordinates.clone_from(&source.coordinates);
+        multipliers.clone_from(&source.multipliers);
+        internal.clone_from(&source.internal);
+        velocity.clone_from(&source.velocity);
+        acceleration.clone_from(&source.acceleration);
+        coordinate_rates.clone_from(&source.coordinate_rates);
+        coordinate_accelerations.clone_from(&source.coordinate_accelerations);
+        pseudo_acceleration.clone_from(&source.pseudo_acceleration);
+        coordinate_pseudo_accelerations.clone_from(&source.coordinate_pseudo_accelerations);
+    }
 }
 
 impl State {
@@ -297,5 +351,45 @@ mod tests {
         let before = s.q[0];
         s.displace_node(0, &Vec3::x(), &Vec3::zeros());
         assert_eq!(s.q[0], before);
+    }
+
+    /// `clone_from` gives a copy equal to the source, and into a state
+    /// whose vectors have the source's lengths it writes in place: every
+    /// vector keeps its buffer.
+    #[test]
+    fn clone_from_copies_in_place() {
+        let r = so3::exp(&Vec3::new(0.3, -1.2, 0.5));
+        let mut source = State::at_rest(1.5, vec![Vec3::new(1.0, 2.0, 3.0); 3], vec![r; 3])
+            .with_unknowns(vec![0.25, 0.5], 4, 2);
+        source.velocity[1] = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        source.acceleration[2][4] = -7.0;
+        source.pseudo_acceleration[0][0] = 8.0;
+        source.multipliers[3] = 9.0;
+        source.internal[1] = 10.0;
+        source.coordinate_rates[0] = 11.0;
+        source.coordinate_accelerations[1] = 12.0;
+        source.coordinate_pseudo_accelerations[0] = 13.0;
+        let mut copy = State::at_rest(0.0, vec![Vec3::zeros(); 3], vec![Rotation::identity(); 3])
+            .with_unknowns(vec![0.0; 2], 4, 2);
+        let buffers = |s: &State| {
+            [
+                s.x.as_ptr() as usize,
+                s.q.as_ptr() as usize,
+                s.coordinates.as_ptr() as usize,
+                s.multipliers.as_ptr() as usize,
+                s.internal.as_ptr() as usize,
+                s.velocity.as_ptr() as usize,
+                s.acceleration.as_ptr() as usize,
+                s.coordinate_rates.as_ptr() as usize,
+                s.coordinate_accelerations.as_ptr() as usize,
+                s.pseudo_acceleration.as_ptr() as usize,
+                s.coordinate_pseudo_accelerations.as_ptr() as usize,
+            ]
+        };
+        let before = buffers(&copy);
+        copy.clone_from(&source);
+        assert_eq!(copy, source);
+        assert_eq!(buffers(&copy), before);
+        assert_eq!(source.clone(), source);
     }
 }

@@ -781,13 +781,23 @@ fn step_controller_cuts_at_a_sudden_load_and_grows_back() {
     // the load cuts the step (from 0.4 s at rest) to the time of its rise
     // (at most 2 ms; measured 0.28 ms) and the controller grows it back,
     // without failing, to what the motion after the load needs: at least
-    // 3 times its smallest (measured 1.2 ms, 4.3 times). Not to the step
+    // 3 times its smallest (measured 1.1 ms, 4.5 times). Not to the step
     // before: the load excites the beam's higher bending modes, which
-    // nothing damps and the error estimate follows (measured: 3135 steps,
-    // 1078 rejected by the estimate, none cut back by Newton)
+    // nothing damps and the error estimate follows
     assert!(
         outcome.error_rejections + outcome.cutbacks > 0,
         "the load was not felt"
+    );
+    // the estimate fluctuates by up to 2 from step to step on this ringing
+    // beam; the PI controller follows its trend (docs/theory.md §15.5):
+    // measured 3053 steps, 464 rejected by the estimate (13 % of the
+    // attempts; 3135 and 1078, 34 %, with the elementary controller),
+    // none cut back by Newton. At most 20 % of the attempts
+    let attempts = outcome.steps + outcome.rejected_steps;
+    assert!(
+        5 * outcome.rejected_steps <= attempts,
+        "{} of {attempts} attempts rejected",
+        outcome.rejected_steps
     );
     assert!(smallest <= 2.0 * rise, "smallest step {smallest:e} s");
     assert!(

@@ -40,6 +40,20 @@ pub const LANDING_SNAP: f64 = 1e-9;
 pub const ERROR_SAFETY: f64 = 0.9;
 /// The error estimate changes the step by at most these factors at once.
 pub const ERROR_FACTORS: (f64, f64) = (0.2, 2.0);
+/// Integral gain `k_I (p + 1)` of the PI step-size controller (Gustafsson
+/// 1991, "Control theoretic techniques for stepsize selection in explicit
+/// Runge–Kutta methods", ACM TOMS 17): the step follows the trend of the
+/// error estimate rather than each value, which fluctuates from step to
+/// step by factors up to 2 on lightly damped multi-mode motions (with the
+/// elementary controller every upward fluctuation by 1.23 was a
+/// rejection; docs/theory.md §15.5).
+pub const PI_INTEGRAL: f64 = 0.3;
+/// Proportional gain `k_P (p + 1)` of the PI controller (Gustafsson 1991).
+pub const PI_PROPORTIONAL: f64 = 0.4;
+/// The previous error estimate enters the PI controller at least as this:
+/// after a stretch of steps with nearly no error (at rest, before a load)
+/// the first step with a finite error is not taken for a steep trend.
+pub const ERROR_MEMORY_FLOOR: f64 = 1e-2;
 /// Retries of one step to land on an event before the event is taken as
 /// happening within the step where it was found.
 pub const MAX_EVENT_RETRIES: usize = 30;
@@ -242,6 +256,13 @@ pub struct StepController {
     crossing: Option<Crossing>,
     /// The size of the next step is set by the error estimate.
     error_controlled: bool,
+    /// Error estimate of the last accepted step (at least
+    /// [`ERROR_MEMORY_FLOOR`]), for the proportional term of the step
+    /// size.
+    last_error: Option<f64>,
+    /// The last attempt was rejected or cut back: the next accepted step
+    /// does not let the size grow.
+    rejected: bool,
 }
 
 impl StepController {
@@ -263,6 +284,8 @@ impl StepController {
             event_sides: Vec::new(),
             crossing: None,
             error_controlled: false,
+            last_error: None,
+            rejected: false,
         }
     }
 
@@ -333,6 +356,29 @@ impl StepController {
         }
     }
 
+    /// The factor on the step size asked by the error estimate `e` of a
+    /// step (relative to its tolerance) with `previous` the estimate of the
+    /// accepted step before, for an estimate of order `p` (`e ∝ hᵖ⁺¹`,
+    /// `k = p + 1`): the PI controller of Gustafsson (1991),
+    /// `(θ/e_n)^{k_I} (e_{n−1}/e_n)^{k_P}`, `k_I = 0.3/k`, `k_P = 0.4/k`,
+    /// which holds `e` at `θ = ρᵏ` (`ρ` = [`ERROR_SAFETY`]: 0.81 for
+    /// `k = 2`); without a previous estimate the elementary `ρ e^{−1/k}`
+    /// (the same steady `e`). Within [`ERROR_FACTORS`] (docs/theory.md
+    /// §13, §15.5).
+    fn error_factor(&self, e: f64, previous: Option<f64>, order: f64) -> f64 {
+        let k = order + 1.0;
+        let e = e.max(f64::MIN_POSITIVE);
+        let factor = match previous {
+            Some(before) => {
+                let (k_i, k_p) = (PI_INTEGRAL / k, PI_PROPORTIONAL / k);
+                let target = ERROR_SAFETY.powf(k);
+                (target / e).powf(k_i) * (before / e).powf(k_p)
+            }
+            None => ERROR_SAFETY * e.powf(-1.0 / k),
+        };
+        factor.clamp(ERROR_FACTORS.0, ERROR_FACTORS.1)
+    }
+
     /// Attempts steps until one is accepted (cutting back, retrying for
     /// events and error estimates as needed), or stops the analysis.
     pub fn advance<S: Stepper + ?Sized>(
@@ -398,6 +444,7 @@ impl StepController {
                             });
                         }
                         self.counts.cutbacks += 1;
+                        self.rejected = true;
                         observer.cutback(&CutbackInfo {
                             increment,
                             time: t,
@@ -412,14 +459,12 @@ impl StepController {
 
             // the local error: reject and shrink, or set the next size
             if let Some(e) = error {
-                let factor = (ERROR_SAFETY
-                    * e.max(1e-300).powf(-1.0 / (stepper.error_order() + 1.0)))
-                .clamp(ERROR_FACTORS.0, ERROR_FACTORS.1);
                 if e > 1.0 {
                     self.counts.wasted_iterations += iterations;
                     self.counts.error_rejections += 1;
+                    self.rejected = true;
                     stepper.reject();
-                    let next = size * factor;
+                    let next = size * self.error_factor(e, None, stepper.error_order()).min(1.0);
                     if next < self.bounds.min {
                         return Err(ControlStop::Diverged {
                             increment,
@@ -431,6 +476,12 @@ impl StepController {
                     self.size = next;
                     continue;
                 }
+                let mut factor = self.error_factor(e, self.last_error, stepper.error_order());
+                if self.rejected {
+                    // no growth straight after a rejection or a cut-back
+                    factor = factor.min(1.0);
+                }
+                self.last_error = Some(e.max(ERROR_MEMORY_FLOOR));
                 self.error_controlled = true;
                 let grown = (size * factor).clamp(self.bounds.min, self.bounds.max);
                 self.size = if iterations <= EASY_ITERATIONS {
@@ -439,6 +490,7 @@ impl StepController {
                     grown.min(size)
                 };
             }
+            self.rejected = false;
 
             // events: land on the first crossing
             let mut landed = Vec::new();
@@ -712,8 +764,11 @@ mod tests {
     }
 
     /// With an error estimate `(h/h₀)³`, rejected steps have an error above
-    /// 1 and the accepted ones settle at `0.9 h₀` (the safety factor): the
-    /// estimate, not the iterations, sets the step.
+    /// 1 and the accepted ones settle at `0.9 h₀`, where the estimate is
+    /// `0.9³`, the PI controller's target: the estimate, not the
+    /// iterations, sets the step. The deviation from it decays as 0.8ⁿ
+    /// (the roots 0.8 and −0.5 of `z² − 0.3 z − 0.4`, the PI recurrence of
+    /// `log h`), below 1e-6 after 80 steps.
     #[test]
     fn the_error_estimate_sets_the_step() {
         let bounds = StepBounds {
@@ -728,14 +783,82 @@ mod tests {
         assert!(c.counts().error_rejections >= 1);
         // every accepted step has an error of at most 1
         assert!(steps.iter().all(|i| i.step <= h0 * (1.0 + 1e-12)));
-        // after the first few, steps of 0.9 h₀ (the last one shortened to
-        // land on the end)
-        let settled = &steps[5..steps.len() - 1];
+        // the steady step (the last one shortened to land on the end)
+        let steady = 0.9 * h0;
+        let settled = &steps[80..steps.len() - 1];
         assert!(
-            settled.iter().all(|i| (i.step - 0.9 * h0).abs() < 1e-9),
+            settled
+                .iter()
+                .all(|i| (i.step - steady).abs() < 1e-6 * steady),
             "{:?}",
             settled.iter().map(|i| i.step).collect::<Vec<_>>()
         );
+    }
+
+    /// After a rejection the next accepted step is not larger than the one
+    /// that passed: an estimate `(h/h₀)³` that jumps to 8 times its value
+    /// for one attempt (a step across a sudden load) is rejected, and the
+    /// sizes tried after it never exceed the accepted retry until a step
+    /// has been accepted without rejection.
+    #[test]
+    fn no_growth_after_a_rejection() {
+        struct Jump(Scalar, usize);
+        impl Stepper for Jump {
+            type Error = ();
+            fn current(&self) -> (&Model, &State) {
+                self.0.current()
+            }
+            fn time(&self) -> f64 {
+                self.0.time()
+            }
+            fn sized_in_time(&self) -> bool {
+                true
+            }
+            fn update_active_set(&mut self, t: f64, o: &mut dyn Observer) -> Result<bool, ()> {
+                self.0.update_active_set(t, o)
+            }
+            fn attempt(&mut self, size: f64, t: f64, i: usize, o: &mut dyn Observer) -> Attempt {
+                self.1 += 1;
+                match self.0.attempt(size, t, i, o) {
+                    Attempt::Converged {
+                        iterations,
+                        residuals,
+                        error,
+                    } => Attempt::Converged {
+                        iterations,
+                        residuals,
+                        // the 30th attempt meets the jump
+                        error: error.map(|e| if self.1 == 30 { 8.0 * e.max(0.2) } else { e }),
+                    },
+                    failed => failed,
+                }
+            }
+            fn attempted_time(&self) -> f64 {
+                self.0.attempted_time()
+            }
+            fn reject(&mut self) {
+                self.0.reject()
+            }
+            fn accept(&mut self, info: &IncrementInfo, o: &mut dyn Observer) -> Result<(), ()> {
+                self.0.accept(info, o)
+            }
+        }
+        let bounds = StepBounds {
+            initial: 0.005,
+            min: 1e-6,
+            max: 1.0,
+        };
+        let mut c = StepController::new(bounds, 1.0);
+        let mut s = Jump(Scalar::new(1.0, Some(0.01)), 0);
+        let mut sizes = Vec::new();
+        while let Ok(Advance::Accepted(i)) = c.advance(&mut s, &mut crate::analysis::NoObserver) {
+            sizes.push(i.step);
+        }
+        let tried = &s.0.sizes;
+        assert_eq!(c.counts().error_rejections, 1, "{tried:?}");
+        // attempt 30 rejected, 31 accepted, 32 not larger than 31
+        assert!(tried[30] < tried[29]);
+        assert!(tried[31] <= tried[30], "{tried:?}");
     }
 
     /// `x = t²` crosses 0.3 at `t = √0.3`: the step across it is rejected

@@ -149,18 +149,20 @@ pub struct DynamicSettings {
 }
 
 impl DynamicSettings {
-    /// Settings from 0 (or the start state's time) to `end_time` with
-    /// steps of `time_step`, adaptive, and every other value at its
-    /// default (docs/model-format.md): `min_step = time_step·1e-6`,
-    /// `max_step = time_step·100` (at most the span), `ρ∞ = 0.9`, error
-    /// tolerance 1e-4, 25 iterations, tolerances 1e-8 / 1e-6 / 1e-6,
-    /// output every step.
+    /// Settings from 0 to `end_time` with steps of `time_step`, adaptive,
+    /// and every other value at its default, as a model file gives them
+    /// (docs/model-format.md): `min_step = time_step·1e-6`,
+    /// `max_step` = a tenth of the span (here `end_time`, the span from
+    /// 0), or `time_step` if larger ([`default_max_step`]), `ρ∞ = 0.9`,
+    /// error tolerance 1e-4, 25 iterations, tolerances 1e-8 / 1e-6 /
+    /// 1e-6, output every step. An analysis that starts later than 0 sets
+    /// `max_step` from its own span.
     pub fn new(end_time: f64, time_step: f64) -> Self {
         Self {
             end_time,
             time_step,
             min_step: time_step * 1e-6,
-            max_step: time_step * 100.0,
+            max_step: default_max_step(end_time, time_step),
             rho_infinity: DEFAULT_RHO_INFINITY,
             adaptive: true,
             error_tolerance: DEFAULT_ERROR_TOLERANCE,
@@ -191,6 +193,14 @@ impl DynamicSettings {
         self.error_tolerance = tol;
         self
     }
+}
+
+/// Default largest step of an adaptive dynamic analysis over `span` whose
+/// first step is `time_step`: a tenth of the span, so that the error
+/// estimate sees the motion at least ten times, or `time_step` if that is
+/// larger (a first step the user asked for is never above the largest).
+pub fn default_max_step(span: f64, time_step: f64) -> f64 {
+    (span / 10.0).max(time_step)
 }
 
 /// Default `ρ∞`: 0.9 damps the spurious high frequencies of stiff members

@@ -4,7 +4,7 @@
 use super::{
     num, Checker, LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MIN_RELATIVE_INCREMENT,
 };
-use crate::analysis::settings::{DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
+use crate::analysis::settings::{default_max_step, DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
 use crate::analysis::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
 use crate::eigen::Method;
 use crate::model::input::{Analyses, AnalysisInput, ModelInput};
@@ -490,9 +490,11 @@ fn dynamic_settings(
         end_time: end,
         time_step,
         min_step: a.min_step.unwrap_or(time_step * 1e-6),
-        max_step: a
-            .max_step
-            .unwrap_or(if adaptive { span / 10.0 } else { time_step }),
+        max_step: a.max_step.unwrap_or(if adaptive {
+            default_max_step(span, time_step)
+        } else {
+            time_step
+        }),
         rho_infinity: a.rho_infinity.unwrap_or(DEFAULT_RHO_INFINITY),
         adaptive,
         error_tolerance: a.error_tolerance.unwrap_or(DEFAULT_ERROR_TOLERANCE),

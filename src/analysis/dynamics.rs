@@ -287,6 +287,8 @@ struct Run {
     mass_scale: [f64; 2],
     /// The matrices of the constrained mass system (D9, D13).
     mass_system: MassSystem,
+    /// The span of the analysis, `end_time − t₀` (D13).
+    span: f64,
     redundant: usize,
     /// The unknown with the largest residual at the last failed attempt.
     location: String,
@@ -495,6 +497,7 @@ impl DynamicAnalysis {
             energies: Energies::default(),
             mass_scale: [0.0; 2],
             mass_system: MassSystem::default(),
+            span: (s.end_time - t0).abs(),
             redundant: 0,
             location: String::new(),
             locks: Vec::new(),
@@ -831,21 +834,26 @@ fn moved(model: &Model, state: &State, e: f64) -> State {
 /// The time step of the differences of D9–D10: the motion over it is
 /// [`MOTION_STEP`] of the model's size, or of the span of the analysis.
 fn motion_step(model: &Model, state: &State, end_time: f64) -> f64 {
+    MOTION_STEP * motion_time(model, state, (end_time - state.time).abs())
+}
+
+/// The time for the fastest node to cover the model's size, for the
+/// fastest spin to turn one radian, or `span`, whichever is shortest.
+fn motion_time(model: &Model, state: &State, span: f64) -> f64 {
     let l = model.length_scale;
     let (mut v, mut w) = (0.0f64, 0.0f64);
     for r in &state.velocity {
         v = v.max(Vec3::new(r[0], r[1], r[2]).norm());
         w = w.max(Vec3::new(r[3], r[4], r[5]).norm());
     }
-    let span = (end_time - state.time).abs().max(f64::MIN_POSITIVE);
-    let mut e = span;
+    let mut e = span.max(f64::MIN_POSITIVE);
     if v > 0.0 {
         e = e.min(l / v);
     }
     if w > 0.0 {
         e = e.min(1.0 / w);
     }
-    MOTION_STEP * e
+    e
 }
 
 /// The multiplier rows of the residual (`−kΦ`) at `state`, by dof.
@@ -891,14 +899,10 @@ pub(super) fn constraint_rates(
 }
 
 /// `−k Φ̇` of the multiplier rows along the motion, by one central
-/// difference over [`PROJECTION_STEP`] of the motion step (D13).
-fn constraint_rate(
-    model: &Model,
-    solver: &mut NewtonSolver,
-    state: &State,
-    end_time: f64,
-) -> Vec<f64> {
-    let e = PROJECTION_STEP / MOTION_STEP * motion_step(model, state, end_time);
+/// difference over [`PROJECTION_STEP`] of the motion time (with the span
+/// of the whole analysis, `span`, for a model at rest) (D13).
+fn constraint_rate(model: &Model, solver: &mut NewtonSolver, state: &State, span: f64) -> Vec<f64> {
+    let e = PROJECTION_STEP * motion_time(model, state, span);
     let rp = constraint_residual(model, solver, &moved(model, state, e));
     let rm = constraint_residual(model, solver, &moved(model, state, -e));
     rp.iter()
@@ -1320,7 +1324,7 @@ impl Dynamics<'_> {
             return Ok(());
         }
         let state = &mut run.state;
-        let rate = constraint_rate(model, self.solver, state, self.settings.end_time);
+        let rate = constraint_rate(model, self.solver, state, run.span);
         let (_, s_eq) = constrained_mass_system(model, self.solver, state, &mut run.mass_system)?;
         let dofs = &self.solver.dofs;
         let rhs = &mut run.work.rhs;

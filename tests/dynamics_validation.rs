@@ -525,13 +525,6 @@ fn four_bar(end: f64, h: f64, rho: f64) -> (f64, f64, f64, f64) {
         for r in rates {
             rate = rate.max(r.norm());
         }
-        if std::env::var("PROBE").is_ok() && ((s.time * 1000.0).round() as i64) % 500 == 0 {
-            eprintln!(
-                "PROBE t={:.3} rates {:?}",
-                s.time,
-                rates.iter().map(|r| r.norm()).collect::<Vec<_>>()
-            );
-        }
         // T + V from the state: ½ m|v|² + ½ Ω·J Ω − m g·x
         let mut kinetic = 0.0;
         let mut potential = 0.0;

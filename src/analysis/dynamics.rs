@@ -8,7 +8,7 @@
 //! ```
 //!
 //! with the joints' augmented Lagrangian (docs/theory.md §15, equation
-//! labels D1–D12 there):
+//! labels D1–D13 there):
 //! - parameters from the spectral radius `ρ∞` (D1);
 //! - the step `q_{n+1} = q_n ∘ exp(h Δq_n)` on the nodes' group, with
 //!   the velocity, acceleration and pseudo-acceleration updates (D2–D4),
@@ -21,7 +21,10 @@
 //!   velocities checked against the constraints (D10);
 //! - a local error estimate `(β − 1/6) h² (a_{n+1} − a_n)` for the step
 //!   controller (D11);
-//! - the energy balance of every step ([`super::energy`], D12).
+//! - the energy balance of every step ([`super::energy`], D12);
+//! - at `ρ∞ ≥ 0.99`, the projection of the converged velocities on the
+//!   velocity constraints, which keeps the undamped parasitic modes of the
+//!   index-3 constraints from growing (D13).
 //!
 //! Node velocities are `(ẋ, Ω)`, `ẋ` global and `Ω` material, as in the
 //! inertia kernels (docs/theory.md §11.1). Multipliers are kept in the

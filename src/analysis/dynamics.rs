@@ -8,7 +8,7 @@
 //! ```
 //!
 //! with the joints' augmented Lagrangian (docs/theory.md §15, equation
-//! labels D1–D12 there):
+//! labels D1–D13 there):
 //! - parameters from the spectral radius `ρ∞` (D1);
 //! - the step `q_{n+1} = q_n ∘ exp(h Δq_n)` on the nodes' group, with
 //!   the velocity, acceleration and pseudo-acceleration updates (D2–D4),
@@ -21,7 +21,10 @@
 //!   velocities checked against the constraints (D10);
 //! - a local error estimate `(β − 1/6) h² (a_{n+1} − a_n)` for the step
 //!   controller (D11);
-//! - the energy balance of every step ([`super::energy`], D12).
+//! - the energy balance of every step ([`super::energy`], D12);
+//! - at `ρ∞ ≥ 0.99`, the projection of the converged velocities on the
+//!   velocity constraints, which keeps the undamped parasitic modes of the
+//!   index-3 constraints from growing (D13).
 //!
 //! Node velocities are `(ẋ, Ω)`, `ẋ` global and `Ω` material, as in the
 //! inertia kernels (docs/theory.md §11.1). Multipliers are kept in the
@@ -75,6 +78,19 @@ const MASSLESS: f64 = 1e-12;
 /// ~1e-12 and the round-off ~1e-10 of the derivatives.
 const MOTION_STEP: f64 = 1e-3;
 
+/// Relative step of the central difference that gives `Φ̇` for the
+/// velocity projection (D13): the motion over the step is 1e-5 of the
+/// model's size, the truncation error `e²Φ⃛/6` ~2e-11 and the round-off
+/// `ε/1e-5` ~2e-11 of the velocities.
+const PROJECTION_STEP: f64 = 1e-5;
+
+/// The spectral radius from which the velocities are projected on the
+/// velocity constraints after each step (D13). Below it, the parasitic
+/// modes of the index-3 constraints decay as `ρ∞ⁿ` (their growth
+/// `n ρ∞ⁿ` peaks below 37 at `ρ∞ = 0.99`); at `ρ∞ = 1` they grow as `n`
+/// and stop the analysis.
+pub const PROJECTION_RHO: f64 = 0.99;
+
 /// Initial velocities whose constraint rates exceed this fraction of the
 /// velocity scale violate the joints (D10).
 const VELOCITY_TOLERANCE: f64 = 1e-6;
@@ -116,6 +132,14 @@ impl GeneralizedAlpha {
     /// `β′ = (1 − α_m)/((1 − α_f) β h²)`: `δv̇ = β′ x` (D6).
     pub fn beta_prime(&self, h: f64) -> f64 {
         (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * h * h)
+    }
+
+    /// Whether the converged velocities of each step are projected on the
+    /// velocity constraints (D13): for `ρ∞ ≥` [`PROJECTION_RHO`], where the
+    /// parasitic modes of the index-3 constraints are not damped
+    /// (`ρ∞ = α_f/(1 − α_f)`).
+    pub fn projects_velocities(&self) -> bool {
+        self.alpha_f / (1.0 - self.alpha_f) >= PROJECTION_RHO
     }
 
     /// `γ′ = γ/(β h)`: `δv = γ′ x` (D6).
@@ -264,6 +288,10 @@ struct Run {
     /// Largest diagonal mass of translations and of rotations (`m_scale`
     /// of D8).
     mass_scale: [f64; 2],
+    /// The matrices of the constrained mass system (D9, D13).
+    mass_system: MassSystem,
+    /// The span of the analysis, `end_time − t₀` (D13).
+    span: f64,
     redundant: usize,
     /// The unknown with the largest residual at the last failed attempt.
     location: String,
@@ -317,6 +345,14 @@ impl Work {
         self.rhs.clear();
         self.rhs.resize(dofs.n_equations(), 0.0);
     }
+}
+
+/// The stiffness and the mass matrix of the constrained mass system (D9,
+/// D13), kept from one step to the next while the pattern is unchanged.
+#[derive(Default)]
+struct MassSystem {
+    stiffness: Option<SparseMatrix>,
+    mass: Option<SparseMatrix>,
 }
 
 /// The scale factors `s` of distance and angle constraints (D8): rows
@@ -463,6 +499,8 @@ impl DynamicAnalysis {
                 }),
             energies: Energies::default(),
             mass_scale: [0.0; 2],
+            mass_system: MassSystem::default(),
+            span: (s.end_time - t0).abs(),
             redundant: 0,
             location: String::new(),
             locks: Vec::new(),
@@ -799,21 +837,26 @@ fn moved(model: &Model, state: &State, e: f64) -> State {
 /// The time step of the differences of D9–D10: the motion over it is
 /// [`MOTION_STEP`] of the model's size, or of the span of the analysis.
 fn motion_step(model: &Model, state: &State, end_time: f64) -> f64 {
+    MOTION_STEP * motion_time(model, state, (end_time - state.time).abs())
+}
+
+/// The time for the fastest node to cover the model's size, for the
+/// fastest spin to turn one radian, or `span`, whichever is shortest.
+fn motion_time(model: &Model, state: &State, span: f64) -> f64 {
     let l = model.length_scale;
     let (mut v, mut w) = (0.0f64, 0.0f64);
     for r in &state.velocity {
         v = v.max(Vec3::new(r[0], r[1], r[2]).norm());
         w = w.max(Vec3::new(r[3], r[4], r[5]).norm());
     }
-    let span = (end_time - state.time).abs().max(f64::MIN_POSITIVE);
-    let mut e = span;
+    let mut e = span.max(f64::MIN_POSITIVE);
     if v > 0.0 {
         e = e.min(l / v);
     }
     if w > 0.0 {
         e = e.min(1.0 / w);
     }
-    MOTION_STEP * e
+    e
 }
 
 /// The multiplier rows of the residual (`−kΦ`) at `state`, by dof.
@@ -856,6 +899,19 @@ pub(super) fn constraint_rates(
         rich(&diffs[0].0, &diffs[1].0),
         rich(&diffs[0].1, &diffs[1].1),
     )
+}
+
+/// `−k Φ̇` of the multiplier rows along the motion, by one central
+/// difference over [`PROJECTION_STEP`] of the motion time (with the span
+/// of the whole analysis, `span`, for a model at rest) (D13).
+fn constraint_rate(model: &Model, solver: &mut NewtonSolver, state: &State, span: f64) -> Vec<f64> {
+    let e = PROJECTION_STEP * motion_time(model, state, span);
+    let rp = constraint_residual(model, solver, &moved(model, state, e));
+    let rm = constraint_residual(model, solver, &moved(model, state, -e));
+    rp.iter()
+        .zip(&rm)
+        .map(|(p, m)| (p - m) / (2.0 * e))
+        .collect()
 }
 
 /// D10: the initial velocities must satisfy `Φ̇ = B v + ∂Φ/∂t = 0`, to
@@ -913,6 +969,130 @@ fn constraint_name(model: &Model, solver: &NewtonSolver, dof: usize) -> String {
     solver.dof_label(model, dof)
 }
 
+/// The matrix of the constrained mass system at `state`,
+///
+/// ```text
+/// [ M    −kBᵀ ]
+/// [ −kB   0   ]
+/// ```
+///
+/// with the rows of unknowns without mass taken from `K + M` instead of
+/// `M`, and the multiplier rows and columns scaled by `m_s/k` (D8 with
+/// `β′ = 1`, without the lower bound 1), left in the solver's matrix: the
+/// matrix of the initial accelerations (D9) and of the velocity projection
+/// (D13). Returns the mass scales `m_s` of translations and rotations and
+/// the scale of each equation.
+fn constrained_mass_system(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    state: &State,
+    buffers: &mut MassSystem,
+) -> Result<([f64; 2], Vec<f64>), NewtonFailure> {
+    let t = state.time;
+    let (dofs, assembler, _) = solver.system();
+    let same = |m: &SparseMatrix| {
+        m.dim() == assembler.matrix.dim()
+            && m.nnz() == assembler.matrix.nnz()
+            && m.row_indices() == assembler.matrix.row_indices()
+    };
+    if !buffers.stiffness.as_ref().is_some_and(same) {
+        buffers.stiffness = Some(assembler.matrix.clone());
+        buffers.mass = Some(assembler.matrix.clone());
+    }
+    let (stiffness, mass) = (
+        buffers.stiffness.as_mut().expect("set above"),
+        buffers.mass.as_mut().expect("set above"),
+    );
+    let ctx = EvalContext {
+        dynamics: true,
+        ..model.context(t, Need::with_inertia(0.0, 1.0))
+    };
+    assembler.assemble_split(model, &ctx, state, stiffness, mass);
+    if !assembler.residual.iter().all(|r| r.is_finite()) {
+        return Err(NewtonFailure::NonFinite {
+            iteration: 0,
+            origin: non_finite_origin(model, state, t),
+        });
+    }
+
+    // mass scales and the massless rows
+    let n = dofs.n_equations();
+    let mut diagonal = vec![0.0; n];
+    for (row, col, v) in mass.entries() {
+        if row == col {
+            diagonal[row] = v;
+        }
+    }
+    let mut scale = [0.0f64; 2];
+    for (eq, &m) in diagonal.iter().enumerate() {
+        match dofs.equation_kind(eq) {
+            DofKind::Translation | DofKind::Coordinate { .. } => scale[0] = scale[0].max(m),
+            DofKind::Rotation => scale[1] = scale[1].max(m),
+            DofKind::Multiplier(_) => {}
+        }
+    }
+    let massless = |eq: usize| match dofs.equation_kind(eq) {
+        DofKind::Translation | DofKind::Coordinate { .. } => diagonal[eq] <= MASSLESS * scale[0],
+        DofKind::Rotation => diagonal[eq] <= MASSLESS * scale[1],
+        DofKind::Multiplier(_) => false,
+    };
+    let is_multiplier: Vec<bool> = (0..n)
+        .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
+        .collect();
+    let light: Vec<bool> = (0..n).map(massless).collect();
+    // multiplier rows and columns scaled to the mass (D8 with β′ = 1)
+    let s_eq: Vec<f64> = (0..n)
+        .map(|eq| match dofs.equation_kind(eq) {
+            DofKind::Multiplier(kind) => {
+                let (m, k) = match kind {
+                    ConstraintKind::Distance => (scale[0], model.scaling.force.0),
+                    ConstraintKind::Angle => (scale[1], model.scaling.moment.0),
+                };
+                if m > 0.0 {
+                    m / k
+                } else {
+                    1.0
+                }
+            }
+            _ => 1.0,
+        })
+        .collect();
+    let values = assembler.matrix.values_mut();
+    let (k, m) = (stiffness.values(), mass.values());
+    for (i, (row, col, _)) in stiffness.entries().enumerate() {
+        let v = if is_multiplier[row] || is_multiplier[col] || light[row] {
+            k[i] + m[i]
+        } else {
+            m[i]
+        };
+        values[i] = v * s_eq[row] * s_eq[col];
+    }
+    Ok((scale, s_eq))
+}
+
+/// Solves the constrained mass system left in the solver's matrix by
+/// [`constrained_mass_system`] for the right-hand side `rhs` (in place).
+fn solve_mass_system(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    state: &State,
+    rhs: &mut [f64],
+) -> Result<(), NewtonFailure> {
+    let (_, assembler, lu) = solver.system();
+    let solved = (|| {
+        if lu.is_none() {
+            *lu = Some(SparseLu::analyze(&assembler.matrix)?);
+        }
+        let lu = lu.as_mut().expect("analysed above");
+        lu.factor(&assembler.matrix)?;
+        lu.solve_in_place(rhs)
+    })();
+    if solved.is_err() || !rhs.iter().all(|v| v.is_finite()) {
+        return Err(singular(model, solver, state, 0));
+    }
+    Ok(())
+}
+
 /// D9: consistent initial accelerations and multipliers. Solves
 ///
 /// ```text
@@ -940,98 +1120,20 @@ fn initial_accelerations(
     } else {
         Vec::new()
     };
-    let (dofs, assembler, lu) = solver.system();
-    let mut stiffness = assembler.matrix.clone();
-    let mut mass = assembler.matrix.clone();
-    let ctx = EvalContext {
-        dynamics: true,
-        ..model.context(t0, Need::with_inertia(0.0, 1.0))
-    };
-    assembler.assemble_split(model, &ctx, state, &mut stiffness, &mut mass);
-    if !assembler.residual.iter().all(|r| r.is_finite()) {
-        return Err(NewtonFailure::NonFinite {
-            iteration: 0,
-            origin: non_finite_origin(model, state, t0),
-        });
-    }
-
-    // mass scales and the massless rows
-    let n = dofs.n_equations();
-    let mut diagonal = vec![0.0; n];
-    for (row, col, v) in mass.entries() {
-        if row == col {
-            diagonal[row] = v;
-        }
-    }
-    let mut scale = [0.0f64; 2];
-    for (eq, &m) in diagonal.iter().enumerate() {
-        match dofs.equation_kind(eq) {
-            DofKind::Translation | DofKind::Coordinate { .. } => scale[0] = scale[0].max(m),
-            DofKind::Rotation => scale[1] = scale[1].max(m),
-            DofKind::Multiplier(_) => {}
-        }
-    }
+    let (scale, s_eq) = constrained_mass_system(model, solver, state, &mut run.mass_system)?;
     run.mass_scale = scale;
-    let massless = |eq: usize| match dofs.equation_kind(eq) {
-        DofKind::Translation | DofKind::Coordinate { .. } => diagonal[eq] <= MASSLESS * scale[0],
-        DofKind::Rotation => diagonal[eq] <= MASSLESS * scale[1],
-        DofKind::Multiplier(_) => false,
-    };
-    let is_multiplier: Vec<bool> = (0..n)
-        .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
-        .collect();
-    let light: Vec<bool> = (0..n).map(massless).collect();
-    // multiplier rows and columns scaled to the mass (D8 with β′ = 1)
-    let s_eq: Vec<f64> = (0..n)
-        .map(|eq| match dofs.equation_kind(eq) {
-            DofKind::Multiplier(kind) => {
-                let (m, k) = match kind {
-                    ConstraintKind::Distance => (scale[0], model.scaling.force.0),
-                    ConstraintKind::Angle => (scale[1], model.scaling.moment.0),
-                };
-                if m > 0.0 {
-                    m / k
-                } else {
-                    1.0
-                }
-            }
-            _ => 1.0,
-        })
-        .collect();
-    let dof_of: Vec<usize> = (0..n).map(|eq| dofs.dof(eq)).collect();
-    {
-        let values = assembler.matrix.values_mut();
-        let (k, m) = (stiffness.values(), mass.values());
-        for (i, (row, col, _)) in stiffness.entries().enumerate() {
-            let v = if is_multiplier[row] || is_multiplier[col] || light[row] {
-                k[i] + m[i]
-            } else {
-                m[i]
-            };
-            values[i] = v * s_eq[row] * s_eq[col];
-        }
-    }
-    let mut rhs: Vec<f64> = (0..n)
+    let (dofs, assembler, _) = solver.system();
+    let mut rhs: Vec<f64> = (0..dofs.n_equations())
         .map(|eq| {
-            let d = dof_of[eq];
-            if is_multiplier[eq] {
+            let d = dofs.dof(eq);
+            if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
                 -second[d] * s_eq[eq]
             } else {
                 -assembler.residual[d]
             }
         })
         .collect();
-    let solved = (|| {
-        if lu.is_none() {
-            *lu = Some(SparseLu::analyze(&assembler.matrix)?);
-        }
-        let lu = lu.as_mut().expect("analysed above");
-        lu.factor(&assembler.matrix)?;
-        lu.solve_in_place(&mut rhs)
-    })();
-    if solved.is_err() || !rhs.iter().all(|v| v.is_finite()) {
-        return Err(singular(model, solver, state, 0));
-    }
+    solve_mass_system(model, solver, state, &mut rhs)?;
     let (dofs, _, _) = solver.system();
     for (eq, z) in rhs.iter().enumerate() {
         let d = dofs.dof(eq);
@@ -1206,6 +1308,54 @@ impl Dynamics<'_> {
             }
         }
         self.place(h);
+    }
+
+    /// D13: projects the converged velocities on the velocity constraints
+    /// `Φ̇ = B v + ∂Φ/∂t = 0` in the metric of the mass,
+    ///
+    /// ```text
+    /// [ M    −kBᵀ ] [ δv ]     [ 0     ]
+    /// [ −kB   0   ] [ μ  ] = − [ −k Φ̇  ]
+    /// ```
+    ///
+    /// (the matrix of D9), then assembles the residual again at the
+    /// projected state for the observer (reactions, energy balance).
+    fn project_velocities(&mut self) -> Result<(), NewtonFailure> {
+        let (model, run) = (self.model, &mut *self.run);
+        let dofs = &self.solver.dofs;
+        if dofs.first_multiplier() == dofs.n_dofs() {
+            return Ok(());
+        }
+        let state = &mut run.state;
+        let rate = constraint_rate(model, self.solver, state, run.span);
+        let (_, s_eq) = constrained_mass_system(model, self.solver, state, &mut run.mass_system)?;
+        let dofs = &self.solver.dofs;
+        let rhs = &mut run.work.rhs;
+        rhs.clear();
+        rhs.extend((0..dofs.n_equations()).map(|eq| {
+            if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
+                -rate[dofs.dof(eq)] * s_eq[eq]
+            } else {
+                0.0
+            }
+        }));
+        solve_mass_system(model, self.solver, state, rhs)?;
+        let dofs = &self.solver.dofs;
+        for (eq, z) in rhs.iter().enumerate() {
+            let d = dofs.dof(eq);
+            if let Some((node, c)) = dofs.node_component(d) {
+                state.velocity[node][c] += z;
+            } else if d < dofs.first_multiplier() {
+                state.coordinate_rates[d - dofs.first_coordinate()] += z;
+            }
+        }
+        let (_, assembler, _) = self.solver.system();
+        let ctx = EvalContext {
+            dynamics: true,
+            ..model.context(state.time, Need::RESIDUAL)
+        };
+        assembler.assemble(model, &ctx, state);
+        Ok(())
     }
 
     /// Largest translation and rotation of the step, `h|Δq|`.
@@ -1634,7 +1784,15 @@ impl Stepper for Dynamics<'_> {
         increment: usize,
         observer: &mut dyn Observer,
     ) -> Attempt {
-        match self.newton(size, increment, observer) {
+        match self
+            .newton(size, increment, observer)
+            .and_then(|converged| {
+                if self.scheme.projects_velocities() {
+                    self.project_velocities().map(|()| converged)
+                } else {
+                    Ok(converged)
+                }
+            }) {
             Ok((iterations, residuals)) => Attempt::Converged {
                 iterations,
                 residuals,

@@ -565,7 +565,7 @@ pub fn stop_watch(model: &Model, stop: &Stop, state: &State) -> f64 {
         stop.gap(state).0 / gap_tolerance(model, stop)
     } else {
         let ctx = model.context(state.time, Need::RESIDUAL);
-        stop.watched_load(&ctx, state) / load_tolerance(model, stop, state)
+        stop.load(&ctx, state) / load_tolerance(model, stop, state)
     }
 }
 
@@ -673,7 +673,7 @@ pub fn stop_events_at(
         let ctx = model.context(time, Need::RESIDUAL);
         if s.contact(state) != Contact::Open
             && s.contact(before) != Contact::Open
-            && s.watched_load_from(&ctx, state, before) <= load_tolerance(model, s, before)
+            && s.load(&ctx, state) <= load_tolerance(model, s, before)
         {
             let (rate, _) = s.rate(state);
             events.push(ContactInfo {

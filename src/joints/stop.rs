@@ -10,7 +10,8 @@
 //! reversed and scaled by `e`. When the rebound rate is too slow to leave
 //! the event band (below `√(2 g_tol |c̈|)`, docs/theory.md §16.4) the
 //! impact is made plastic and the stop closes: it is then the constraint
-//! `Φ = c − c_lim = 0` with its multiplier, whose load `N` (the contact
+//! `Φ = c − c_c = 0` (`c_c` where it closed, within the event tolerance of
+//! the limit) with its multiplier, whose load `N` (the contact
 //! force or moment, positive pushing the coordinate back into its range)
 //! is watched in turn; the stop opens again when `N` falls to zero.
 //!
@@ -94,7 +95,7 @@ pub struct Stop {
 const CONTACT: usize = 0;
 const EVENTS: usize = 1;
 const LOAD_SCALE: usize = 2;
-const LAST_LOAD: usize = 3;
+const CLOSED_AT: usize = 3;
 
 impl Stop {
     /// Limits `source`, a coordinate of joint `joint`, to
@@ -163,8 +164,12 @@ impl Stop {
             .map_or(Contact::Open, |&c| Contact::of_code(c))
     }
 
-    /// Sets its contact in `state` and counts the event.
+    /// Sets its contact in `state` and counts the event. A stop that
+    /// closes holds the coordinate where it is, within the event tolerance
+    /// of its limit (see [`Self::held_value`]).
     pub fn set_contact(&self, state: &mut State, contact: Contact) {
+        let c = self.coordinate(state);
+        state.internal[self.slot(CLOSED_AT)] = if contact == Contact::Open { 0.0 } else { c };
         state.internal[self.slot(CONTACT)] = contact.code();
         let events = self.slot(EVENTS);
         state.internal[events] = if state.internal[events] > 0.5 {
@@ -173,7 +178,6 @@ impl Stop {
             1.0
         };
         state.internal[self.slot(LOAD_SCALE)] = 0.0;
-        state.internal[self.slot(LAST_LOAD)] = 0.0;
     }
 
     /// Opens it in `state` without counting an event (the impact that
@@ -181,7 +185,6 @@ impl Stop {
     pub fn reopen(&self, state: &mut State) {
         state.internal[self.slot(CONTACT)] = Contact::Open.code();
         state.internal[self.slot(LOAD_SCALE)] = 0.0;
-        state.internal[self.slot(LAST_LOAD)] = 0.0;
     }
 
     /// `(−1)ⁿ`, `n` the number of its events so far: the sign of its event
@@ -210,30 +213,6 @@ impl Stop {
             .unwrap_or(0.0)
     }
 
-    /// The contact load watched for the release: the mean of `N` at
-    /// `state` and at the last accepted step in contact,
-    /// `½ (N_n + N_{n−1})` (`N` alone on the first step after the stop
-    /// closed). The multiplier of index-3 generalised-α carries a parasitic
-    /// oscillation of period two steps (amplification `−ρ∞`) after each
-    /// restart of the integrator and change of step size, which the mean of
-    /// consecutive steps filters out; without it a contact at rest could
-    /// open on a spurious sign change of `N` (docs/theory.md §16.4).
-    pub fn watched_load(&self, ctx: &EvalContext, state: &State) -> f64 {
-        self.watched_load_from(ctx, state, state)
-    }
-
-    /// [`Self::watched_load`] at `state` with the load of the last
-    /// accepted step read in `memory` (the accepted state, once `state`'s
-    /// internal variables have been updated).
-    pub fn watched_load_from(&self, ctx: &EvalContext, state: &State, memory: &State) -> f64 {
-        let n = self.load(ctx, state);
-        if self.load_scale(memory) > 0.0 {
-            0.5 * (n + memory.internal[self.slot(LAST_LOAD)])
-        } else {
-            n
-        }
-    }
-
     fn reference(&self, state: &State) -> f64 {
         if self.source.is_angle() {
             state.internal[self.offsets.internal]
@@ -260,6 +239,15 @@ impl Stop {
         }
     }
 
+    /// The value `c_c` a closed stop holds the coordinate at: where the
+    /// step that closed it landed, within the event tolerance of the limit
+    /// (holding the limit itself would pull the coordinate across the
+    /// remaining gap within the next step, with a load of the order of
+    /// `m g_tol/h²` that may open the contact again).
+    pub fn held_value(&self, state: &State) -> f64 {
+        state.internal[self.slot(CLOSED_AT)]
+    }
+
     /// The value of the limit of `contact`.
     pub fn limit(&self, contact: Contact) -> f64 {
         match contact {
@@ -276,7 +264,7 @@ impl Stop {
             return 0.0;
         }
         let (k, p) = self.scaling(ctx);
-        let phi = self.coordinate(state) - self.limit(contact);
+        let phi = self.coordinate(state) - self.held_value(state);
         // generalised load along the coordinate: −(pΦ − kλ)
         contact.side() * (k * state.multipliers[self.offsets.multipliers] - p * phi)
     }
@@ -329,8 +317,8 @@ impl Element for Stop {
         1
     }
     /// The unwrapped angle (angles only), the contact, the parity of the
-    /// number of events, the largest load carried, the load at the last
-    /// accepted step.
+    /// number of events, the largest load carried, the coordinate where
+    /// it closed.
     fn n_internal(&self) -> usize {
         usize::from(self.source.is_angle()) + 4
     }
@@ -358,9 +346,9 @@ impl Element for Stop {
             }
             return;
         }
-        // closed: Φ = c(q) − c_lim
+        // closed: Φ = c(q) − c_c
         let c = self.source.function(self.reference(state));
-        let value = self.limit(contact);
+        let value = self.held_value(state);
         let phi = |conf: &Conf, o: &mut [HyperDual]| {
             c(conf, o);
             o[0] = o[0] + (-value);
@@ -389,9 +377,8 @@ impl Element for Stop {
             internal[0] = self.source.value(state, internal[0]);
         }
         if self.contact(state) != Contact::Open {
-            let n = self.load(ctx, state);
-            internal[first + LOAD_SCALE] = internal[first + LOAD_SCALE].max(n.abs());
-            internal[first + LAST_LOAD] = n;
+            let n = self.load(ctx, state).abs();
+            internal[first + LOAD_SCALE] = internal[first + LOAD_SCALE].max(n);
         }
     }
     fn result_names(&self) -> &'static [&'static str] {

@@ -493,3 +493,44 @@ fn stop_input_errors_name_the_stop() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The builder writes `[[stops]]`; the stop's results in the reference
+/// configuration: open, the gap to the nearer limit.
+#[test]
+fn the_builder_writes_the_stop_entry() {
+    use unfold::elements::ElementKind;
+    use unfold::model::builder::*;
+    let mut m = ModelBuilder::new("hinge with stops");
+    let a = m.node([-0.5, 0.0, 0.0]);
+    let b = m.node([0.0, -0.5, 0.0]);
+    m.add(RigidBody::at(a, 2.0).inertia([0.1, 0.1, 0.1]));
+    m.add(RigidBody::at(b, 1.0).inertia([0.1, 0.1, 0.1]));
+    m.fix(a, Dofs::ALL);
+    let hinge = m.add(
+        Joint::revolute(a, b)
+            .axis([0.0, 0.0, 1.0])
+            .at([0.0, 0.0, 0.0]),
+    );
+    let stop = m.add(
+        Stop::on(hinge)
+            .lower(-10.0)
+            .upper(95.0)
+            .unit(AngleUnit::Deg)
+            .restitution(0.3),
+    );
+    let model = m.build().unwrap();
+    assert_eq!(model.element(stop).kind(), ElementKind::Stop);
+    let r = model.results(stop, &model.initial_state());
+    assert_eq!(r.get("contact"), Some(0.0));
+    assert_eq!(r.get("load"), Some(0.0));
+    // c = 0: the nearer limit is −10°, 10° away (round-off)
+    assert!((r.get("gap").unwrap() - 10f64.to_radians()).abs() < 1e-12);
+    let text = m.to_toml().unwrap();
+    assert!(
+        text.contains("[[stops]]") && text.contains("restitution = 0.3"),
+        "{text}"
+    );
+    let input: ModelInput = toml::from_str(&text).unwrap();
+    assert_eq!(input.stops.len(), 1);
+    assert!(Model::from_input(&input).is_ok());
+}

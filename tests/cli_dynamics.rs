@@ -738,4 +738,105 @@ unit = "deg"
     // √(k/J_O), J_O = 1/12 + 0.5² = 1/3 kg·m²: to round-off of the solver
     assert!((num(&modes[0], "omega_rad_s") - 6f64.sqrt()).abs() < 1e-9);
     assert_eq!(summary(&out)["status"], "completed");
+
+/// The header of `events.csv` (docs/results.md).
+const EVENTS_HEADER: &str =
+    "step,increment,time,element,kind,joint,coordinate,rate_before,rate_after,impulse,energy_lost";
+
+/// The lock of the latched panels is one row of `events.csv`, on the step
+/// where `latches.csv` first shows the latch locked, and is counted in
+/// `summary.json`.
+#[test]
+fn events_csv_lists_the_lock_of_a_latch() {
+    let dir = scratch("events-latch");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/latched_panels.toml");
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(out.join("events.csv")).unwrap();
+    assert_eq!(text.lines().next(), Some(EVENTS_HEADER));
+    let events = table(&out.join("events.csv"));
+    assert_eq!(events.len(), 1, "{text}");
+    let e = &events[0];
+    assert_eq!(e["kind"], "lock");
+    assert_eq!(e["element"], "20");
+    assert_eq!(e["joint"], "10");
+    let latches = table(&out.join("latches.csv"));
+    let first = latches
+        .iter()
+        .find(|r| num(r, "locked") == 1.0)
+        .expect("the latch locks");
+    assert_eq!(e["step"], first["step"]);
+    // the same time (to the digits of each file, 1e-10 relative)
+    assert!((num(e, "time") - num(first, "time")).abs() <= 1e-10 * num(e, "time"));
+    // at the locking angle (90°, within the event tolerance 1e-8 rad)
+    assert!((num(e, "coordinate") - std::f64::consts::FRAC_PI_2).abs() <= 1e-8);
+    assert!(num(e, "rate_before") > 0.0 && num(e, "rate_after") == 0.0);
+    assert!(num(e, "impulse") < 0.0 && num(e, "energy_lost") > 0.0);
+    let s = summary(&out);
+    let d = &s["analyses"][0]["dynamic"];
+    assert_eq!(d["locks"], 1, "{d}");
+    assert_eq!(d["impacts"], 0, "{d}");
+    assert_eq!(d["contacts_closed"], 0, "{d}");
+    assert_eq!(d["contacts_released"], 0, "{d}");
+}
+
+/// The pendulum falls from the horizontal onto a stop at −60° with
+/// restitution 0.5: rebounds (`impact` rows, the rate reversed and halved)
+/// until the rebound is too slow, then rests (`contact`); the counts in
+/// `summary.json` match the rows. Without the stop (and without any
+/// event), `events.csv` holds its header alone.
+#[test]
+fn events_csv_lists_the_impacts_of_a_stop() {
+    let dir = scratch("events-stop");
+    let model = dir.join("pendulum.toml");
+    let analysis = "[analysis]\ntype = \"dynamic\"\nend_time = 3.0\ntime_step = 0.01\n";
+    let stop =
+        "curve = \"constant\"\n\n[[stops]]\nid = 8\njoint = 7\nlower = -60.0\nunit = \"deg\"\nrestitution = 0.5\n";
+    std::fs::write(&model, pendulum(analysis, stop)).unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let events = table(&out.join("events.csv"));
+    assert!(events.len() >= 2, "{events:?}");
+    let (last, impacts) = events.split_last().unwrap();
+    for e in impacts {
+        assert_eq!(e["kind"], "impact");
+        assert_eq!(e["element"], "8");
+        assert_eq!(e["joint"], "7");
+        assert!((num(e, "coordinate") + 60f64.to_radians()).abs() <= 1e-8);
+        // ω⁺ = −e ω⁻ (1e-6, the digits of the file)
+        let (before, after) = (num(e, "rate_before"), num(e, "rate_after"));
+        assert!((after + 0.5 * before).abs() <= 1e-6 * before.abs(), "{e:?}");
+        assert!(num(e, "impulse") > 0.0 && num(e, "energy_lost") > 0.0);
+    }
+    assert_eq!(last["kind"], "contact");
+    assert_eq!(num(last, "rate_after"), 0.0);
+    let s = summary(&out);
+    let d = &s["analyses"][0]["dynamic"];
+    assert_eq!(d["impacts"], impacts.len(), "{d}");
+    assert_eq!(d["contacts_closed"], 1, "{d}");
+    assert_eq!(d["locks"], 0, "{d}");
+    // the stop's results: in contact at the end, holding the pendulum
+    let stops = table(&out.join("stops.csv"));
+    let end = stops.last().unwrap();
+    assert_eq!(num(end, "contact"), -1.0);
+    assert!(num(end, "load") > 0.0);
+
+    // no stop: the header alone
+    std::fs::write(
+        &model,
+        pendulum(
+            &analysis.replace("3.0", "0.05").replace("0.01", "0.001"),
+            "",
+        ),
+    )
+    .unwrap();
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(out.join("events.csv")).unwrap();
+    assert_eq!(text, format!("{EVENTS_HEADER}\n"));
+    assert!(!out.join("stops.csv").exists());
+    let s = summary(&out);
+    assert_eq!(s["analyses"][0]["dynamic"]["impacts"], 0);
 }

@@ -45,14 +45,14 @@ use super::control::{
     Advance, Attempt, ControlStop, EventFunction, StepBounds, StepController, Stepper,
 };
 use super::energy::{Energies, EnergyBalance};
-use super::impact::{self, LockInfo};
+use super::impact::{self, ContactInfo, ContactKind, LockInfo};
 use super::newton::{non_finite_origin, NewtonFailure, NewtonSolver, SINGULAR_PIVOT};
 use super::settings::DynamicSettings;
 use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer};
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
 use crate::elements::{ConstraintKind, ConstraintScaling, EvalContext, Need};
 use crate::linalg::{smallest_relative_pivot, SparseLu, SparseMatrix};
-use crate::model::{Model, Prescribed};
+use crate::model::{Id, Model, Prescribed};
 use crate::so3::{self, Mat3, Vec3};
 use crate::state::State;
 
@@ -225,6 +225,8 @@ pub struct DynamicOutcome {
     pub event_retries: usize,
     /// The latches that locked, in order (docs/joints.md §6.2).
     pub locks: Vec<LockInfo>,
+    /// The events of the stops, in order (docs/joints.md §6.3).
+    pub contacts: Vec<ContactInfo>,
     /// Time reached.
     pub time: f64,
     /// Energies at the last converged state.
@@ -298,6 +300,8 @@ struct Run {
     /// The latches locked so far, and the rank analyses their locks ran.
     locks: Vec<LockInfo>,
     lock_rank_analyses: usize,
+    /// The events of the stops so far.
+    contacts: Vec<ContactInfo>,
     started: Instant,
     finished: bool,
     error: Option<DynamicError>,
@@ -505,6 +509,7 @@ impl DynamicAnalysis {
             location: String::new(),
             locks: Vec::new(),
             lock_rank_analyses: 0,
+            contacts: Vec::new(),
             started,
             finished: false,
             error: None,
@@ -512,6 +517,7 @@ impl DynamicAnalysis {
 
         // latches at their value lock, without impact (docs/joints.md §6.2)
         impact::lock_at_start(model, &mut run.state);
+        impact::close_at_start(model, &mut run.state);
 
         // rank of the constraints: redundant ones out
         let rank = self.solver.constraint_rank(model, &run.state, t0);
@@ -584,6 +590,7 @@ impl DynamicAnalysis {
                 .with_events(
                     impact::latch_events(model)
                         .into_iter()
+                        .chain(impact::stop_events(model))
                         .chain(std::mem::take(&mut self.events))
                         .collect(),
                 ),
@@ -717,6 +724,7 @@ impl DynamicAnalysis {
         let wall_time = run
             .as_ref()
             .map_or(0.0, |r| r.started.elapsed().as_secs_f64());
+        let contacts = run.as_ref().map_or(Vec::new(), |r| r.contacts.clone());
         let (state, counts, redundant, energies, error, locks) = match run {
             Some(r) => {
                 let mut counts = r.controller.map(|c| c.counts()).unwrap_or_default();
@@ -752,6 +760,7 @@ impl DynamicAnalysis {
             rank_analyses: counts.rank_analyses,
             event_retries: counts.event_retries,
             locks,
+            contacts,
             energies,
             wall_time,
             error,
@@ -1850,6 +1859,9 @@ impl Stepper for Dynamics<'_> {
             }
             None => Vec::new(),
         };
+        // stops reached or released: impact, then a restart (§16.4)
+        let contacts = self.stop_events(info)?;
+        let run = &mut *self.run;
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual();
         run.energies = run.balance.record(model, &run.state, Some(residual));
@@ -1858,7 +1870,61 @@ impl Stepper for Dynamics<'_> {
         for l in &locks {
             observer.lock(l);
         }
+        for c in &contacts {
+            observer.contact(c);
+        }
         run.locks.extend(locks);
+        run.contacts.extend(contacts);
         Ok(())
+    }
+}
+
+impl Dynamics<'_> {
+    /// The events of the stops at the accepted step `info`
+    /// ([`impact::stop_events_at`]), and the restart after them.
+    fn stop_events(&mut self, info: &IncrementInfo) -> Result<Vec<ContactInfo>, DynamicError> {
+        let (model, run) = (self.model, &mut *self.run);
+        let end_time = self.settings.end_time;
+        let Some(i) = impact::stop_events_at(
+            model,
+            self.solver,
+            &run.accepted,
+            &mut run.state,
+            info.increment,
+            end_time,
+        )?
+        else {
+            return Ok(Vec::new());
+        };
+        run.lock_rank_analyses += 1;
+        run.redundant = run.redundant.max(i.redundant);
+        let restart = |solver: &mut NewtonSolver, run: &mut Run| {
+            initial_accelerations(model, solver, run, end_time).map_err(|failure| {
+                DynamicError::Initial {
+                    time: info.time,
+                    failure,
+                }
+            })
+        };
+        restart(self.solver, run)?;
+        // a contact that closed with a pulling load opens again
+        let closed: Vec<Id> = i
+            .events
+            .iter()
+            .filter(|c| c.kind == ContactKind::Close)
+            .map(|c| c.stop)
+            .collect();
+        if impact::release_pulling(model, &mut run.state, &closed) {
+            let rank = self.solver.constraint_rank(model, &run.state, info.time);
+            for &k in &rank.redundant {
+                run.state.multipliers[k] = 0.0;
+            }
+            restart(self.solver, run)?;
+        }
+        run.last_step = None;
+        run.a_before.clear();
+        run.a_before_coordinates.clear();
+        run.balance.impact(i.energy_lost, i.work);
+        Ok(i.events)
     }
 }

@@ -31,7 +31,8 @@ use super::newton::{NewtonSolver, SINGULAR_PIVOT};
 use crate::dofs::{DofKind, NO_EQUATION};
 use crate::elements::{ConstraintKind, Element, EvalContext, Need};
 use crate::joints::latch::EVENT_TOLERANCE;
-use crate::joints::Latch;
+use crate::joints::stop::Contact;
+use crate::joints::{Latch, Stop};
 use crate::linalg::{smallest_relative_pivot, SparseLu};
 use crate::model::{Id, Model};
 use crate::state::State;
@@ -137,6 +138,21 @@ pub fn lock_at_start(model: &Model, state: &mut State) {
     }
 }
 
+/// Closes, without impact, the open stops of `state` that are at a limit
+/// (within the event tolerance): the start of a dynamic analysis. A
+/// contact whose consistent load then pulls opens at the end of the first
+/// step (a release event).
+pub fn close_at_start(model: &Model, state: &mut State) {
+    for e in &model.elements {
+        if let Some(s) = e.as_stop() {
+            let (g, side) = s.gap(state);
+            if s.contact(state) == Contact::Open && g.abs() <= gap_tolerance(model, s) {
+                s.set_contact(state, side);
+            }
+        }
+    }
+}
+
 /// What [`lock_latches`] did.
 pub struct Impact {
     /// The latches locked.
@@ -176,7 +192,7 @@ fn jump(
     solver: &mut NewtonSolver,
     state: &mut State,
     rhs_of: &dyn Fn(usize, usize) -> f64,
-    struck: &[(usize, &Latch, &[f64])],
+    struck: &[(usize, &[usize], &[f64])],
 ) -> Result<Jump, Singular> {
     let time = state.time;
     let (dofs, assembler, lu) = solver.system();
@@ -225,9 +241,9 @@ fn jump(
     }
     // an impulse on an unknown without mass that nothing else holds has no
     // finite answer
-    for &(_, l, grad) in struck {
+    for &(_, nodes, grad) in struck {
         let largest = grad.iter().fold(0.0f64, |a, g| a.max(g.abs()));
-        for (k, &node) in l.pair_nodes().iter().enumerate() {
+        for (k, &node) in nodes.iter().enumerate() {
             for c in 0..6 {
                 let eq = dofs.equation(6 * node + c);
                 if eq != NO_EQUATION
@@ -419,11 +435,11 @@ pub fn lock_latches(
             .find(|((&r, _), _)| r == eq)
             .map_or(0.0, |((_, l), (rate, _))| l.scaling(&ctx).0 * rate)
     };
-    let hit: Vec<(usize, &Latch, &[f64])> = rows
+    let hit: Vec<(usize, &[usize], &[f64])> = rows
         .iter()
         .zip(&reached)
         .zip(&struck)
-        .map(|((&r, &l), (_, g))| (r, l, g.as_slice()))
+        .map(|((&r, &l), (_, g))| (r, l.pair_nodes(), g.as_slice()))
         .collect();
     let j = jump(model, solver, state, &rhs_of, &hit).map_err(failed)?;
     let kinetic_after = energy::energies(model, state).kinetic;
@@ -454,4 +470,421 @@ pub fn lock_latches(
         // T⁺ − T₁ = W − ½ΔvᵀMΔv
         work: kinetic_after - kinetic_consistent + j.energy,
     }))
+}
+
+// ---------- unilateral stops (docs/theory.md §16.4) ----------
+
+/// A closed stop opens when its contact load falls to this fraction of the
+/// largest load it has carried since it closed (the release event's
+/// tolerance).
+pub const RELEASE_TOLERANCE: f64 = 1e-6;
+
+/// Contact loads below this fraction of the constraint scaling `k` count
+/// as zero in the release tolerance (a stop that closed without load).
+const NEGLIGIBLE_LOAD: f64 = 1e-12;
+
+/// What happened at a stop ([`ContactInfo::kind`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactKind {
+    /// An impact with restitution: the coordinate rebounds, the stop stays
+    /// open.
+    Impact,
+    /// A plastic impact (or a rebound too slow to leave the contact) that
+    /// closes the stop.
+    Close,
+    /// The contact load fell to zero: the stop opens, no impact.
+    Release,
+}
+
+impl ContactKind {
+    /// The name written in `events.csv`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Impact => "impact",
+            Self::Close => "contact",
+            Self::Release => "release",
+        }
+    }
+}
+
+/// An event of a stop during a dynamic analysis
+/// ([`super::Observer::contact`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactInfo {
+    /// The step that landed on it.
+    pub increment: usize,
+    /// Its time.
+    pub time: f64,
+    /// The stop.
+    pub stop: Id,
+    /// The joint whose coordinate it limits.
+    pub joint: Id,
+    /// What happened.
+    pub kind: ContactKind,
+    /// The coordinate at the event.
+    pub coordinate: f64,
+    /// `ċ⁻`, `ċ⁺`: the coordinate's rate before and after the event (with
+    /// the velocities consistent with the other constraints).
+    pub rate_before: f64,
+    /// See [`Self::rate_before`].
+    pub rate_after: f64,
+    /// The impulse of the stop along the coordinate, positive pushing it
+    /// back into its range (N·s, or N·m·s for an angle); 0 for a release.
+    pub impulse: f64,
+    /// The energy the impact dissipates, `(1 − e)/(1 + e) ½ ΔvᵀMΔv`
+    /// (docs/theory.md §16, LK3 with restitution); stops struck in the same
+    /// step share one impact and report its whole loss.
+    pub energy_lost: f64,
+    /// `T₁ − T⁺`, the drop of the kinetic energy over the impact (from the
+    /// velocities consistent with the other constraints).
+    pub kinetic_energy_drop: f64,
+}
+
+/// `|g|` at or below which a step has landed on a stop's limit: as a
+/// latch's ([`EVENT_TOLERANCE`], of the model's size for a length).
+pub fn gap_tolerance(model: &Model, stop: &Stop) -> f64 {
+    if stop.is_angle() {
+        EVENT_TOLERANCE
+    } else {
+        EVENT_TOLERANCE * model.length_scale
+    }
+}
+
+/// `|N|` at or below which a closed stop's load counts as zero.
+fn load_tolerance(model: &Model, stop: &Stop, state: &State) -> f64 {
+    let ctx = model.context(state.time, Need::RESIDUAL);
+    let k = stop.scaling(&ctx).0;
+    RELEASE_TOLERANCE * stop.load_scale(state).max(NEGLIGIBLE_LOAD * k)
+}
+
+/// The stop's watched quantity relative to its tolerance, `w`: the gap
+/// `g/g_tol` while open, the load `N/N_tol` while closed; an event when
+/// it reaches 0 (lands within ±1).
+pub fn stop_watch(model: &Model, stop: &Stop, state: &State) -> f64 {
+    if stop.contact(state) == Contact::Open {
+        stop.gap(state).0 / gap_tolerance(model, stop)
+    } else {
+        let ctx = model.context(state.time, Need::RESIDUAL);
+        stop.load(&ctx, state) / load_tolerance(model, stop, state)
+    }
+}
+
+/// The event function of a stop: `(−1)ⁿ w` ([`stop_watch`],
+/// [`Stop::watch_sign`]), with the tolerance 1.
+pub struct StopEvent {
+    element: usize,
+    name: String,
+}
+
+impl EventFunction for StopEvent {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+    fn value(&self, model: &Model, state: &State) -> f64 {
+        match model.elements[self.element].as_stop() {
+            Some(s) => s.watch_sign(state) * stop_watch(model, s, state),
+            None => 1.0,
+        }
+    }
+    fn tolerance(&self) -> f64 {
+        1.0
+    }
+}
+
+/// The event functions of the model's stops.
+pub fn stop_events(model: &Model) -> Vec<Box<dyn EventFunction>> {
+    let mut events: Vec<Box<dyn EventFunction>> = Vec::new();
+    for (element, e) in model.elements.iter().enumerate() {
+        if e.as_stop().is_some() {
+            events.push(Box::new(StopEvent {
+                element,
+                name: format!("stop {}", e.id()),
+            }));
+        }
+    }
+    events
+}
+
+/// What [`stop_events_at`] did.
+pub struct ContactImpact {
+    /// The events, in the order of the stops.
+    pub events: Vec<ContactInfo>,
+    /// Constraint equations found redundant by the last rank analysis.
+    pub redundant: usize,
+    /// The energy lost by the impact (0 if there was none).
+    pub energy_lost: f64,
+    /// Work of the impulses through drivers and prescribed motions.
+    pub work: f64,
+}
+
+/// The error of an impact at stops.
+fn stop_failure(model: &Model, stops: &[&Stop], time: f64, why: Singular) -> DynamicError {
+    let latches = stops
+        .iter()
+        .map(|s| format!("stop {}", s.id()))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let reason = match why {
+        Singular::Massless(node, c) => format!(
+            "the impulse of the stop acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies the joint joins their mass",
+            model.node_ids[node],
+            crate::model::COMPONENT_NAMES[c]
+        ),
+        Singular::System(at) => format!(
+            "the impact equations are singular{at}: the mass matrix is singular on the motion the impulse excites; give the bodies mass"
+        ),
+    };
+    DynamicError::Impact {
+        latches,
+        time,
+        reason,
+    }
+}
+
+/// The events of the stops over the accepted step from `before` to
+/// `state` (docs/theory.md §16.4):
+/// - a closed stop whose load has fallen to zero (`N ≤ N_tol`) opens;
+/// - an open stop that has reached a limit (`g` from above `g_tol` to at
+///   most `g_tol`) is struck: after the velocities are made consistent
+///   with the other constraints, the rebound rate `e |ċ⁻|` is compared with
+///   `v_min = √(2 g_tol |c̈|)` (`c̈` the coordinate's mean acceleration
+///   over the step), the rate that brings the coordinate back within the
+///   event band from `g_tol` away: above it the impact has restitution
+///   `e`, `B Δv = −(1 + e) ċ⁻`, and the stop stays open; at or below it the
+///   impact is plastic, `B Δv = −ċ⁻`, and the stop closes (persistent
+///   contact: no chattering of ever shorter rebounds).
+///
+/// Each event is counted in the stop's state ([`Stop::watch_sign`]). The
+/// accelerations are left to the caller (D9 at the post-event state),
+/// then [`release_pulling`].
+pub fn stop_events_at(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    before: &State,
+    state: &mut State,
+    increment: usize,
+    end_time: f64,
+) -> Result<Option<ContactImpact>, DynamicError> {
+    let stops: Vec<&Stop> = model.elements.iter().filter_map(|e| e.as_stop()).collect();
+    let time = state.time;
+    let mut events = Vec::new();
+    // releases
+    for s in &stops {
+        let ctx = model.context(time, Need::RESIDUAL);
+        if s.contact(state) != Contact::Open
+            && s.contact(before) != Contact::Open
+            && s.load(&ctx, state) <= load_tolerance(model, s, before)
+        {
+            let (rate, _) = s.rate(state);
+            events.push(ContactInfo {
+                increment,
+                time,
+                stop: s.id(),
+                joint: s.joint(),
+                kind: ContactKind::Release,
+                coordinate: s.coordinate(state),
+                rate_before: rate,
+                rate_after: rate,
+                impulse: 0.0,
+                energy_lost: 0.0,
+                kinetic_energy_drop: 0.0,
+            });
+            s.set_contact(state, Contact::Open);
+        }
+    }
+    // impacts
+    let reached: Vec<&Stop> = stops
+        .iter()
+        .copied()
+        .filter(|s| {
+            s.contact(state) == Contact::Open
+                && s.contact(before) == Contact::Open
+                && stop_watch(model, s, before) > 1.0
+                && stop_watch(model, s, state) <= 1.0
+        })
+        .collect();
+    if reached.is_empty() {
+        if events.is_empty() {
+            return Ok(None);
+        }
+        let rank = solver.constraint_rank(model, state, time);
+        for &k in &rank.redundant {
+            state.multipliers[k] = 0.0;
+        }
+        return Ok(Some(ContactImpact {
+            events,
+            redundant: rank.redundant.len(),
+            energy_lost: 0.0,
+            work: 0.0,
+        }));
+    }
+    let failed = |why| stop_failure(model, &reached, time, why);
+    // mean acceleration of each coordinate over the step
+    let h = time - before.time;
+    let accelerations: Vec<f64> = reached
+        .iter()
+        .map(|s| {
+            if h > 0.0 {
+                ((s.rate(state).0 - s.rate(before).0) / h).abs()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+
+    // 1. velocities consistent with the constraints already active
+    if solver.dofs.first_multiplier() < solver.dofs.n_dofs() {
+        let (rates, _) = constraint_rates(model, solver, state, end_time);
+        jump(model, solver, state, &|_, d| -rates[d], &[]).map_err(failed)?;
+    }
+    let kinetic_consistent = energy::energies(model, state).kinetic;
+
+    // 2. the impact: each stop struck is a constraint for it
+    struct Struck<'a> {
+        stop: &'a Stop,
+        side: Contact,
+        rate: f64,
+        grad: Vec<f64>,
+        /// The restitution applied: `e`, or 0 when the stop closes.
+        e: f64,
+        approaching: bool,
+    }
+    let struck: Vec<Struck> = reached
+        .iter()
+        .zip(&accelerations)
+        .map(|(&s, &a)| {
+            let side = s.gap(state).1;
+            let (rate, grad) = s.rate(state);
+            // the rate towards the limit
+            let approach = -side.side() * rate;
+            let v_min = (2.0 * gap_tolerance(model, s) * a).sqrt();
+            let e = if s.restitution() * approach > v_min {
+                s.restitution()
+            } else {
+                0.0
+            };
+            Struck {
+                stop: s,
+                side,
+                rate,
+                grad,
+                e,
+                approaching: approach > 0.0,
+            }
+        })
+        .collect();
+    for k in &struck {
+        // counts the event; closed for the impact
+        k.stop.set_contact(state, k.side);
+    }
+    let rank = solver.constraint_rank(model, state, time);
+    for &k in &rank.redundant {
+        state.multipliers[k] = 0.0;
+    }
+    let first = solver.dofs.first_multiplier();
+    let rows: Vec<usize> = struck
+        .iter()
+        .map(|k| solver.dofs.equation(first + k.stop.multiplier()))
+        .collect();
+    let ctx = model.context(time, Need::RESIDUAL);
+    // −k B Δv = k (1 + e) ċ⁻ on the rows of the stops approaching; a stop
+    // reached moving away (grazing) keeps its rate
+    let rhs_of = |eq: usize, _: usize| {
+        rows.iter()
+            .zip(&struck)
+            .find(|(&r, _)| r == eq)
+            .map_or(0.0, |(_, k)| {
+                if k.approaching {
+                    k.stop.scaling(&ctx).0 * (1.0 + k.e) * k.rate
+                } else {
+                    0.0
+                }
+            })
+    };
+    let hit: Vec<(usize, &[usize], &[f64])> = rows
+        .iter()
+        .zip(&struck)
+        .map(|(&r, k)| (r, k.stop.pair_nodes(), k.grad.as_slice()))
+        .collect();
+    let j = jump(model, solver, state, &rhs_of, &hit).map_err(failed)?;
+    let kinetic_after = energy::energies(model, state).kinetic;
+    // ½ΔvᵀMΔv = (1 + e)² × Carnot's loss; with restitution the loss is
+    // (1 − e²) of it: (1 − e)/(1 + e) ½ΔvᵀMΔv (one e for the impact; stops
+    // with different e struck together report the drop of T)
+    let e0 = struck[0].e;
+    let energy_lost = if struck.iter().all(|k| k.e == e0) {
+        (1.0 - e0) / (1.0 + e0) * j.energy
+    } else {
+        kinetic_consistent - kinetic_after
+    };
+    // the stops that rebound open again (no event counted: the impact was
+    // the event)
+    let mut reopened = false;
+    for k in &struck {
+        if k.e > 0.0 || !k.approaching {
+            k.stop.reopen(state);
+            reopened = true;
+        }
+    }
+    let redundant = if reopened {
+        let rank = solver.constraint_rank(model, state, time);
+        for &k in &rank.redundant {
+            state.multipliers[k] = 0.0;
+        }
+        rank.redundant.len()
+    } else {
+        rank.redundant.len()
+    };
+    for (k, &eq) in struck.iter().zip(&rows) {
+        let closes = k.stop.contact(state) != Contact::Open;
+        events.push(ContactInfo {
+            increment,
+            time,
+            stop: k.stop.id(),
+            joint: k.stop.joint(),
+            kind: if closes {
+                ContactKind::Close
+            } else {
+                ContactKind::Impact
+            },
+            coordinate: k.stop.coordinate(state),
+            rate_before: k.rate,
+            rate_after: k.stop.rate(state).0,
+            impulse: if eq == NO_EQUATION {
+                0.0
+            } else {
+                k.side.side() * k.stop.scaling(&ctx).0 * j.solution[eq]
+            },
+            energy_lost,
+            kinetic_energy_drop: kinetic_consistent - kinetic_after,
+        });
+    }
+    Ok(Some(ContactImpact {
+        events,
+        redundant,
+        energy_lost,
+        work: kinetic_after - kinetic_consistent + energy_lost,
+    }))
+}
+
+/// Opens, without counting an event, the stops of `state` that closed at
+/// this state's impact but whose consistent load pulls (`N < 0`, found
+/// with the accelerations of D9): the contact closed while the motion was
+/// leaving it. Returns whether any opened (the caller then analyses the
+/// rank of the constraints and computes the accelerations again).
+pub fn release_pulling(model: &Model, state: &mut State, closed_now: &[Id]) -> bool {
+    let ctx = model.context(state.time, Need::RESIDUAL);
+    let mut opened = false;
+    for e in &model.elements {
+        if let Some(s) = e.as_stop() {
+            if closed_now.contains(&s.id())
+                && s.contact(state) != Contact::Open
+                && s.load(&ctx, state) < 0.0
+            {
+                s.reopen(state);
+                opened = true;
+            }
+        }
+    }
+    opened
 }

@@ -29,7 +29,7 @@ pub mod statics;
 pub use control::EventFunction;
 pub use dynamics::{Continuation, DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
 pub use energy::{Energies, EnergyBalance};
-pub use impact::LockInfo;
+pub use impact::{ContactInfo, ContactKind, LockInfo};
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
 pub use settings::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
@@ -130,6 +130,11 @@ pub trait Observer {
     /// After the step on which a latch locked (reported to
     /// [`Observer::increment`], with the post-impact state, first).
     fn lock(&mut self, _info: &LockInfo) {}
+
+    /// After the step on which a stop was struck, closed or released
+    /// (reported to [`Observer::increment`], with the post-event state,
+    /// first).
+    fn contact(&mut self, _info: &ContactInfo) {}
 
     /// A remark worth showing the user (redundant constraints removed).
     fn note(&mut self, _text: &str) {}

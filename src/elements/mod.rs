@@ -291,6 +291,12 @@ pub trait Element: Send + Sync {
         None
     }
 
+    /// The element as a unilateral stop, for the analyses that watch
+    /// contacts (docs/joints.md §6.3).
+    fn as_stop(&self) -> Option<&crate::joints::Stop> {
+        None
+    }
+
     /// New values of the internal variables after the state has converged
     /// (unwrapped joint angles, hysteresis); `internal` holds the old ones.
     fn update_internal(&self, _ctx: &EvalContext, _state: &State, _internal: &mut [f64]) {}

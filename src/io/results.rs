@@ -41,8 +41,8 @@ use serde::Serialize;
 
 use super::vtk;
 use crate::analysis::{
-    AnalysisSettings, DynamicOutcome, Energies, IncrementInfo, Observer, StaticAnalysis,
-    StaticOutcome,
+    AnalysisSettings, ContactKind, DynamicOutcome, Energies, IncrementInfo, Observer,
+    StaticAnalysis, StaticOutcome,
 };
 use crate::elements::{ElementKind, Need};
 use crate::model::Model;
@@ -52,12 +52,13 @@ use crate::state::State;
 /// Result files in the output directory that unfold writes besides the
 /// tables of the element kinds ([`ElementKind::results_file`]) and the
 /// grids `vtk/step_NNNNN.vtu`.
-const RUN_FILES: [&str; 8] = [
+const RUN_FILES: [&str; 9] = [
     "log.txt",
     "steps.csv",
     "nodes.csv",
     "nodes_velocities.csv",
     "energies.csv",
+    "events.csv",
     "reactions.csv",
     "unfold.pvd",
     "summary.json",
@@ -149,12 +150,22 @@ pub struct DynamicRecord {
     pub largest_energy_balance_error: f64,
     /// Largest kinetic energy over the steps: the scale of the errors.
     pub largest_kinetic_energy: f64,
+    /// Events written to `events.csv`: latches locked, impacts of stops
+    /// with rebound, contacts closed (plastic impacts), contacts released.
+    pub locks: usize,
+    /// See [`Self::locks`].
+    pub impacts: usize,
+    /// See [`Self::locks`].
+    pub contacts_closed: usize,
+    /// See [`Self::locks`].
+    pub contacts_released: usize,
 }
 
 impl DynamicRecord {
     /// The record of `outcome`, with the largest balance error and kinetic
     /// energy seen over its steps.
     pub fn of(outcome: &DynamicOutcome, largest_error: f64, largest_kinetic: f64) -> Self {
+        let count = |k| outcome.contacts.iter().filter(|c| c.kind == k).count();
         Self {
             steps: outcome.steps,
             rejected_steps: outcome.rejected_steps,
@@ -165,6 +176,10 @@ impl DynamicRecord {
             energy_balance_error: outcome.energies.balance_error,
             largest_energy_balance_error: largest_error.max(outcome.energies.balance_error.abs()),
             largest_kinetic_energy: largest_kinetic.max(outcome.energies.kinetic),
+            locks: outcome.locks.len(),
+            impacts: count(ContactKind::Impact),
+            contacts_closed: count(ContactKind::Close),
+            contacts_released: count(ContactKind::Release),
         }
     }
 }
@@ -637,6 +652,39 @@ struct MotionFiles {
     velocities: CsvFile,
     /// `energies.csv`.
     energies: CsvFile,
+    /// `events.csv`: written row by row as events happen, after the step
+    /// they happened on.
+    events: CsvFile,
+}
+
+/// The header of `events.csv` (docs/results.md).
+pub const EVENTS_HEADER: &str =
+    "step,increment,time,element,kind,joint,coordinate,rate_before,rate_after,impulse,energy_lost";
+
+/// One row of `events.csv`: a latch locking, a stop struck, closed or
+/// released.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EventRow<'a> {
+    /// The increment (time step) it happened on, numbered across the run.
+    pub increment: usize,
+    /// Its time.
+    pub time: f64,
+    /// The latch or stop.
+    pub element: crate::model::Id,
+    /// `lock`, `impact`, `contact` or `release`.
+    pub kind: &'a str,
+    /// The joint whose coordinate it watches.
+    pub joint: crate::model::Id,
+    /// The coordinate at the event.
+    pub coordinate: f64,
+    /// The coordinate's rate before and after.
+    pub rate_before: f64,
+    /// See [`Self::rate_before`].
+    pub rate_after: f64,
+    /// The impulse along the coordinate.
+    pub impulse: f64,
+    /// The energy the impact dissipated.
+    pub energy_lost: f64,
 }
 
 /// Relative motion over the step of the differences that give the rates of
@@ -771,7 +819,7 @@ impl ResultWriter {
         };
         let writes = |name: &str| match name {
             "reactions.csv" => !supported.is_empty(),
-            "nodes_velocities.csv" | "energies.csv" => dynamics,
+            "nodes_velocities.csv" | "energies.csv" | "events.csv" => dynamics,
             // written again by whoever writes the summary
             "summary.json" => false,
             _ => ElementKind::ALL
@@ -863,6 +911,7 @@ impl ResultWriter {
                             dir.join("energies.csv"),
                             "step,time,kinetic,strain,gravity,spring,external_work,dissipated,balance_error",
                         )?,
+                        events: CsvFile::create(dir.join("events.csv"), EVENTS_HEADER)?,
                     })
                 })
                 .transpose()?,
@@ -904,6 +953,38 @@ impl ResultWriter {
     pub fn write_summary(&self, summary: &Summary) -> io::Result<()> {
         let text = serde_json::to_string_pretty(summary).map_err(io::Error::other)?;
         vtk::write_atomically(&self.dir.join("summary.json"), (text + "\n").as_bytes())
+    }
+
+    /// Appends `row` to `events.csv` (a run with dynamics; its step, the
+    /// last output step, was written before).
+    pub fn write_event(&mut self, row: &EventRow) -> io::Result<()> {
+        let step = self.pvd.len().saturating_sub(1);
+        let Some(m) = self.motion.as_mut() else {
+            return Ok(());
+        };
+        m.events.pending = format!(
+            "{step},{},{:e},{},{},{},{:e},{:e},{:e},{:e},{:e}\n",
+            row.increment,
+            row.time,
+            row.element,
+            row.kind,
+            row.joint,
+            row.coordinate,
+            row.rate_before,
+            row.rate_after,
+            row.impulse,
+            row.energy_lost
+        );
+        match m.events.append() {
+            Ok(()) => {
+                m.events.settle();
+                Ok(())
+            }
+            Err(e) => {
+                m.events.rollback();
+                Err(e)
+            }
+        }
     }
 
     /// Every CSV file.

@@ -48,12 +48,13 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use super::modes::ModalFiles;
 use super::restart::RestartWriter;
-use super::results::{file_error, AnalysisEnd, ResultWriter, RunStatus, Summary};
+use super::results::{file_error, AnalysisEnd, EventRow, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
-    AnalysisSettings, Continuation, CutbackInfo, DynamicAnalysis, DynamicError, Energies,
-    EventInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome, WarningInfo,
+    AnalysisSettings, ContactInfo, Continuation, CutbackInfo, DynamicAnalysis, DynamicError,
+    Energies, EventInfo, IncrementInfo, IterationInfo, LockInfo, Observer, StaticAnalysis,
+    StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
 use crate::model::Model;
@@ -670,6 +671,29 @@ impl Recorder {
         self.writer.dir()
     }
 
+    /// Appends `row` to `events.csv`; a write error fails the run at its
+    /// end (the analysis goes on: its other results are being written).
+    fn write_event(&mut self, row: &EventRow) {
+        self.line(&format!(
+            "step {:4}  t = {:.6}: {} at element {} (joint {}): rate {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}",
+            row.increment,
+            row.time,
+            row.kind,
+            row.element,
+            row.joint,
+            row.rate_before,
+            row.rate_after,
+            row.impulse,
+            row.energy_lost
+        ));
+        let _writing = self.stop.output();
+        if let Err(e) = self.writer.write_event(row) {
+            if self.failure.is_none() {
+                self.failure = Some(e.to_string());
+            }
+        }
+    }
+
     /// Writes a line to `log.txt` and shows it.
     pub fn line(&mut self, text: &str) {
         self.log.line(text);
@@ -944,6 +968,36 @@ impl Observer for Recorder {
             info.reason,
             info.next_step
         ));
+    }
+
+    fn lock(&mut self, info: &LockInfo) {
+        self.write_event(&EventRow {
+            increment: info.increment + self.increment_offset,
+            time: info.time,
+            element: info.latch,
+            kind: "lock",
+            joint: info.joint,
+            coordinate: info.coordinate,
+            rate_before: info.rate_before,
+            rate_after: 0.0,
+            impulse: info.impulse,
+            energy_lost: info.energy_lost,
+        });
+    }
+
+    fn contact(&mut self, info: &ContactInfo) {
+        self.write_event(&EventRow {
+            increment: info.increment + self.increment_offset,
+            time: info.time,
+            element: info.stop,
+            kind: info.kind.name(),
+            joint: info.joint,
+            coordinate: info.coordinate,
+            rate_before: info.rate_before,
+            rate_after: info.rate_after,
+            impulse: info.impulse,
+            energy_lost: info.energy_lost,
+        });
     }
 
     fn event(&mut self, info: &EventInfo) {

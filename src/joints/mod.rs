@@ -17,6 +17,7 @@ pub mod joint;
 pub mod kinematics;
 pub mod latch;
 pub mod spring;
+pub mod stop;
 pub mod types;
 
 pub use coordinate::PairCoordinate;
@@ -26,6 +27,7 @@ pub use joint::Joint;
 pub use kinematics::Pair;
 pub use latch::Latch;
 pub use spring::{JointSpring, Law};
+pub use stop::Stop;
 pub use types::{Coordinate, JointType};
 
 #[cfg(test)]

@@ -44,7 +44,7 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 21] = [
+pub const TOP_LEVEL_KEYS: [&str; 22] = [
     "title",
     "analysis",
     "nodes",
@@ -64,6 +64,7 @@ pub const TOP_LEVEL_KEYS: [&str; 21] = [
     "hinge_laws",
     "drivers",
     "latches",
+    "stops",
     "initial_motion",
     "output",
 ];
@@ -131,6 +132,9 @@ pub struct ModelInput {
     /// Locks of joint coordinates at the end of their travel.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub latches: Vec<LatchInput>,
+    /// Unilateral stops of joint coordinates (joint limits).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stops: Vec<StopInput>,
     /// Rigid motions of sets of nodes at the start (dynamic analyses).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial_motion: Vec<InitialMotionInput>,
@@ -369,6 +373,35 @@ pub struct LatchInput {
     /// `rigid` (default): once locked, `c = c_L` is a constraint.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mode: Option<LatchMode>,
+}
+
+/// A unilateral stop on a joint coordinate (docs/joints.md §6.3): the
+/// coordinate stays within `[lower, upper]`, impacts at a limit with
+/// restitution `restitution`, and rests against it in persistent contact.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StopInput {
+    /// Element id.
+    pub id: Id,
+    /// The joint.
+    pub joint: Id,
+    /// Which coordinate (`angle`, `slide`, `angle1`...), default the joint's
+    /// first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// `c_min` (m, or rad unless `unit` says otherwise); none: no lower
+    /// limit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower: Option<f64>,
+    /// `c_max`; none: no upper limit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upper: Option<f64>,
+    /// Unit of the limits for an angle coordinate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+    /// Coefficient of restitution `e ∈ [0, 1]`, default 0 (plastic).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
 }
 
 /// How a latch's coordinate reaches its locking value.

@@ -4,7 +4,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::Builder;
-use super::{drivers, hinge_laws, joint_springs, latches};
+use super::{drivers, hinge_laws, joint_springs, latches, stops};
 use crate::elements::Element;
 use crate::joints::types::{Coordinate, JointParameters};
 use crate::joints::{Joint, JointType, Pair, PairCoordinate};
@@ -105,6 +105,13 @@ pub(super) fn build(cx: &mut Builder) {
         let entity = format!("latch {}", l.id);
         let id_ok = cx.claim_id(&entity, l.id);
         if let (Some(e), true) = (latches::latch(cx, &entity, l, &joints), id_ok) {
+            cx.elements.push(Box::new(e));
+        }
+    }
+    for l in &input.stops {
+        let entity = format!("stop {}", l.id);
+        let id_ok = cx.claim_id(&entity, l.id);
+        if let (Some(e), true) = (stops::stop(cx, &entity, l, &joints), id_ok) {
             cx.elements.push(Box::new(e));
         }
     }

@@ -25,6 +25,7 @@ mod output;
 mod sections;
 mod settings;
 mod springs;
+mod stops;
 mod supports;
 
 use super::input::*;
@@ -291,6 +292,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.hinge_laws.len(),
         input.drivers.len(),
         input.latches.len(),
+        input.stops.len(),
         generated,
     ]
     .into_iter()

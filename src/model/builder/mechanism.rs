@@ -4,10 +4,11 @@ use super::{Body, CurveHandle, Entity, ModelBuilder};
 use crate::joints::{Coordinate, JointType};
 use crate::model::handles::{
     DriverHandle, HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, NodeHandle,
+    StopHandle,
 };
 use crate::model::input::{
     AngleUnit, Approach, DriverInput, HingeLawInput, JointInput, JointSpringInput, LatchInput,
-    StartBranch, TapeSpringInput,
+    StartBranch, StopInput, TapeSpringInput,
 };
 use crate::model::Id;
 
@@ -467,6 +468,76 @@ impl Entity for Latch {
         self.input.id = m.element_id(self.id, 1);
         let handle = LatchHandle(self.input.id);
         m.input.latches.push(self.input);
+        handle
+    }
+}
+
+/// A unilateral stop on a joint coordinate (docs/joints.md §6.3): the
+/// coordinate stays within its limits, with impacts of restitution `e`
+/// and persistent contact (in dynamic analyses).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stop {
+    input: StopInput,
+    id: Option<Id>,
+}
+
+impl Stop {
+    /// A stop on the first coordinate of `joint`, without limits yet (see
+    /// [`Stop::lower`], [`Stop::upper`]); values in m, or rad unless
+    /// [`Stop::unit`] says otherwise.
+    pub fn on(joint: JointHandle) -> Self {
+        Self {
+            input: StopInput {
+                joint: joint.0,
+                ..StopInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// The joint coordinate it limits.
+    pub fn coordinate(mut self, coordinate: Coordinate) -> Self {
+        self.input.coordinate = Some(coordinate.name().into());
+        self
+    }
+
+    /// The lower limit `c_min`.
+    pub fn lower(mut self, value: f64) -> Self {
+        self.input.lower = Some(value);
+        self
+    }
+
+    /// The upper limit `c_max`.
+    pub fn upper(mut self, value: f64) -> Self {
+        self.input.upper = Some(value);
+        self
+    }
+
+    /// The unit of the limits of an angle.
+    pub fn unit(mut self, unit: AngleUnit) -> Self {
+        self.input.unit = Some(unit);
+        self
+    }
+
+    /// The coefficient of restitution `e ∈ [0, 1]` (default 0).
+    pub fn restitution(mut self, e: f64) -> Self {
+        self.input.restitution = Some(e);
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for Stop {
+    type Handle = StopHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> StopHandle {
+        self.input.id = m.element_id(self.id, 1);
+        let handle = StopHandle(self.input.id);
+        m.input.stops.push(self.input);
         handle
     }
 }

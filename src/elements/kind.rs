@@ -31,6 +31,8 @@ pub enum ElementKind {
     Driver,
     /// Lock of a joint coordinate at the end of its travel.
     Latch,
+    /// Disc rolling without slipping on a plane.
+    RollingDisc,
 }
 
 /// A cell data array of the VTK files filled from an element's results:
@@ -58,7 +60,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 11] = [
+    pub const ALL: [ElementKind; 12] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -70,6 +72,7 @@ impl ElementKind {
         Self::HingeLaw,
         Self::Driver,
         Self::Latch,
+        Self::RollingDisc,
     ];
 
     /// Lower-case name used in messages and output file names.
@@ -86,6 +89,7 @@ impl ElementKind {
             Self::HingeLaw => "hinge law",
             Self::Driver => "driver",
             Self::Latch => "latch",
+            Self::RollingDisc => "rolling disc",
         }
     }
 
@@ -103,6 +107,7 @@ impl ElementKind {
             Self::Driver => 9,
             Self::HingeLaw => 10,
             Self::Latch => 11,
+            Self::RollingDisc => 12,
         }
     }
 
@@ -118,6 +123,7 @@ impl ElementKind {
             Self::JointSpring => Some("joint_springs.csv"),
             Self::HingeLaw => Some("hinge_laws.csv"),
             Self::Latch => Some("latches.csv"),
+            Self::RollingDisc => Some("rolling.csv"),
             Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
     }
@@ -128,6 +134,7 @@ impl ElementKind {
             Self::Joint => "joint",
             Self::Driver => "driver",
             Self::Latch => "latch",
+            Self::RollingDisc => "joint",
             _ => "element",
         }
     }

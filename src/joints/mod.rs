@@ -16,6 +16,7 @@ pub mod hyperdual;
 pub mod joint;
 pub mod kinematics;
 pub mod latch;
+pub mod rolling;
 pub mod spring;
 pub mod types;
 
@@ -25,6 +26,7 @@ pub use hinge::{Branch, HingeLaw, Hysteresis, Response, TapeSpring};
 pub use joint::Joint;
 pub use kinematics::Pair;
 pub use latch::Latch;
+pub use rolling::RollingDisc;
 pub use spring::{JointSpring, Law};
 pub use types::{Coordinate, JointType};
 

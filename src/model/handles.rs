@@ -120,6 +120,11 @@ element_handle!(
     LatchHandle,
     ElementKind::Latch
 );
+element_handle!(
+    /// A rolling disc.
+    RollingDiscHandle,
+    ElementKind::RollingDisc
+);
 
 /// The nodes and elements of a beam line.
 #[derive(Clone, Debug, PartialEq, Eq)]

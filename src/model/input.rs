@@ -44,7 +44,7 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 21] = [
+pub const TOP_LEVEL_KEYS: [&str; 22] = [
     "title",
     "analysis",
     "nodes",
@@ -64,6 +64,7 @@ pub const TOP_LEVEL_KEYS: [&str; 21] = [
     "hinge_laws",
     "drivers",
     "latches",
+    "rolling_discs",
     "initial_motion",
     "output",
 ];
@@ -131,6 +132,10 @@ pub struct ModelInput {
     /// Locks of joint coordinates at the end of their travel.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub latches: Vec<LatchInput>,
+    /// Discs rolling without slipping on fixed planes (docs/joints.md
+    /// §3.8).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rolling_discs: Vec<RollingDiscInput>,
     /// Rigid motions of sets of nodes at the start (dynamic analyses).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial_motion: Vec<InitialMotionInput>,
@@ -369,6 +374,27 @@ pub struct LatchInput {
     /// `rigid` (default): once locked, `c = c_L` is a constraint.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mode: Option<LatchMode>,
+}
+
+/// A rigid disc rolling without slipping on a fixed plane
+/// (docs/joints.md §3.8): its node is at the centre, its axis a material
+/// direction of the node.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RollingDiscInput {
+    /// Element id.
+    pub id: Id,
+    /// The node at the disc's centre.
+    pub node: Id,
+    /// Radius of the disc (m), positive.
+    pub radius: f64,
+    /// The disc's axis in the node's material frame.
+    pub axis: [f64; 3],
+    /// A point of the plane (global), default the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 3]>,
+    /// The plane's normal (global), pointing to the disc's side.
+    pub normal: [f64; 3],
 }
 
 /// How a latch's coordinate reaches its locking value.

@@ -34,7 +34,7 @@ pub use builder::ModelBuilder;
 pub use handles::{
     BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
     JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
-    RigidBodyHandle, SpringHandle,
+    RigidBodyHandle, RollingDiscHandle, SpringHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.

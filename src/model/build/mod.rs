@@ -22,6 +22,7 @@ mod loads;
 mod masses;
 mod nodes;
 mod output;
+mod rolling;
 mod sections;
 mod settings;
 mod springs;
@@ -274,6 +275,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.hinge_laws.len(),
         input.drivers.len(),
         input.latches.len(),
+        input.rolling_discs.len(),
         generated,
     ]
     .into_iter()
@@ -325,6 +327,7 @@ impl Model {
         b.springs();
         b.loads();
         joints::build(&mut b);
+        b.rolling_discs();
         let gravity = b.gravity();
         b.supports();
         b.prescribed();

@@ -738,6 +738,7 @@ unit = "deg"
     // √(k/J_O), J_O = 1/12 + 0.5² = 1/3 kg·m²: to round-off of the solver
     assert!((num(&modes[0], "omega_rad_s") - 6f64.sqrt()).abs() < 1e-9);
     assert_eq!(summary(&out)["status"], "completed");
+}
 
 /// The header of `events.csv` (docs/results.md).
 const EVENTS_HEADER: &str =

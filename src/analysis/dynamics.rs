@@ -779,13 +779,80 @@ fn dynamic_context<'a>(
     scheme: &GeneralizedAlpha,
     h: f64,
 ) -> EvalContext<'a> {
+    let ctx = model.context(
+        time,
+        Need::with_inertia(scheme.gamma_prime(h), scheme.beta_prime(h)),
+    );
+    // velocity constraints as lengths τ A v, τ = 1/γ′: their rows of S are
+    // A + τ ∂(Av)/∂q T, scaled by D8 as the distance constraints' B T
     EvalContext {
         dynamics: true,
-        ..model.context(
-            time,
-            Need::with_inertia(scheme.gamma_prime(h), scheme.beta_prime(h)),
-        )
+        scaling: ConstraintScaling {
+            rate_time: 1.0 / scheme.gamma_prime(h),
+            ..ctx.scaling
+        },
+        ..ctx
     }
+}
+
+/// Whether an element has a velocity constraint (rolling discs).
+fn has_velocity_constraints(model: &Model) -> bool {
+    model
+        .elements
+        .iter()
+        .any(|e| (0..e.n_multipliers()).any(|k| e.velocity_constraint(k)))
+}
+
+/// Which dofs are the multipliers of velocity constraints
+/// ([`crate::elements::Element::velocity_constraint`]), by dof.
+fn velocity_rows(model: &Model, dofs: &DofMap) -> Vec<bool> {
+    let mut rows = vec![false; dofs.n_dofs()];
+    for (i, e) in model.elements.iter().enumerate() {
+        let o = dofs.first_multiplier() + model.offsets(i).multipliers;
+        for k in 0..e.n_multipliers() {
+            rows[o + k] = e.velocity_constraint(k);
+        }
+    }
+    rows
+}
+
+/// The residual of velocity constraints, `−kτ A v` (τ = 1), at `state`
+/// and its derivative along the motion at `v̇ = 0` (`−kτ Ȧ v`, central
+/// differences with Richardson extrapolation as in D9), by dof.
+fn velocity_constraint_rates(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    state: &State,
+    end_time: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let e = motion_step(model, state, end_time);
+    let mut residual = |s: &State| {
+        let (_, assembler, _) = solver.system();
+        let ctx = EvalContext {
+            dynamics: true,
+            ..model.context(s.time, Need::RESIDUAL)
+        };
+        assembler.assemble(model, &ctx, s);
+        assembler.residual.clone()
+    };
+    let r0 = residual(state);
+    let mut first = Vec::new();
+    for h in [e, 0.5 * e] {
+        let rp = residual(&moved(model, state, h));
+        let rm = residual(&moved(model, state, -h));
+        first.push(
+            rp.iter()
+                .zip(&rm)
+                .map(|(p, m)| (p - m) / (2.0 * h))
+                .collect::<Vec<f64>>(),
+        );
+    }
+    let rate = first[0]
+        .iter()
+        .zip(&first[1])
+        .map(|(a, b)| (4.0 * b - a) / 3.0)
+        .collect();
+    (r0, rate)
 }
 
 /// Velocities and accelerations of the prescribed components at `t`, from
@@ -934,7 +1001,15 @@ fn check_velocities(
     if solver.dofs.first_multiplier() == solver.dofs.n_dofs() {
         return Ok(());
     }
-    let (rate, _) = constraint_rates(model, solver, state, end_time);
+    let (mut rate, _) = constraint_rates(model, solver, state, end_time);
+    // a velocity constraint's own residual −kA v is its violation
+    let rows = velocity_rows(model, &solver.dofs);
+    if rows.contains(&true) {
+        let (value, _) = velocity_constraint_rates(model, solver, state, end_time);
+        for (d, _) in rows.iter().enumerate().filter(|(_, &r)| r) {
+            rate[d] = value[d];
+        }
+    }
     let l = model.length_scale;
     let (mut v, mut w) = (0.0f64, 0.0f64);
     for r in &state.velocity {
@@ -996,6 +1071,7 @@ fn constrained_mass_system(
     solver: &mut NewtonSolver,
     state: &State,
     buffers: &mut MassSystem,
+    velocity_rows: Option<(&[bool], &SparseMatrix)>,
 ) -> Result<([f64; 2], Vec<f64>), NewtonFailure> {
     let t = state.time;
     let (dofs, assembler, _) = solver.system();
@@ -1066,10 +1142,14 @@ fn constrained_mass_system(
             _ => 1.0,
         })
         .collect();
+    let dof_of: Vec<usize> = (0..n).map(|eq| dofs.dof(eq)).collect();
     let values = assembler.matrix.values_mut();
     let (k, m) = (stiffness.values(), mass.values());
     for (i, (row, col, _)) in stiffness.entries().enumerate() {
-        let v = if is_multiplier[row] || is_multiplier[col] || light[row] {
+        // the rows of velocity constraints take their ∂r/∂v
+        let v = if let Some((c, true)) = velocity_rows.map(|(r, c)| (c, r[dof_of[row]])) {
+            c.values()[i]
+        } else if is_multiplier[row] || is_multiplier[col] || light[row] {
             k[i] + m[i]
         } else {
             m[i]
@@ -1124,12 +1204,32 @@ fn initial_accelerations(
     }
     state.coordinate_accelerations.fill(0.0);
     let has_constraints = solver.dofs.first_multiplier() < solver.dofs.n_dofs();
-    let second = if has_constraints {
+    let mut second = if has_constraints {
         constraint_rates(model, solver, state, end_time).1
     } else {
         Vec::new()
     };
-    let (scale, s_eq) = constrained_mass_system(model, solver, state, &mut run.mass_system)?;
+    // velocity constraints (rolling): A v̇ = −Ȧ v, their rows from ∂r/∂v (τ = 1)
+    let by_dof = velocity_rows(model, &solver.dofs);
+    let damping = if by_dof.contains(&true) {
+        let (_, rate) = velocity_constraint_rates(model, solver, state, end_time);
+        for (d, _) in by_dof.iter().enumerate().filter(|(_, &r)| r) {
+            second[d] = rate[d];
+        }
+        let (_, assembler, _) = solver.system();
+        let (mut k, mut c) = (assembler.matrix.clone(), assembler.matrix.clone());
+        let ctx = EvalContext {
+            dynamics: true,
+            ..model.context(t0, Need::with_inertia(1.0, 0.0))
+        };
+        assembler.assemble_split(model, &ctx, state, &mut k, &mut c);
+        Some(c)
+    } else {
+        None
+    };
+    let rows = damping.as_ref().map(|c| (by_dof.as_slice(), c));
+    let (scale, s_eq) =
+        constrained_mass_system(model, solver, state, &mut run.mass_system, rows)?;
     run.mass_scale = scale;
     let (dofs, assembler, _) = solver.system();
     let mut rhs: Vec<f64> = (0..dofs.n_equations())
@@ -1332,12 +1432,15 @@ impl Dynamics<'_> {
     fn project_velocities(&mut self) -> Result<(), NewtonFailure> {
         let (model, run) = (self.model, &mut *self.run);
         let dofs = &self.solver.dofs;
-        if dofs.first_multiplier() == dofs.n_dofs() {
+        // no joints; or rolling discs, whose velocity constraints the
+        // integrator already enforces at each step (docs/theory.md §15.7)
+        if dofs.first_multiplier() == dofs.n_dofs() || has_velocity_constraints(model) {
             return Ok(());
         }
         let state = &mut run.state;
         let rate = constraint_rate(model, self.solver, state, run.span);
-        let (_, s_eq) = constrained_mass_system(model, self.solver, state, &mut run.mass_system)?;
+        let (_, s_eq) =
+            constrained_mass_system(model, self.solver, state, &mut run.mass_system, None)?;
         let dofs = &self.solver.dofs;
         let rhs = &mut run.work.rhs;
         rhs.clear();

@@ -33,6 +33,9 @@ pub enum ElementKind {
     Latch,
     /// Unilateral stop of a joint coordinate (joint limits with impact).
     Stop,
+
+    /// Disc rolling without slipping on a plane.
+    RollingDisc,
 }
 
 /// A cell data array of the VTK files filled from an element's results:
@@ -60,7 +63,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 12] = [
+    pub const ALL: [ElementKind; 13] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -73,6 +76,8 @@ impl ElementKind {
         Self::Driver,
         Self::Latch,
         Self::Stop,
+
+        Self::RollingDisc,
     ];
 
     /// Lower-case name used in messages and output file names.
@@ -90,6 +95,8 @@ impl ElementKind {
             Self::Driver => "driver",
             Self::Latch => "latch",
             Self::Stop => "stop",
+
+            Self::RollingDisc => "rolling disc",
         }
     }
 
@@ -108,6 +115,8 @@ impl ElementKind {
             Self::HingeLaw => 10,
             Self::Latch => 11,
             Self::Stop => 12,
+
+            Self::RollingDisc => 13,
         }
     }
 
@@ -124,6 +133,8 @@ impl ElementKind {
             Self::HingeLaw => Some("hinge_laws.csv"),
             Self::Latch => Some("latches.csv"),
             Self::Stop => Some("stops.csv"),
+
+            Self::RollingDisc => Some("rolling.csv"),
             Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
     }
@@ -135,6 +146,8 @@ impl ElementKind {
             Self::Driver => "driver",
             Self::Latch => "latch",
             Self::Stop => "stop",
+
+            Self::RollingDisc => "joint",
             _ => "element",
         }
     }

@@ -144,6 +144,13 @@ pub struct ConstraintScaling {
     pub force: (f64, f64),
     /// `(k, p)` of angle constraints.
     pub moment: (f64, f64),
+    /// `τ`: velocity constraints `A(q) v = 0` (rolling, paper eq. 15)
+    /// enter the residual as the lengths `τ A v`, scaled as distance
+    /// constraints. 1 by default; `1/γ′` in the iterations of the
+    /// generalised-α method, so that their rows of the iteration matrix
+    /// are `A + τ ∂(Av)/∂q`, of the order of a holonomic constraint's `B`
+    /// (docs/joints.md §3.8, docs/theory.md D8).
+    pub rate_time: f64,
 }
 
 impl ConstraintScaling {
@@ -161,6 +168,7 @@ impl Default for ConstraintScaling {
         Self {
             force: (1.0, 1.0),
             moment: (1.0, 1.0),
+            rate_time: 1.0,
         }
     }
 }
@@ -275,6 +283,15 @@ pub trait Element: Send + Sync {
     /// tolerance.
     fn multiplier_kind(&self, _k: usize) -> ConstraintKind {
         ConstraintKind::Distance
+    }
+
+    /// Whether constraint equation `k` is a velocity constraint
+    /// `A(q) v = 0` (rolling, paper eq. 15) rather than a holonomic one:
+    /// its row of the iteration matrix comes from `∂r/∂v`, and the
+    /// initial conditions of a dynamic analysis treat it at velocity
+    /// level (docs/theory.md D9–D10).
+    fn velocity_constraint(&self, _k: usize) -> bool {
+        false
     }
 
     /// Whether the element's constraints act at `time` in `state` (a

@@ -37,6 +37,7 @@ fn ctx() -> EvalContext<'static> {
         scaling: ConstraintScaling {
             force: (3.0, 2.0),
             moment: (5.0, 1.5),
+            rate_time: 1.0,
         },
     }
 }

@@ -125,6 +125,11 @@ element_handle!(
     StopHandle,
     ElementKind::Stop
 );
+element_handle!(
+    /// A rolling disc.
+    RollingDiscHandle,
+    ElementKind::RollingDisc
+);
 
 /// The nodes and elements of a beam line.
 #[derive(Clone, Debug, PartialEq, Eq)]

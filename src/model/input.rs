@@ -44,7 +44,7 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 22] = [
+pub const TOP_LEVEL_KEYS: [&str; 23] = [
     "title",
     "analysis",
     "nodes",
@@ -65,6 +65,7 @@ pub const TOP_LEVEL_KEYS: [&str; 22] = [
     "drivers",
     "latches",
     "stops",
+    "rolling_discs",
     "initial_motion",
     "output",
 ];
@@ -135,6 +136,10 @@ pub struct ModelInput {
     /// Unilateral stops of joint coordinates (joint limits).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stops: Vec<StopInput>,
+    /// Discs rolling without slipping on fixed planes (docs/joints.md
+    /// §3.8).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rolling_discs: Vec<RollingDiscInput>,
     /// Rigid motions of sets of nodes at the start (dynamic analyses).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial_motion: Vec<InitialMotionInput>,
@@ -402,6 +407,27 @@ pub struct StopInput {
     /// Coefficient of restitution `e ∈ [0, 1]`, default 0 (plastic).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub restitution: Option<f64>,
+}
+
+/// A rigid disc rolling without slipping on a fixed plane
+/// (docs/joints.md §3.8): its node is at the centre, its axis a material
+/// direction of the node.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RollingDiscInput {
+    /// Element id.
+    pub id: Id,
+    /// The node at the disc's centre.
+    pub node: Id,
+    /// Radius of the disc (m), positive.
+    pub radius: f64,
+    /// The disc's axis in the node's material frame.
+    pub axis: [f64; 3],
+    /// A point of the plane (global), default the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 3]>,
+    /// The plane's normal (global), pointing to the disc's side.
+    pub normal: [f64; 3],
 }
 
 /// How a latch's coordinate reaches its locking value.

@@ -34,7 +34,7 @@ pub use builder::ModelBuilder;
 pub use handles::{
     BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
     JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
-    RigidBodyHandle, SpringHandle, StopHandle,
+    RigidBodyHandle, RollingDiscHandle, SpringHandle, StopHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.
@@ -265,6 +265,7 @@ impl Model {
             scaling: ConstraintScaling {
                 force: (0.0, 0.0),
                 moment: (0.0, 0.0),
+                rate_time: 1.0,
             },
             ..self.context(0.0, Need::STIFFNESS)
         };
@@ -296,6 +297,7 @@ impl Model {
         ConstraintScaling {
             force: (pick(kf, scale), pick(kf, penalty)),
             moment: (pick(km, scale), pick(km, penalty)),
+            rate_time: 1.0,
         }
     }
 

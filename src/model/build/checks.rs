@@ -110,6 +110,7 @@ pub(super) fn check_restraint(
                 crate::elements::ElementKind::Spring
                     | crate::elements::ElementKind::Joint
                     | crate::elements::ElementKind::Driver
+                    | crate::elements::ElementKind::RollingDisc
             )
         {
             grounded[nodes[0]] = true;

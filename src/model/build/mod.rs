@@ -22,6 +22,7 @@ mod loads;
 mod masses;
 mod nodes;
 mod output;
+mod rolling;
 mod sections;
 mod settings;
 mod springs;
@@ -293,6 +294,8 @@ fn model_size(input: &ModelInput) -> usize {
         input.drivers.len(),
         input.latches.len(),
         input.stops.len(),
+
+        input.rolling_discs.len(),
         generated,
     ]
     .into_iter()
@@ -344,6 +347,7 @@ impl Model {
         b.springs();
         b.loads();
         joints::build(&mut b);
+        b.rolling_discs();
         let gravity = b.gravity();
         b.supports();
         b.prescribed();

@@ -4,11 +4,11 @@ use super::{Body, CurveHandle, Entity, ModelBuilder};
 use crate::joints::{Coordinate, JointType};
 use crate::model::handles::{
     DriverHandle, HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, NodeHandle,
-    StopHandle,
+    RollingDiscHandle, StopHandle,
 };
 use crate::model::input::{
     AngleUnit, Approach, DriverInput, HingeLawInput, JointInput, JointSpringInput, LatchInput,
-    StartBranch, StopInput, TapeSpringInput,
+    RollingDiscInput, StartBranch, StopInput, TapeSpringInput,
 };
 use crate::model::Id;
 
@@ -538,6 +538,62 @@ impl Entity for Stop {
         self.input.id = m.element_id(self.id, 1);
         let handle = StopHandle(self.input.id);
         m.input.stops.push(self.input);
+        handle
+    }
+}
+
+
+/// A rigid disc rolling without slipping on a fixed plane
+/// (docs/joints.md §3.8): its node at the centre, its axis a material
+/// direction of the node. The disc must touch the plane in the reference
+/// configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RollingDisc {
+    input: RollingDiscInput,
+    id: Option<Id>,
+}
+
+impl RollingDisc {
+    /// A disc of radius `radius` centred on `node`, with axis `axis`
+    /// (material frame of the node), on the plane through the origin with
+    /// normal `normal` (pointing to the disc's side).
+    pub fn new(
+        node: NodeHandle,
+        radius: f64,
+        axis: impl Into<[f64; 3]>,
+        normal: impl Into<[f64; 3]>,
+    ) -> Self {
+        Self {
+            input: RollingDiscInput {
+                node: node.0,
+                radius,
+                axis: axis.into(),
+                normal: normal.into(),
+                ..RollingDiscInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// A point of the plane (default the origin).
+    pub fn point(mut self, point: impl Into<[f64; 3]>) -> Self {
+        self.input.point = Some(point.into());
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for RollingDisc {
+    type Handle = RollingDiscHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> RollingDiscHandle {
+        self.input.id = m.element_id(self.id, 1);
+        let handle = RollingDiscHandle(self.input.id);
+        m.input.rolling_discs.push(self.input);
         handle
     }
 }

@@ -580,7 +580,10 @@ const WIREFRAME_BANDS: (u32, u32) = (50, 70);
 impl Wireframe {
     /// An empty drawing, isometric, with its title and the names of its
     /// groups of lines.
-    pub fn new(title: impl Into<String>, groups: impl IntoIterator<Item = impl Into<String>>) -> Self {
+    pub fn new(
+        title: impl Into<String>,
+        groups: impl IntoIterator<Item = impl Into<String>>,
+    ) -> Self {
         Self {
             title: title.into(),
             groups: groups.into_iter().map(Into::into).collect(),
@@ -623,7 +626,12 @@ impl Wireframe {
             .panels
             .iter()
             .map(|panel| {
-                let mut b = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+                let mut b = [
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                ];
                 let ends = panel.segments.iter().flat_map(|s| [s.from, s.to]);
                 for p in ends.chain(panel.points.iter().map(|p| p.0)).filter(finite) {
                     let (u, v, _) = self.view.project(p);
@@ -700,8 +708,12 @@ impl Wireframe {
                 .estimate_text_size(&panel.label, &font)
                 .map_err(|e| drawing_error(&e))?;
             let x = left + (PANEL_SIZE.0 as i32 - lw as i32) / 2;
-            root.draw(&Text::new(panel.label.clone(), (x, top + PANEL_SIZE.1 as i32), font))
-                .map_err(|e| drawing_error(&e))?;
+            root.draw(&Text::new(
+                panel.label.clone(),
+                (x, top + PANEL_SIZE.1 as i32),
+                font,
+            ))
+            .map_err(|e| drawing_error(&e))?;
         }
 
         // legend: a short line of each group's colour and its name
@@ -899,7 +911,14 @@ mod tests {
             .panel(square("large", 2.0));
         assert_eq!(drawing.size(), (2 * PANEL_SIZE.0, PANEL_SIZE.1 + 120));
         let svg = drawing.to_svg().unwrap();
-        for s in ["Two squares", "small", "large", "sides", "other sides", "corner"] {
+        for s in [
+            "Two squares",
+            "small",
+            "large",
+            "sides",
+            "other sides",
+            "corner",
+        ] {
             assert!(svg.contains(s), "missing {s:?}");
         }
         // 8 sides and 3 legend lines, 2 dots

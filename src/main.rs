@@ -710,6 +710,8 @@ fn run(
         }
     }
     let report = recorder.finish_after(last.as_ref(), &state);
+    // the charts of `[output] plots`, from the files as they now stand
+    let plotted = write_plots(path, out, &input);
 
     for e in &report.output_errors {
         eprintln!("error: cannot write results: {e}");
@@ -775,10 +777,76 @@ fn run(
         }
         None => {}
     }
-    if !report.output_errors.is_empty() {
+    if !report.output_errors.is_empty() || !plotted {
         return ExitCode::from(EXIT_FAILED);
     }
     ExitCode::SUCCESS
+}
+
+/// Writes the charts `[output] plots` of the model file into `out/plots`
+/// (replacing the pictures there), leaving out with a note those the
+/// results do not have (energies of a static run); whether it succeeded.
+fn write_plots(model: &Path, out: &Path, input: &ModelInput) -> bool {
+    let Some(names) = input.output.as_ref().map(|o| &o.plots) else {
+        return true;
+    };
+    if names.is_empty() {
+        return true;
+    }
+    let dir = out.join("plots");
+    let drawn = Histories::read(out, Some(model)).and_then(|h| {
+        let available = h.available();
+        let mut groups = Vec::new();
+        for name in names {
+            match Group::from_name(name) {
+                Some(g) if available.contains(&g) => groups.push(g),
+                _ => {
+                    eprintln!("note: plots: no {name} chart: the results have no histories for it")
+                }
+            }
+        }
+        if groups.is_empty() {
+            return Ok(Vec::new());
+        }
+        let figures = h.figures(&Request {
+            groups,
+            ..Request::default()
+        })?;
+        remove_pictures(&dir);
+        Histories::write(&figures, &dir, Format::Both)
+    });
+    match drawn {
+        Ok(files) => {
+            if !files.is_empty() {
+                eprintln!("plots: {} files in {}", files.len(), dir.display());
+            }
+            true
+        }
+        Err(e @ HistoryError::Unavailable { .. }) => {
+            eprintln!("note: plots: {e}");
+            true
+        }
+        Err(e) => {
+            eprintln!("error: cannot write plots: {e}");
+            false
+        }
+    }
+}
+
+/// Removes the pictures (`.png`, `.svg`) of an earlier run from `dir`.
+fn remove_pictures(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if matches!(
+            path.extension().and_then(|e| e.to_str()),
+            Some("png" | "svg")
+        ) {
+            let _ = std::fs::remove_file(&path);
+        }
+    }
 }
 
 /// Sets the velocities and accelerations of `state` to zero.

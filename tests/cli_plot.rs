@@ -30,37 +30,37 @@ fn s(p: &Path) -> &str {
 }
 
 /// Runs the model `text` (written into `dir/model.toml`) into `dir/out`.
-fn run_model(dir: &Path, text: &str) -> PathBuf {
+fn run_model(dir: &Path, text: &str) -> (PathBuf, Output) {
     let model = dir.join("model.toml");
     std::fs::write(&model, text).unwrap();
     let out = dir.join("out");
     let o = unfold(&["run", s(&model), "--out", s(&out), "--quiet"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    out
+    (out, o)
 }
 
-/// The two panels of tests/data/latched_panels.toml, run to 0.05 s: the
-/// latch locks at about 0.04 s.
-fn latched_panels(dir: &Path) -> PathBuf {
+/// The two panels of tests/data/latched_panels.toml, run to 0.05 s (the
+/// latch locks at about 0.04 s), with `output` appended.
+fn latched_panels(dir: &Path, output: &str) -> (PathBuf, Output) {
     let text = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/latched_panels.toml"),
     )
     .unwrap()
     .replace("end_time = 0.1", "end_time = 0.05");
-    run_model(dir, &text)
+    run_model(dir, &(text + output))
 }
 
 /// A static run with a hinge law and a driver on one revolute joint: the
 /// link of examples/hinge_lock_cycle.toml driven to 96° and back in 40
 /// increments.
-fn driven_hinge(dir: &Path) -> PathBuf {
+fn driven_hinge(dir: &Path, output: &str) -> (PathBuf, Output) {
     let text = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/hinge_lock_cycle.toml"),
     )
     .unwrap()
     .replace("initial_increment = 0.01", "initial_increment = 0.1")
     .replace("max_increment = 0.01", "max_increment = 0.1");
-    run_model(dir, &text)
+    run_model(dir, &(text + output))
 }
 
 /// Decodes a PNG file: its size and RGB pixels.
@@ -104,7 +104,32 @@ fn read(path: &Path) -> String {
 #[test]
 fn dynamic_run_with_a_latch() {
     let dir = scratch("dynamic");
-    let out = latched_panels(&dir);
+    let (out, run) = latched_panels(&dir, "\n[output]\nplots = [\"joints\", \"energies\"]\n");
+
+    // the charts of `[output] plots`, written by the run
+    let mut written: Vec<String> = std::fs::read_dir(out.join("plots"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    written.sort();
+    assert_eq!(
+        written,
+        [
+            "energies.png",
+            "energies.svg",
+            "energy_balance_error.png",
+            "energy_balance_error.svg",
+            "joint_10.png",
+            "joint_10.svg"
+        ]
+    );
+    assert!(
+        stderr(&run).contains("plots: 6 files in"),
+        "{}",
+        stderr(&run)
+    );
+    assert_drawn_png(&out.join("plots/joint_10.png"));
+
     let plots = dir.join("plots");
     let o = unfold(&["plot", s(&out), "--out", s(&plots)]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -208,7 +233,14 @@ fn dynamic_run_with_a_latch() {
 #[test]
 fn static_run_and_bad_input() {
     let dir = scratch("static");
-    let out = driven_hinge(&dir);
+    // `[output] plots` asks for energies, which a static run does not have
+    let (out, run) = driven_hinge(&dir, "\n[output]\nplots = [\"energies\"]\n");
+    assert!(
+        stderr(&run).contains("note: plots: no energies chart"),
+        "{}",
+        stderr(&run)
+    );
+    assert!(!out.join("plots").exists());
     let plots = dir.join("plots");
     let o = unfold(&["plot", s(&out), "--out", s(&plots), "--format", "both"]);
     assert!(o.status.success(), "{}", stderr(&o));

@@ -665,6 +665,14 @@ impl Histories {
                 Group::Energies => figures.extend(self.energy_figures(request)?),
             }
         }
+        // a run that stopped before its first step has rows without values
+        figures.retain(|f| f.chart.series.iter().any(|s| has_values(&s.points)));
+        if figures.is_empty() {
+            return Err(HistoryError::Unavailable {
+                group: "results",
+                reason: format!("{} has no step with values", self.dir.display()),
+            });
+        }
         Ok(figures)
     }
 
@@ -924,10 +932,18 @@ impl Histories {
         let x = self.time_axis(request.units);
         let energy = request.units.energy();
         let mut chart = Chart::new("Energies", x.clone(), Axis::new("energy", energy));
+        // a form of energy the model does not have (zero throughout, or
+        // round-off: below 1e-9 of the largest energy) is left out; the
+        // kinetic energy is always shown
+        let largest = histories
+            .iter()
+            .flatten()
+            .map(|p| p.1.abs())
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
         for ((_, legend), points) in columns.iter().zip(histories) {
-            // a form of energy the model does not have (zero throughout) is
-            // left out; the kinetic energy is always shown
-            if *legend != "kinetic T" && points.iter().all(|p| p.1 == 0.0 || !p.1.is_finite()) {
+            let negligible = |v: f64| !v.is_finite() || v.abs() <= 1e-9 * largest;
+            if *legend != "kinetic T" && points.iter().all(|p| negligible(p.1)) {
                 continue;
             }
             chart = chart.series(Series::new(*legend, points));

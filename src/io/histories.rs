@@ -807,22 +807,25 @@ impl Histories {
         request: &Request,
         chosen: &dyn Fn(Id) -> bool,
     ) -> Result<Vec<Figure>, HistoryError> {
-        // (file, id column, [(column, legend)], entity name)
-        let sources: [(&Option<Table>, &'static str, &str, Vec<(&str, &str)>); 4] = [
+        // the files of loads along joint coordinates: (table, its name in
+        // `Coordinates::acting`, id column, [(column, legend)])
+        type Source<'t> = (&'t Option<Table>, &'static str, &'static str, Legends);
+        type Legends = &'static [(&'static str, &'static str)];
+        let sources: [Source; 4] = [
             (
                 &self.joint_springs,
                 "joint_springs",
                 "element",
-                vec![("spring", "spring"), ("damper", "damper")],
+                &[("spring", "spring"), ("damper", "damper")],
             ),
             (
                 &self.hinge_laws,
                 "hinge_laws",
                 "element",
-                vec![("moment", "hinge law")],
+                &[("moment", "hinge law")],
             ),
-            (&self.latches, "latches", "latch", vec![("load", "latch")]),
-            (&self.drivers, "drivers", "driver", vec![("load", "driver")]),
+            (&self.latches, "latches", "latch", &[("load", "latch")]),
+            (&self.drivers, "drivers", "driver", &[("load", "driver")]),
         ];
         // series by joint and by kind of coordinate (angle or not): None
         // when unknown

@@ -222,7 +222,7 @@ fn dynamic_run_with_a_latch() {
     let o = unfold(&["plot", s(&out), "--format", "svg", "--out", s(&ev)]);
     assert!(o.status.success(), "{}", stderr(&o));
     let joint = read(&ev.join("joint_10.svg"));
-    assert!(joint.contains("latch 20 locks, 2.250e0 lost"), "{joint}");
+    assert!(joint.contains("latch 20 locks, 2.25 J lost"), "{joint}");
     assert_eq!(joint.matches("locks").count(), 1);
     assert!(joint.contains("event at joint 10"));
 }

@@ -323,6 +323,26 @@ impl Table {
     }
 }
 
+/// `x` to four significant digits, in exponent form outside [1e-3, 1e5).
+fn significant(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 {
+        return "0".into();
+    }
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        let text = format!("{x:.decimals$}");
+        // trailing zeros say nothing here
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 /// Whether a series has a finite value.
 fn has_values(points: &[(f64, f64)]) -> bool {
     points.iter().any(|p| p.0.is_finite() && p.1.is_finite())
@@ -386,6 +406,8 @@ struct Event {
     time: f64,
     joint: Option<Id>,
     label: String,
+    /// Energy lost at the event (`events.csv`), in the model's units.
+    lost: Option<f64>,
 }
 
 /// The result files of one run, read.
@@ -504,6 +526,7 @@ impl Histories {
                         time: t.number(r, time)?,
                         joint,
                         label: format!("latch {id} locks"),
+                        lost: None,
                     });
                 }
             }
@@ -528,30 +551,26 @@ impl Histories {
                 if let Some(j) = joint {
                     label += &format!(" at joint {j}");
                 }
-                if let Some(c) = lost {
-                    let e = t.number(r, c)?;
-                    if e.is_finite() {
-                        label += &format!(", {e:.3e} lost");
-                    }
-                }
+                let lost = match lost {
+                    Some(c) => Some(t.number(r, c)?).filter(|e| e.is_finite()),
+                    None => None,
+                };
                 // a lock already marked from latches.csv at the same instant
-                // and joint takes this label instead of a second line
+                // (and joint, where both are known) takes the energy lost
+                // instead of a second line
                 let tol = 1e-9 * at.abs().max(1.0);
                 if let Some(e) = events.iter_mut().find(|e: &&mut Event| {
-                    (e.time - at).abs() <= tol && (e.joint == joint || joint.is_none())
+                    (e.time - at).abs() <= tol
+                        && (e.joint == joint || joint.is_none() || e.joint.is_none())
                 }) {
-                    if let Some(c) = lost {
-                        let lost = t.number(r, c)?;
-                        if lost.is_finite() {
-                            e.label += &format!(", {lost:.3e} lost");
-                        }
-                    }
+                    e.lost = e.lost.or(lost);
                     continue;
                 }
                 events.push(Event {
                     time: at,
                     joint,
                     label,
+                    lost,
                 });
             }
         }
@@ -684,9 +703,13 @@ impl Histories {
             .filter(move |e| joint.is_none() || e.joint.is_none() || e.joint == joint)
     }
 
-    fn with_events(&self, mut chart: Chart, joint: Option<Id>) -> Chart {
+    fn with_events(&self, mut chart: Chart, joint: Option<Id>, units: UnitLabels) -> Chart {
         for e in self.events_of(joint) {
-            chart = chart.event(e.time, e.label.clone());
+            let label = match e.lost {
+                Some(lost) => format!("{}, {} {} lost", e.label, significant(lost), units.energy()),
+                None => e.label.clone(),
+            };
+            chart = chart.event(e.time, label);
         }
         chart
     }
@@ -746,7 +769,7 @@ impl Histories {
                 if any {
                     figures.push(Figure {
                         name: format!("joint_{id}"),
-                        chart: self.with_events(chart, Some(id)),
+                        chart: self.with_events(chart, Some(id), request.units),
                     });
                 }
                 continue;
@@ -793,7 +816,7 @@ impl Histories {
                 };
                 figures.push(Figure {
                     name,
-                    chart: self.with_events(chart, Some(id)),
+                    chart: self.with_events(chart, Some(id), request.units),
                 });
             }
         }
@@ -897,7 +920,7 @@ impl Histories {
             }
             figures.push(Figure {
                 name,
-                chart: self.with_events(chart, joint),
+                chart: self.with_events(chart, joint, request.units),
             });
         }
         Ok(figures)
@@ -953,7 +976,7 @@ impl Histories {
         }
         let mut figures = vec![Figure {
             name: "energies".into(),
-            chart: self.with_events(chart, None),
+            chart: self.with_events(chart, None, request.units),
         }];
         if has_values(&error) {
             let chart = Chart::new(
@@ -964,7 +987,7 @@ impl Histories {
             .series(Series::new("balance error E", error));
             figures.push(Figure {
                 name: "energy_balance_error".into(),
-                chart: self.with_events(chart, None),
+                chart: self.with_events(chart, None, request.units),
             });
         }
         Ok(figures)
@@ -995,5 +1018,45 @@ impl Histories {
             }
         }
         Ok(written)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn energies_are_labelled_to_four_digits() {
+        assert_eq!(significant(2.25), "2.25");
+        assert_eq!(significant(235.6161), "235.6");
+        assert_eq!(significant(-0.0123456), "-0.01235");
+        assert_eq!(significant(12000.0), "12000");
+        assert_eq!(significant(0.0), "0");
+        assert_eq!(significant(1.5e-6), "1.500e-6");
+    }
+
+    #[test]
+    fn malformed_rows_are_named_by_line() {
+        let dir = std::env::temp_dir().join(format!("unfold-histories-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.csv");
+        std::fs::write(&path, "step,time,joint,c1\n0,0,1,0.5\n\n1,0.1,1,abc\n").unwrap();
+        let t = Table::read(&path).unwrap().unwrap();
+        let e = t.histories("joint", &["c1"]).unwrap_err().to_string();
+        assert!(
+            e.ends_with("t.csv, line 4: column `c1`: \"abc\" is not a number"),
+            "{e}"
+        );
+        std::fs::write(&path, "step,time\n0,0,3\n").unwrap();
+        let e = Table::read(&path).unwrap_err().to_string();
+        assert!(
+            e.ends_with("t.csv, line 2: 3 fields, but the header names 2 columns"),
+            "{e}"
+        );
+        std::fs::write(&path, "").unwrap();
+        let e = Table::read(&path).unwrap_err().to_string();
+        assert!(e.contains("line 1: empty file"), "{e}");
+        assert!(Table::read(&dir.join("absent.csv")).unwrap().is_none());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -3,7 +3,12 @@
 //! ```text
 //! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii] [--restart FILE]
 //! unfold check MODEL.toml
+//! unfold plot RESULTS_DIR [joints|moments|energies ...] [--joint ID ...] [--format png|svg|both]
+//!             [--out DIR] [--degrees] [--units si|model] [--model MODEL.toml]
 //! ```
+//! `unfold plot` draws the time histories of a run from its result files
+//! (docs/plots.md): joint coordinates with the lock instants, moments
+//! along the joint coordinates, energies and the energy balance error.
 //! A model file with a sequence of analyses (`[[analysis]]`) runs them in
 //! order, each from the final state of the one before, into one set of
 //! result files. A modal analysis (`type = "modal"`) linearises about the
@@ -38,6 +43,7 @@ use unfold::analysis::{
     AnalysisSettings, DynamicAnalysis, DynamicError, IncrementInfo, ModalAnalysis, ModalError,
     ModalOutcome, ModalSettings, NewtonFailure, StaticAnalysis,
 };
+use unfold::io::histories::{Format, Group, Histories, HistoryError, Request, UnitLabels};
 use unfold::io::model_file::read_model;
 use unfold::io::restart::{fingerprint, Restart, RestartError, RestartWriter, Resume};
 use unfold::io::results::AnalysisEnd;
@@ -104,6 +110,51 @@ enum Command {
         /// Model file.
         model: PathBuf,
     },
+    /// Draw the time histories of a run from its result files: joint
+    /// coordinates, moments along them, energies (docs/plots.md).
+    Plot {
+        /// Results directory of a run (`unfold run MODEL --out DIR`).
+        results: PathBuf,
+        /// Charts to draw: `joints`, `moments`, `energies` (default: every
+        /// one the results allow).
+        #[arg(value_name = "WHAT")]
+        what: Vec<String>,
+        /// Only the joint and moment charts of this joint (repeatable).
+        #[arg(long = "joint", value_name = "ID")]
+        joints: Vec<u64>,
+        /// File format of the charts.
+        #[arg(long, value_enum, default_value = "both")]
+        format: PlotFormat,
+        /// Directory for the charts (default: RESULTS/plots).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+        /// Angles in degrees (the result files give radians).
+        #[arg(long)]
+        degrees: bool,
+        /// Unit names on the axes: `si` (s, m, N, N·m, J) or `model`
+        /// (named by dimension, for a model in other units).
+        #[arg(long, value_enum, default_value = "si")]
+        units: PlotUnits,
+        /// The model file, which tells angles from lengths (default: the
+        /// one named in summary.json).
+        #[arg(long, value_name = "FILE")]
+        model: Option<PathBuf>,
+    },
+}
+
+/// `--format` of `unfold plot`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PlotFormat {
+    Png,
+    Svg,
+    Both,
+}
+
+/// `--units` of `unfold plot`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PlotUnits {
+    Si,
+    Model,
 }
 
 /// Exit code for an analysis that stopped early or unwritable results
@@ -116,6 +167,46 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Check { model } => check(&model),
+        Command::Plot {
+            results,
+            what,
+            joints,
+            format,
+            out,
+            degrees,
+            units,
+            model,
+        } => {
+            let format = match format {
+                PlotFormat::Png => Format::Png,
+                PlotFormat::Svg => Format::Svg,
+                PlotFormat::Both => Format::Both,
+            };
+            let units = match units {
+                PlotUnits::Si => UnitLabels::Si,
+                PlotUnits::Model => UnitLabels::Model,
+            };
+            let mut groups = Vec::new();
+            for w in &what {
+                match Group::from_name(w) {
+                    Some(g) => groups.push(g),
+                    None => {
+                        eprintln!(
+                            "error: {w:?}: not a kind of chart; give joints, moments or energies"
+                        );
+                        return ExitCode::from(EXIT_INPUT);
+                    }
+                }
+            }
+            let request = Request {
+                groups,
+                joints,
+                degrees,
+                units,
+            };
+            let out = out.unwrap_or_else(|| results.join("plots"));
+            plot(&results, model.as_deref(), &request, &out, format)
+        }
         Command::Run {
             model,
             out,
@@ -162,6 +253,42 @@ fn main() -> ExitCode {
                 Encoding::Binary
             };
             run(&model, &out, quiet, encoding, restart.as_deref())
+        }
+    }
+}
+
+/// `unfold plot`: draws the charts of `request` from the results in
+/// `dir` into `out`, one line per file written; exit code 2 for results
+/// that cannot be read or do not have what is asked, 1 if a chart cannot
+/// be written.
+fn plot(
+    dir: &Path,
+    model: Option<&Path>,
+    request: &Request,
+    out: &Path,
+    format: Format,
+) -> ExitCode {
+    let drawn = Histories::read(dir, model).and_then(|h| {
+        for note in h.notes() {
+            eprintln!("note: {note}");
+        }
+        let figures = h.figures(request)?;
+        Histories::write(&figures, out, format)
+    });
+    match drawn {
+        Ok(files) => {
+            for f in files {
+                println!("{}", f.display());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            let code = match e {
+                HistoryError::Write { .. } | HistoryError::Plot(_) => EXIT_FAILED,
+                _ => EXIT_INPUT,
+            };
+            ExitCode::from(code)
         }
     }
 }
@@ -583,6 +710,8 @@ fn run(
         }
     }
     let report = recorder.finish_after(last.as_ref(), &state);
+    // the charts of `[output] plots`, from the files as they now stand
+    let plotted = write_plots(path, out, &input);
 
     for e in &report.output_errors {
         eprintln!("error: cannot write results: {e}");
@@ -648,10 +777,76 @@ fn run(
         }
         None => {}
     }
-    if !report.output_errors.is_empty() {
+    if !report.output_errors.is_empty() || !plotted {
         return ExitCode::from(EXIT_FAILED);
     }
     ExitCode::SUCCESS
+}
+
+/// Writes the charts `[output] plots` of the model file into `out/plots`
+/// (replacing the pictures there), leaving out with a note those the
+/// results do not have (energies of a static run); whether it succeeded.
+fn write_plots(model: &Path, out: &Path, input: &ModelInput) -> bool {
+    let Some(names) = input.output.as_ref().map(|o| &o.plots) else {
+        return true;
+    };
+    if names.is_empty() {
+        return true;
+    }
+    let dir = out.join("plots");
+    let drawn = Histories::read(out, Some(model)).and_then(|h| {
+        let available = h.available();
+        let mut groups = Vec::new();
+        for name in names {
+            match Group::from_name(name) {
+                Some(g) if available.contains(&g) => groups.push(g),
+                _ => {
+                    eprintln!("note: plots: no {name} chart: the results have no histories for it")
+                }
+            }
+        }
+        if groups.is_empty() {
+            return Ok(Vec::new());
+        }
+        let figures = h.figures(&Request {
+            groups,
+            ..Request::default()
+        })?;
+        remove_pictures(&dir);
+        Histories::write(&figures, &dir, Format::Both)
+    });
+    match drawn {
+        Ok(files) => {
+            if !files.is_empty() {
+                eprintln!("plots: {} files in {}", files.len(), dir.display());
+            }
+            true
+        }
+        Err(e @ HistoryError::Unavailable { .. }) => {
+            eprintln!("note: plots: {e}");
+            true
+        }
+        Err(e) => {
+            eprintln!("error: cannot write plots: {e}");
+            false
+        }
+    }
+}
+
+/// Removes the pictures (`.png`, `.svg`) of an earlier run from `dir`.
+fn remove_pictures(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if matches!(
+            path.extension().and_then(|e| e.to_str()),
+            Some("png" | "svg")
+        ) {
+            let _ = std::fs::remove_file(&path);
+        }
+    }
 }
 
 /// Sets the velocities and accelerations of `state` to zero.

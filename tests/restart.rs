@@ -119,6 +119,7 @@ fn a_run_stopped_half_way_and_restarted_ends_as_one_never_stopped() {
     let mut whole = driven_bend(&[2.0], 600.0);
     whole.output = Some(OutputInput {
         restart_times: vec![1.0],
+        ..OutputInput::default()
     });
     let (code, err, out_whole) = run(&dir, "whole", &whole, &[]);
     assert_eq!(code, 0, "{err}");
@@ -436,6 +437,7 @@ fn restart_times_outside_the_run_are_refused() {
         let mut input = driven_bend(&[2.0], 600.0);
         input.output = Some(OutputInput {
             restart_times: vec![t],
+            ..OutputInput::default()
         });
         let (code, err, _) = run(&dir, name, &input, &[]);
         assert_eq!(code, 2, "t = {t}: {err}");

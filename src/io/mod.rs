@@ -13,8 +13,11 @@
 //!   run continues;
 //! - [`vtk`]: the VTK unstructured-grid (`.vtu`) and collection (`.pvd`)
 //!   writers;
-//! - [`plot`]: line charts of result histories, as SVG and PNG files.
+//! - [`plot`]: line charts of result histories, as SVG and PNG files;
+//! - [`histories`]: the charts of a run for a report (joint coordinates,
+//!   hinge moments, energies), drawn from its result files.
 
+pub mod histories;
 pub mod model_file;
 pub mod modes;
 pub mod plot;

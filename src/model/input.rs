@@ -157,6 +157,11 @@ pub struct OutputInput {
     /// order, within the analyses; the analyses land on them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub restart_times: Vec<f64>,
+    /// Charts written with the results when the run ends (`joints`,
+    /// `moments`, `energies`; docs/plots.md), into `plots/` of the
+    /// output directory.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plots: Vec<String>,
 }
 
 /// A kinematic pair between node A and node B (or the ground).

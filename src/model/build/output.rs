@@ -1,4 +1,4 @@
-//! `[output]`: the restart times.
+//! `[output]`: the restart times and the charts written with the results.
 
 use super::{num, Checker};
 use crate::model::input::OutputInput;
@@ -30,5 +30,14 @@ pub(super) fn check(ck: &mut Checker, output: Option<&OutputInput>, end_time: f6
             "output",
             "restart_times must be in increasing order",
         );
+    }
+    for name in &o.plots {
+        if crate::io::histories::Group::from_name(name).is_none() {
+            ck.push(
+                ModelErrorKind::Invalid,
+                "output",
+                format!("plots: {name:?} is not a kind of chart; give \"joints\", \"moments\" or \"energies\""),
+            );
+        }
     }
 }

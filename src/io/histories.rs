@@ -1,0 +1,1062 @@
+//! Time histories of a run, drawn from its result files for a report
+//! (docs/plots.md): the joint coordinates, the moments (or forces) the
+//! joint springs, hinge laws, latches and drivers apply along them, and
+//! the energies of a dynamic analysis with its balance error on a chart
+//! of its own.
+//!
+//! The files are read as `unfold run` writes them (docs/results.md);
+//! which coordinates are angles and which joint each spring, law, latch
+//! and driver acts on is read from the model file named in
+//! `summary.json` (or given). The instants at which latches lock (the
+//! first step with `locked = 1` in `latches.csv`) and the events of
+//! `events.csv`, when the run wrote one, are vertical lines on the charts
+//! of their joint and on the energy charts.
+//!
+//! ```no_run
+//! use unfold::io::histories::{Format, Histories, Request};
+//!
+//! let h = Histories::read("results/panels".as_ref(), None).unwrap();
+//! let figures = h.figures(&Request::default()).unwrap();
+//! for path in Histories::write(&figures, "results/panels/plots".as_ref(), Format::Both).unwrap() {
+//!     println!("{}", path.display());
+//! }
+//! ```
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+use super::plot::{Axis, Chart, PlotError, Series};
+use crate::joints::{Coordinate, JointType};
+use crate::model::Id;
+
+/// A family of charts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Group {
+    /// The coordinates of every joint against `t`, one chart per joint.
+    Joints,
+    /// Moments and forces along the joint coordinates: joint springs and
+    /// dampers, hinge laws, latch loads and driver loads, one chart per
+    /// joint.
+    Moments,
+    /// Energies of a dynamic analysis, and its balance error.
+    Energies,
+}
+
+impl Group {
+    /// Every group, in the order charts are written.
+    pub const ALL: [Group; 3] = [Group::Joints, Group::Moments, Group::Energies];
+
+    /// Name on the command line and in `[output] plots`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Group::Joints => "joints",
+            Group::Moments => "moments",
+            Group::Energies => "energies",
+        }
+    }
+
+    /// The group named `name`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|g| g.name() == name)
+    }
+}
+
+/// How the axes name the units of the values, which are those of the
+/// model (docs/model-format.md: consistent units of the user's choice).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UnitLabels {
+    /// SI: s, m, N, N·m, J (the recommended system).
+    #[default]
+    Si,
+    /// The model's own units, named by their dimension ("force·length").
+    Model,
+}
+
+impl UnitLabels {
+    fn time(self) -> &'static str {
+        match self {
+            Self::Si => "s",
+            Self::Model => "time unit",
+        }
+    }
+    fn length(self) -> &'static str {
+        match self {
+            Self::Si => "m",
+            Self::Model => "length unit",
+        }
+    }
+    fn force(self) -> &'static str {
+        match self {
+            Self::Si => "N",
+            Self::Model => "force unit",
+        }
+    }
+    fn moment(self) -> &'static str {
+        match self {
+            Self::Si => "N·m",
+            Self::Model => "force·length",
+        }
+    }
+    fn energy(self) -> &'static str {
+        match self {
+            Self::Si => "J",
+            Self::Model => "force·length",
+        }
+    }
+}
+
+/// What to draw.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Request {
+    /// The groups; empty for every group the results allow.
+    pub groups: Vec<Group>,
+    /// The joints of the joint and moment charts; empty for all.
+    pub joints: Vec<Id>,
+    /// Angles in degrees (the files give radians).
+    pub degrees: bool,
+    /// Unit names on the axes.
+    pub units: UnitLabels,
+}
+
+/// File formats of the charts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Format {
+    /// PNG pictures.
+    Png,
+    /// SVG drawings.
+    Svg,
+    /// Both.
+    #[default]
+    Both,
+}
+
+/// A chart and the stem of its file names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Figure {
+    /// File name without extension (`joint_10`).
+    pub name: String,
+    /// The chart.
+    pub chart: Chart,
+}
+
+/// Why the histories could not be read or drawn.
+#[derive(Debug, thiserror::Error)]
+pub enum HistoryError {
+    /// The results directory does not exist.
+    #[error("{0}: no such directory")]
+    NoDirectory(PathBuf),
+    /// The directory holds no results of a run.
+    #[error("{0}: no results here (no steps.csv); write them with `unfold run MODEL --out DIR`")]
+    NoResults(PathBuf),
+    /// A file could not be read.
+    #[error("{path}: {source}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        source: std::io::Error,
+    },
+    /// A result file is not as `unfold run` writes it.
+    #[error("{path}, line {line}: {message}")]
+    Malformed {
+        /// The file.
+        path: PathBuf,
+        /// Line number, from 1.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A joint asked for is not in the results.
+    #[error("joint {id}: not in {path} (its joints: {known})")]
+    UnknownJoint {
+        /// The joint asked for.
+        id: Id,
+        /// `joints.csv`.
+        path: PathBuf,
+        /// The joints it holds.
+        known: String,
+    },
+    /// A group asked for that the results cannot give.
+    #[error("{group}: nothing to plot: {reason}")]
+    Unavailable {
+        /// The group's name.
+        group: &'static str,
+        /// Why.
+        reason: String,
+    },
+    /// The output directory could not be created.
+    #[error("{path}: {source}")]
+    Write {
+        /// The directory.
+        path: PathBuf,
+        /// What went wrong.
+        source: std::io::Error,
+    },
+    /// A chart could not be drawn or written.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
+}
+
+/// A CSV result file: header and rows as text, numbers parsed on demand
+/// so that an error names the line.
+#[derive(Clone, Debug)]
+struct Table {
+    path: PathBuf,
+    header: Vec<String>,
+    /// Line number (from 1) and fields of each row.
+    rows: Vec<(usize, Vec<String>)>,
+}
+
+impl Table {
+    /// Reads `path`; `None` if the file does not exist.
+    fn read(path: &Path) -> Result<Option<Self>, HistoryError> {
+        let text = match std::fs::read_to_string(path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(source) => {
+                return Err(HistoryError::Read {
+                    path: path.to_path_buf(),
+                    source,
+                })
+            }
+        };
+        let malformed = |line, message: String| HistoryError::Malformed {
+            path: path.to_path_buf(),
+            line,
+            message,
+        };
+        let mut lines = text.lines().enumerate();
+        let header: Vec<String> = match lines.next() {
+            Some((_, h)) if !h.trim().is_empty() => {
+                h.split(',').map(|c| c.trim().to_string()).collect()
+            }
+            _ => return Err(malformed(1, "empty file: no header row".into())),
+        };
+        let mut rows = Vec::new();
+        for (k, line) in lines {
+            if line.trim().is_empty() {
+                continue;
+            }
+            let fields: Vec<String> = line.split(',').map(|f| f.trim().to_string()).collect();
+            if fields.len() != header.len() {
+                return Err(malformed(
+                    k + 1,
+                    format!(
+                        "{} fields, but the header names {} columns",
+                        fields.len(),
+                        header.len()
+                    ),
+                ));
+            }
+            rows.push((k + 1, fields));
+        }
+        Ok(Some(Self {
+            path: path.to_path_buf(),
+            header,
+            rows,
+        }))
+    }
+
+    /// Index of column `name`, if the file has it.
+    fn find(&self, name: &str) -> Option<usize> {
+        self.header.iter().position(|h| h == name)
+    }
+
+    /// Index of column `name`, which the file must have.
+    fn column(&self, name: &str) -> Result<usize, HistoryError> {
+        self.find(name).ok_or_else(|| HistoryError::Malformed {
+            path: self.path.clone(),
+            line: 1,
+            message: format!("no column `{name}` in the header"),
+        })
+    }
+
+    /// The number in row `r`, column `c`: NaN where the field is empty.
+    fn number(&self, r: usize, c: usize) -> Result<f64, HistoryError> {
+        let (line, fields) = &self.rows[r];
+        let field = &fields[c];
+        if field.is_empty() {
+            return Ok(f64::NAN);
+        }
+        field.parse().map_err(|_| HistoryError::Malformed {
+            path: self.path.clone(),
+            line: *line,
+            message: format!("column `{}`: {field:?} is not a number", self.header[c]),
+        })
+    }
+
+    /// The id in row `r`, column `c`.
+    fn id(&self, r: usize, c: usize) -> Result<Id, HistoryError> {
+        let (line, fields) = &self.rows[r];
+        fields[c].parse().map_err(|_| HistoryError::Malformed {
+            path: self.path.clone(),
+            line: *line,
+            message: format!("column `{}`: {:?} is not an id", self.header[c], fields[c]),
+        })
+    }
+
+    /// For each id of column `id_column` (in increasing order), its
+    /// points `(time, value)` of each of `columns`.
+    #[allow(clippy::type_complexity)]
+    fn histories(
+        &self,
+        id_column: &str,
+        columns: &[&str],
+    ) -> Result<BTreeMap<Id, Vec<Vec<(f64, f64)>>>, HistoryError> {
+        let time = self.column("time")?;
+        let id = self.column(id_column)?;
+        let cols: Vec<usize> = columns
+            .iter()
+            .map(|c| self.column(c))
+            .collect::<Result<_, _>>()?;
+        let mut out: BTreeMap<Id, Vec<Vec<(f64, f64)>>> = BTreeMap::new();
+        for r in 0..self.rows.len() {
+            let t = self.number(r, time)?;
+            let entry = out
+                .entry(self.id(r, id)?)
+                .or_insert_with(|| vec![Vec::new(); cols.len()]);
+            for (k, &c) in cols.iter().enumerate() {
+                entry[k].push((t, self.number(r, c)?));
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// `x` to four significant digits, in exponent form outside [1e-3, 1e5).
+fn significant(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 {
+        return "0".into();
+    }
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        let text = format!("{x:.decimals$}");
+        // trailing zeros say nothing here
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+/// Whether a series has a finite value.
+fn has_values(points: &[(f64, f64)]) -> bool {
+    points.iter().any(|p| p.0.is_finite() && p.1.is_finite())
+}
+
+/// What the model file says about the coordinates in the results.
+#[derive(Clone, Debug, Default)]
+struct Coordinates {
+    /// Type of each joint.
+    joints: BTreeMap<Id, JointType>,
+    /// Joint and coordinate of each joint spring, hinge law, latch and
+    /// joint driver, by file and id.
+    acting: BTreeMap<(&'static str, Id), (Id, Coordinate)>,
+}
+
+impl Coordinates {
+    /// From the model file at `path` (parsed, not built).
+    fn of_model(path: &Path) -> Option<Self> {
+        let text = std::fs::read_to_string(path).ok()?;
+        let input = super::model_file::parse_model(&text, path).ok()?;
+        let joints: BTreeMap<Id, JointType> = input.joints.iter().map(|j| (j.id, j.kind)).collect();
+        // the coordinate named, or the joint's first (as the model builder
+        // resolves it, src/model/build/joints.rs)
+        let resolve = |joint: Id, name: &Option<String>| -> Option<(Id, Coordinate)> {
+            let coords = joints.get(&joint)?.coordinates();
+            let c = match name {
+                None => coords.first().copied(),
+                Some(n) => coords.iter().copied().find(|c| c.name() == n),
+            }?;
+            Some((joint, c))
+        };
+        let mut acting = BTreeMap::new();
+        for s in &input.joint_springs {
+            if let Some(c) = resolve(s.joint, &s.coordinate) {
+                acting.insert(("joint_springs", s.id), c);
+            }
+        }
+        for h in &input.hinge_laws {
+            if let Some(c) = resolve(h.joint, &h.coordinate) {
+                acting.insert(("hinge_laws", h.id), c);
+            }
+        }
+        for l in &input.latches {
+            if let Some(c) = resolve(l.joint, &l.coordinate) {
+                acting.insert(("latches", l.id), c);
+            }
+        }
+        for d in &input.drivers {
+            if let Some(c) = d.joint.and_then(|j| resolve(j, &d.coordinate)) {
+                acting.insert(("drivers", d.id), c);
+            }
+        }
+        Some(Self { joints, acting })
+    }
+}
+
+/// A vertical line: at `t`, on the charts of `joint` (all joint charts if
+/// `None`) and on the energy charts.
+#[derive(Clone, Debug, PartialEq)]
+struct Event {
+    time: f64,
+    joint: Option<Id>,
+    label: String,
+    /// Energy lost at the event (`events.csv`), in the model's units.
+    lost: Option<f64>,
+}
+
+/// The result files of one run, read.
+#[derive(Debug)]
+pub struct Histories {
+    dir: PathBuf,
+    /// Types of the analyses of the run (`summary.json`), if known.
+    analysis_types: Vec<String>,
+    /// Coordinates of the model, if its file could be read.
+    coordinates: Option<Coordinates>,
+    /// The model file looked for.
+    model_file: Option<PathBuf>,
+    joints: Option<Table>,
+    joint_springs: Option<Table>,
+    hinge_laws: Option<Table>,
+    latches: Option<Table>,
+    drivers: Option<Table>,
+    energies: Option<Table>,
+    events: Vec<Event>,
+}
+
+impl Histories {
+    /// Reads the result files in `dir`; `model` is the model file that
+    /// says which coordinates are angles (default: the one named in
+    /// `summary.json`, relative to the current directory if relative).
+    pub fn read(dir: &Path, model: Option<&Path>) -> Result<Self, HistoryError> {
+        if !dir.is_dir() {
+            return Err(HistoryError::NoDirectory(dir.to_path_buf()));
+        }
+        if !dir.join("steps.csv").is_file() {
+            return Err(HistoryError::NoResults(dir.to_path_buf()));
+        }
+        let summary_path = dir.join("summary.json");
+        let summary: Option<serde_json::Value> = match std::fs::read_to_string(&summary_path) {
+            Ok(text) => Some(
+                serde_json::from_str(&text).map_err(|e| HistoryError::Malformed {
+                    path: summary_path.clone(),
+                    line: e.line(),
+                    message: e.to_string(),
+                })?,
+            ),
+            Err(_) => None,
+        };
+        let analysis_types = summary
+            .as_ref()
+            .and_then(|s| s["analyses"].as_array())
+            .map(|a| {
+                a.iter()
+                    .filter_map(|x| x["type"].as_str().map(str::to_string))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let model_file = model.map(Path::to_path_buf).or_else(|| {
+            summary
+                .as_ref()
+                .and_then(|s| s["model"].as_str())
+                .map(PathBuf::from)
+        });
+        let coordinates = model_file.as_deref().and_then(Coordinates::of_model);
+        let table = |name: &str| Table::read(&dir.join(name));
+        let mut h = Self {
+            dir: dir.to_path_buf(),
+            analysis_types,
+            coordinates,
+            model_file,
+            joints: table("joints.csv")?,
+            joint_springs: table("joint_springs.csv")?,
+            hinge_laws: table("hinge_laws.csv")?,
+            latches: table("latches.csv")?,
+            drivers: table("drivers.csv")?,
+            energies: table("energies.csv")?,
+            events: Vec::new(),
+        };
+        h.events = h.read_events()?;
+        Ok(h)
+    }
+
+    /// What the charts cannot know, to tell the user: the model file was
+    /// not found, so angles and lengths are not told apart.
+    pub fn notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        let has_coordinates = self.joints.is_some()
+            || self.joint_springs.is_some()
+            || self.hinge_laws.is_some()
+            || self.latches.is_some();
+        if self.coordinates.is_none() && has_coordinates {
+            let which = self
+                .model_file
+                .as_ref()
+                .map_or("summary.json names none".into(), |p| {
+                    format!("{} cannot be read", p.display())
+                });
+            notes.push(format!(
+                "model file unknown ({which}; give it with --model): coordinates are plotted as the files give them, angles in rad and slides in length units, without telling them apart"
+            ));
+        }
+        notes
+    }
+
+    /// Lock instants (`latches.csv`) and the events of `events.csv`.
+    fn read_events(&self) -> Result<Vec<Event>, HistoryError> {
+        let mut events = Vec::new();
+        if let Some(t) = &self.latches {
+            let (time, latch, locked) =
+                (t.column("time")?, t.column("latch")?, t.column("locked")?);
+            let mut seen = BTreeSet::new();
+            for r in 0..t.rows.len() {
+                let id = t.id(r, latch)?;
+                if t.number(r, locked)? == 1.0 && seen.insert(id) {
+                    let joint = self
+                        .coordinates
+                        .as_ref()
+                        .and_then(|c| c.acting.get(&("latches", id)))
+                        .map(|a| a.0);
+                    events.push(Event {
+                        time: t.number(r, time)?,
+                        joint,
+                        label: format!("latch {id} locks"),
+                        lost: None,
+                    });
+                }
+            }
+        }
+        // events.csv, when the run wrote one: `time`, `joint`, `energy_lost`
+        // and possibly a kind of event
+        if let Some(t) = Table::read(&self.dir.join("events.csv"))? {
+            let time = t.column("time")?;
+            let joint = t.find("joint");
+            let lost = t.find("energy_lost");
+            let kind = ["event", "kind", "type"].iter().find_map(|c| t.find(c));
+            for r in 0..t.rows.len() {
+                let at = t.number(r, time)?;
+                let joint = match joint {
+                    Some(c) if !t.rows[r].1[c].is_empty() => Some(t.id(r, c)?),
+                    _ => None,
+                };
+                let mut label = match kind {
+                    Some(c) if !t.rows[r].1[c].is_empty() => t.rows[r].1[c].clone(),
+                    _ => "event".to_string(),
+                };
+                if let Some(j) = joint {
+                    label += &format!(" at joint {j}");
+                }
+                let lost = match lost {
+                    Some(c) => Some(t.number(r, c)?).filter(|e| e.is_finite()),
+                    None => None,
+                };
+                // a lock already marked from latches.csv at the same instant
+                // (and joint, where both are known) takes the energy lost
+                // instead of a second line
+                let tol = 1e-9 * at.abs().max(1.0);
+                if let Some(e) = events.iter_mut().find(|e: &&mut Event| {
+                    (e.time - at).abs() <= tol
+                        && (e.joint == joint || joint.is_none() || e.joint.is_none())
+                }) {
+                    e.lost = e.lost.or(lost);
+                    continue;
+                }
+                events.push(Event {
+                    time: at,
+                    joint,
+                    label,
+                    lost,
+                });
+            }
+        }
+        Ok(events)
+    }
+
+    /// The horizontal axis: the load parameter of static and kinematic
+    /// analyses, time in dynamic ones.
+    fn time_axis(&self, units: UnitLabels) -> Axis {
+        let dynamic = self.analysis_types.iter().any(|t| t == "dynamic") || self.energies.is_some();
+        let quasi_static = self
+            .analysis_types
+            .iter()
+            .any(|t| t == "static" || t == "kinematic");
+        match (dynamic, quasi_static) {
+            (true, false) => Axis::new("time t", units.time()),
+            (true, true) => Axis::new("t: load parameter (static), time (dynamic)", units.time()),
+            _ => Axis::dimensionless("load parameter t"),
+        }
+    }
+
+    /// The joints in `joints.csv`, in increasing id.
+    pub fn joint_ids(&self) -> Result<Vec<Id>, HistoryError> {
+        let Some(t) = &self.joints else {
+            return Ok(Vec::new());
+        };
+        let c = t.column("joint")?;
+        let ids: BTreeSet<Id> = (0..t.rows.len())
+            .map(|r| t.id(r, c))
+            .collect::<Result<_, _>>()?;
+        Ok(ids.into_iter().collect())
+    }
+
+    /// The groups these results can give.
+    pub fn available(&self) -> Vec<Group> {
+        let mut groups = Vec::new();
+        if self.joints.is_some() {
+            groups.push(Group::Joints);
+        }
+        if self.joint_springs.is_some()
+            || self.hinge_laws.is_some()
+            || self.latches.is_some()
+            || self.drivers.is_some()
+        {
+            groups.push(Group::Moments);
+        }
+        if self.energies.is_some() {
+            groups.push(Group::Energies);
+        }
+        groups
+    }
+
+    /// The charts of `request`: an error if a group asked for has nothing
+    /// to draw, or a joint asked for is not in the results.
+    pub fn figures(&self, request: &Request) -> Result<Vec<Figure>, HistoryError> {
+        let available = self.available();
+        let groups: Vec<Group> = if request.groups.is_empty() {
+            available.clone()
+        } else {
+            let mut g = request.groups.clone();
+            g.sort();
+            g.dedup();
+            g
+        };
+        if groups.is_empty() {
+            return Err(HistoryError::Unavailable {
+                group: "results",
+                reason: format!(
+                    "{} has no joint, moment or energy histories",
+                    self.dir.display()
+                ),
+            });
+        }
+        let known = self.joint_ids()?;
+        for &id in &request.joints {
+            if !known.contains(&id) {
+                return Err(HistoryError::UnknownJoint {
+                    id,
+                    path: self.dir.join("joints.csv"),
+                    known: if known.is_empty() {
+                        "none".into()
+                    } else {
+                        known
+                            .iter()
+                            .map(Id::to_string)
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    },
+                });
+            }
+        }
+        let chosen = |j: Id| request.joints.is_empty() || request.joints.contains(&j);
+        let mut figures = Vec::new();
+        for group in groups {
+            if !available.contains(&group) {
+                let reason = match group {
+                    Group::Joints => "the model has no joints (no joints.csv)",
+                    Group::Moments => {
+                        "the model has no joint springs, hinge laws, latches or drivers"
+                    }
+                    Group::Energies => "no energies.csv: energies are written by dynamic analyses",
+                };
+                return Err(HistoryError::Unavailable {
+                    group: group.name(),
+                    reason: reason.into(),
+                });
+            }
+            match group {
+                Group::Joints => figures.extend(self.joint_figures(request, &chosen)?),
+                Group::Moments => figures.extend(self.moment_figures(request, &chosen)?),
+                Group::Energies => figures.extend(self.energy_figures(request)?),
+            }
+        }
+        // a run that stopped before its first step has rows without values
+        figures.retain(|f| f.chart.series.iter().any(|s| has_values(&s.points)));
+        if figures.is_empty() {
+            return Err(HistoryError::Unavailable {
+                group: "results",
+                reason: format!("{} has no step with values", self.dir.display()),
+            });
+        }
+        Ok(figures)
+    }
+
+    /// The events on the charts of joint `joint` (`None`: charts of no
+    /// single joint, which show every event).
+    fn events_of(&self, joint: Option<Id>) -> impl Iterator<Item = &Event> {
+        self.events
+            .iter()
+            .filter(move |e| joint.is_none() || e.joint.is_none() || e.joint == joint)
+    }
+
+    fn with_events(&self, mut chart: Chart, joint: Option<Id>, units: UnitLabels) -> Chart {
+        for e in self.events_of(joint) {
+            let label = match e.lost {
+                Some(lost) => format!("{}, {} {} lost", e.label, significant(lost), units.energy()),
+                None => e.label.clone(),
+            };
+            chart = chart.event(e.time, label);
+        }
+        chart
+    }
+
+    /// The unit of coordinate `c` (and the factor from the file's values).
+    fn coordinate_unit(c: Coordinate, request: &Request) -> (&'static str, f64) {
+        if c.is_angle() {
+            if request.degrees {
+                ("°", 180.0 / std::f64::consts::PI)
+            } else {
+                ("rad", 1.0)
+            }
+        } else {
+            (request.units.length(), 1.0)
+        }
+    }
+
+    /// One chart per joint and kind of coordinate (angles, lengths).
+    fn joint_figures(
+        &self,
+        request: &Request,
+        chosen: &dyn Fn(Id) -> bool,
+    ) -> Result<Vec<Figure>, HistoryError> {
+        let Some(t) = &self.joints else {
+            return Ok(Vec::new());
+        };
+        let names: Vec<&str> = ["c1", "c2", "c3"]
+            .into_iter()
+            .filter(|c| t.find(c).is_some())
+            .collect();
+        let histories = t.histories("joint", &names)?;
+        let x = self.time_axis(request.units);
+        let mut figures = Vec::new();
+        for (id, columns) in histories {
+            if !chosen(id) {
+                continue;
+            }
+            let kind = self
+                .coordinates
+                .as_ref()
+                .and_then(|c| c.joints.get(&id))
+                .copied();
+            let Some(kind) = kind else {
+                // coordinates of unknown kind: as in the file
+                let mut chart = Chart::new(
+                    format!("Joint {id}: coordinates"),
+                    x.clone(),
+                    Axis::new("coordinate", format!("rad or {}", request.units.length())),
+                );
+                let mut any = false;
+                for (name, points) in names.iter().zip(columns) {
+                    if has_values(&points) {
+                        chart = chart.series(Series::new(*name, points));
+                        any = true;
+                    }
+                }
+                if any {
+                    figures.push(Figure {
+                        name: format!("joint_{id}"),
+                        chart: self.with_events(chart, Some(id), request.units),
+                    });
+                }
+                continue;
+            };
+            let coords = kind.coordinates();
+            if coords.is_empty() {
+                continue;
+            }
+            let angles: Vec<usize> = (0..coords.len())
+                .filter(|&k| coords[k].is_angle())
+                .collect();
+            let lengths: Vec<usize> = (0..coords.len())
+                .filter(|&k| !coords[k].is_angle())
+                .collect();
+            let split = !angles.is_empty() && !lengths.is_empty();
+            for (part, members) in [("angles", angles), ("lengths", lengths)] {
+                if members.is_empty() {
+                    continue;
+                }
+                let first = coords[members[0]];
+                let (unit, factor) = Self::coordinate_unit(first, request);
+                let quantity = if first.is_angle() {
+                    "angle"
+                } else {
+                    "displacement"
+                };
+                let what: Vec<&str> = members.iter().map(|&k| coords[k].name()).collect();
+                let mut chart = Chart::new(
+                    format!("Joint {id} ({}): {}", kind.name(), what.join(", ")),
+                    x.clone(),
+                    Axis::new(quantity, unit),
+                );
+                for &k in &members {
+                    let points = columns[k].iter().map(|&(t, v)| (t, v * factor));
+                    chart = chart.series(Series::new(
+                        format!("{} (c{})", coords[k].name(), k + 1),
+                        points,
+                    ));
+                }
+                let name = if split {
+                    format!("joint_{id}_{part}")
+                } else {
+                    format!("joint_{id}")
+                };
+                figures.push(Figure {
+                    name,
+                    chart: self.with_events(chart, Some(id), request.units),
+                });
+            }
+        }
+        Ok(figures)
+    }
+
+    /// One chart per joint of the moments (or forces) along its
+    /// coordinates; all of them on one chart when the joints are unknown.
+    fn moment_figures(
+        &self,
+        request: &Request,
+        chosen: &dyn Fn(Id) -> bool,
+    ) -> Result<Vec<Figure>, HistoryError> {
+        // the files of loads along joint coordinates: (table, its name in
+        // `Coordinates::acting`, id column, [(column, legend)])
+        type Source<'t> = (&'t Option<Table>, &'static str, &'static str, Legends);
+        type Legends = &'static [(&'static str, &'static str)];
+        let sources: [Source; 4] = [
+            (
+                &self.joint_springs,
+                "joint_springs",
+                "element",
+                &[("spring", "spring"), ("damper", "damper")],
+            ),
+            (
+                &self.hinge_laws,
+                "hinge_laws",
+                "element",
+                &[("moment", "hinge law")],
+            ),
+            (&self.latches, "latches", "latch", &[("load", "latch")]),
+            (&self.drivers, "drivers", "driver", &[("load", "driver")]),
+        ];
+        // series by joint and by kind of coordinate (angle or not): None
+        // when unknown
+        let mut charts: BTreeMap<(Option<Id>, bool), Vec<Series>> = BTreeMap::new();
+        for (table, file, id_column, columns) in sources {
+            let Some(t) = table else { continue };
+            let cols: Vec<&str> = columns.iter().map(|c| c.0).collect();
+            for (id, histories) in t.histories(id_column, &cols)? {
+                let acting = self
+                    .coordinates
+                    .as_ref()
+                    .and_then(|c| c.acting.get(&(file, id)))
+                    .copied();
+                if let Some((joint, _)) = acting {
+                    if !chosen(joint) {
+                        continue;
+                    }
+                } else if file == "drivers" && self.coordinates.is_some() {
+                    // a driver of a node, not of a joint coordinate
+                    continue;
+                }
+                let key = (acting.map(|a| a.0), acting.is_none_or(|a| a.1.is_angle()));
+                for ((_, legend), points) in columns.iter().zip(histories) {
+                    // a damper that never acts is left out
+                    if !has_values(&points)
+                        || (*legend == "damper" && points.iter().all(|p| p.1 == 0.0))
+                    {
+                        continue;
+                    }
+                    let coordinate = acting.map_or(String::new(), |a| format!(", {}", a.1.name()));
+                    charts
+                        .entry(key)
+                        .or_default()
+                        .push(Series::new(format!("{legend} {id}{coordinate}"), points));
+                }
+            }
+        }
+        let x = self.time_axis(request.units);
+        let split = |joint: Option<Id>| {
+            charts.contains_key(&(joint, true)) && charts.contains_key(&(joint, false))
+        };
+        let mut figures = Vec::new();
+        for (&(joint, angle), series) in &charts {
+            let known = self.coordinates.is_some();
+            let (quantity, unit) = match (known, angle) {
+                (false, _) => (
+                    "moment or force",
+                    format!("{} or {}", request.units.moment(), request.units.force()),
+                ),
+                (true, true) => ("moment", request.units.moment().to_string()),
+                (true, false) => ("force", request.units.force().to_string()),
+            };
+            let (title, mut name) = match joint {
+                Some(j) => (
+                    format!("Joint {j}: {quantity}s along its coordinates"),
+                    format!("moments_joint_{j}"),
+                ),
+                None => (
+                    "Moments and forces along the joint coordinates".into(),
+                    "moments".into(),
+                ),
+            };
+            if split(joint) {
+                name += if angle { "_moments" } else { "_forces" };
+            }
+            let mut chart = Chart::new(title, x.clone(), Axis::new(quantity, unit));
+            for s in series {
+                chart = chart.series(s.clone());
+            }
+            figures.push(Figure {
+                name,
+                chart: self.with_events(chart, joint, request.units),
+            });
+        }
+        Ok(figures)
+    }
+
+    /// The energies, and the balance error on a chart of its own.
+    fn energy_figures(&self, request: &Request) -> Result<Vec<Figure>, HistoryError> {
+        let Some(t) = &self.energies else {
+            return Ok(Vec::new());
+        };
+        let columns = [
+            ("kinetic", "kinetic T"),
+            ("strain", "strain"),
+            ("gravity", "gravity"),
+            ("spring", "springs"),
+            ("external_work", "external work W"),
+            ("dissipated", "dissipated D"),
+        ];
+        let names: Vec<&str> = columns.iter().map(|c| c.0).collect();
+        let time = t.column("time")?;
+        let cols: Vec<usize> = names
+            .iter()
+            .map(|c| t.column(c))
+            .collect::<Result<_, _>>()?;
+        let balance = t.column("balance_error")?;
+        let mut histories = vec![Vec::with_capacity(t.rows.len()); cols.len()];
+        let mut error = Vec::with_capacity(t.rows.len());
+        for r in 0..t.rows.len() {
+            let at = t.number(r, time)?;
+            for (k, &c) in cols.iter().enumerate() {
+                histories[k].push((at, t.number(r, c)?));
+            }
+            error.push((at, t.number(r, balance)?));
+        }
+        let x = self.time_axis(request.units);
+        let energy = request.units.energy();
+        let mut chart = Chart::new("Energies", x.clone(), Axis::new("energy", energy));
+        // a form of energy the model does not have (zero throughout, or
+        // round-off: below 1e-9 of the largest energy) is left out; the
+        // kinetic energy is always shown
+        let largest = histories
+            .iter()
+            .flatten()
+            .map(|p| p.1.abs())
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        for ((_, legend), points) in columns.iter().zip(histories) {
+            let negligible = |v: f64| !v.is_finite() || v.abs() <= 1e-9 * largest;
+            if *legend != "kinetic T" && points.iter().all(|p| negligible(p.1)) {
+                continue;
+            }
+            chart = chart.series(Series::new(*legend, points));
+        }
+        let mut figures = vec![Figure {
+            name: "energies".into(),
+            chart: self.with_events(chart, None, request.units),
+        }];
+        if has_values(&error) {
+            let chart = Chart::new(
+                "Energy balance error E = (T + V) − (T₀ + V₀) − W + D",
+                x,
+                Axis::new("E", energy),
+            )
+            .series(Series::new("balance error E", error));
+            figures.push(Figure {
+                name: "energy_balance_error".into(),
+                chart: self.with_events(chart, None, request.units),
+            });
+        }
+        Ok(figures)
+    }
+
+    /// Writes `figures` into `out` (created if missing) as
+    /// `<name>.png` and/or `<name>.svg`; returns the files written.
+    pub fn write(
+        figures: &[Figure],
+        out: &Path,
+        format: Format,
+    ) -> Result<Vec<PathBuf>, HistoryError> {
+        std::fs::create_dir_all(out).map_err(|source| HistoryError::Write {
+            path: out.to_path_buf(),
+            source,
+        })?;
+        let mut written = Vec::new();
+        for f in figures {
+            if matches!(format, Format::Png | Format::Both) {
+                let path = out.join(format!("{}.png", f.name));
+                f.chart.write_png(&path)?;
+                written.push(path);
+            }
+            if matches!(format, Format::Svg | Format::Both) {
+                let path = out.join(format!("{}.svg", f.name));
+                f.chart.write_svg(&path)?;
+                written.push(path);
+            }
+        }
+        Ok(written)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn energies_are_labelled_to_four_digits() {
+        assert_eq!(significant(2.25), "2.25");
+        assert_eq!(significant(235.6161), "235.6");
+        assert_eq!(significant(-0.0123456), "-0.01235");
+        assert_eq!(significant(12000.0), "12000");
+        assert_eq!(significant(0.0), "0");
+        assert_eq!(significant(1.5e-6), "1.500e-6");
+    }
+
+    #[test]
+    fn malformed_rows_are_named_by_line() {
+        let dir = std::env::temp_dir().join(format!("unfold-histories-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.csv");
+        std::fs::write(&path, "step,time,joint,c1\n0,0,1,0.5\n\n1,0.1,1,abc\n").unwrap();
+        let t = Table::read(&path).unwrap().unwrap();
+        let e = t.histories("joint", &["c1"]).unwrap_err().to_string();
+        assert!(
+            e.ends_with("t.csv, line 4: column `c1`: \"abc\" is not a number"),
+            "{e}"
+        );
+        std::fs::write(&path, "step,time\n0,0,3\n").unwrap();
+        let e = Table::read(&path).unwrap_err().to_string();
+        assert!(
+            e.ends_with("t.csv, line 2: 3 fields, but the header names 2 columns"),
+            "{e}"
+        );
+        std::fs::write(&path, "").unwrap();
+        let e = Table::read(&path).unwrap_err().to_string();
+        assert!(e.contains("line 1: empty file"), "{e}");
+        assert!(Table::read(&dir.join("absent.csv")).unwrap().is_none());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -1,5 +1,6 @@
 //! Line charts of result histories (moments along a deployment, driver
-//! loads, joint angles), written as SVG or PNG files.
+//! loads, joint angles) and line drawings of configurations, written as
+//! SVG or PNG files.
 //!
 //! Every chart says what it shows: each axis is a quantity with its unit
 //! ([`Axis`]), and each series has its own colour, line pattern (solid,
@@ -8,6 +9,10 @@
 //! are drawn with gaps, their markers shifted along the curve. Events
 //! such as a change of stage are vertical lines with a label
 //! ([`Chart::event`]).
+//!
+//! Line drawings of configurations ([`Wireframe`]): the members of a
+//! structure as lines in a parallel projection (isometric by default),
+//! several configurations side by side at one scale.
 //!
 //! The charts are drawn with `plotters` and an embedded font (DejaVu
 //! Sans, `assets/fonts/`, Bitstream Vera licence), so no system font
@@ -430,31 +435,326 @@ impl Chart {
 
     /// Writes the chart as an SVG file.
     pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
-        let svg = self.to_svg()?;
-        std::fs::write(path, svg).map_err(|source| PlotError::Io {
-            path: path.display().to_string(),
-            source,
-        })
+        write_text(path, &self.to_svg()?)
     }
 
     /// Writes the chart as a PNG file.
     pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
-        let pixels = self.to_rgb()?;
-        let io = |source| PlotError::Io {
-            path: path.display().to_string(),
-            source,
-        };
-        let file = std::fs::File::create(path).map_err(io)?;
-        let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), SIZE.0, SIZE.1);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let encoded = encoder
-            .write_header()
-            .and_then(|mut w| w.write_image_data(&pixels).and_then(|()| w.finish()));
-        encoded.map_err(|e| match e {
-            png::EncodingError::IoError(source) => io(source),
-            other => drawing_error(&other),
-        })
+        write_png(path, &self.to_rgb()?, SIZE)
+    }
+}
+
+/// Writes `pixels` (RGB, row by row) as a PNG file of `size`.
+fn write_png(path: &Path, pixels: &[u8], size: (u32, u32)) -> Result<(), PlotError> {
+    let io = |source| PlotError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let file = std::fs::File::create(path).map_err(io)?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), size.0, size.1);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let encoded = encoder
+        .write_header()
+        .and_then(|mut w| w.write_image_data(pixels).and_then(|()| w.finish()));
+    encoded.map_err(|e| match e {
+        png::EncodingError::IoError(source) => io(source),
+        other => drawing_error(&other),
+    })
+}
+
+/// Writes `svg` to `path`.
+fn write_text(path: &Path, svg: &str) -> Result<(), PlotError> {
+    std::fs::write(path, svg).map_err(|source| PlotError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+// ---------- line drawings of configurations ----------
+
+/// A parallel projection seen from the direction of azimuth `azimuth`
+/// (from `x` towards `y`) and elevation `elevation` above the `x`–`y`
+/// plane, `z` up on the page.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// Azimuth of the direction towards the viewer (rad).
+    pub azimuth: f64,
+    /// Elevation of the direction towards the viewer (rad).
+    pub elevation: f64,
+}
+
+impl View {
+    /// The isometric view from `(1, 1, 1)`: the three axes are drawn at
+    /// 120° to one another, foreshortened alike by `√(2/3)`.
+    pub fn isometric() -> Self {
+        Self {
+            azimuth: std::f64::consts::FRAC_PI_4,
+            elevation: (1.0 / 3f64.sqrt()).asin(),
+        }
+    }
+
+    /// The unit vectors of the page: right, up, and towards the viewer
+    /// (`w = (cos e cos a, cos e sin a, sin e)`, `right = z × w / |z × w|`,
+    /// `up = w × right`).
+    fn axes(&self) -> [[f64; 3]; 3] {
+        let (ca, sa) = (self.azimuth.cos(), self.azimuth.sin());
+        let (ce, se) = (self.elevation.cos(), self.elevation.sin());
+        let w = [ce * ca, ce * sa, se];
+        let right = [-sa, ca, 0.0];
+        let up = [
+            w[1] * right[2] - w[2] * right[1],
+            w[2] * right[0] - w[0] * right[2],
+            w[0] * right[1] - w[1] * right[0],
+        ];
+        [right, up, w]
+    }
+
+    /// The point `p` on the page: `(right, up)` coordinates, in the units
+    /// of `p`, and its depth towards the viewer.
+    pub fn project(&self, p: [f64; 3]) -> (f64, f64, f64) {
+        let [r, u, w] = self.axes();
+        let dot = |a: [f64; 3]| a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
+        (dot(r), dot(u), dot(w))
+    }
+}
+
+/// A line segment of a drawing and the group it belongs to (which sets
+/// its colour and its legend entry).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Segment {
+    /// First end.
+    pub from: [f64; 3],
+    /// Second end.
+    pub to: [f64; 3],
+    /// Index of its group in [`Wireframe::groups`].
+    pub group: usize,
+}
+
+/// One configuration of a drawing: its segments and marked points.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Panel {
+    /// Caption under the panel.
+    pub label: String,
+    /// Lines.
+    pub segments: Vec<Segment>,
+    /// Points marked with a dot, with their group.
+    pub points: Vec<([f64; 3], usize)>,
+}
+
+/// Configurations of a structure drawn side by side as lines in a
+/// parallel projection, all at one scale, with a title, a caption under
+/// each and a legend naming the groups of lines.
+///
+/// ```
+/// use unfold::io::plot::{Panel, Segment, Wireframe};
+///
+/// let edge = |from, to| Segment { from, to, group: 0 };
+/// let cube = Panel {
+///     label: "unit cube".into(),
+///     segments: vec![edge([0.0; 3], [1.0, 0.0, 0.0]), edge([0.0; 3], [0.0, 0.0, 1.0])],
+///     points: vec![([0.0; 3], 1)],
+/// };
+/// let svg = Wireframe::new("A cube", ["edges", "corners"]).panel(cube).to_svg().unwrap();
+/// assert!(svg.contains("unit cube"));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Wireframe {
+    /// Title above the panels.
+    pub title: String,
+    /// Legend names of the groups, in order (colours of [`Chart`]'s
+    /// series).
+    pub groups: Vec<String>,
+    /// The configurations, left to right.
+    pub panels: Vec<Panel>,
+    /// The projection.
+    pub view: View,
+}
+
+/// Size of one panel of a [`Wireframe`], pixels.
+pub const PANEL_SIZE: (u32, u32) = (600, 520);
+
+/// Heights of a [`Wireframe`]'s title band and legend band, pixels.
+const WIREFRAME_BANDS: (u32, u32) = (50, 70);
+
+impl Wireframe {
+    /// An empty drawing, isometric, with its title and the names of its
+    /// groups of lines.
+    pub fn new(title: impl Into<String>, groups: impl IntoIterator<Item = impl Into<String>>) -> Self {
+        Self {
+            title: title.into(),
+            groups: groups.into_iter().map(Into::into).collect(),
+            panels: Vec::new(),
+            view: View::isometric(),
+        }
+    }
+
+    /// Adds a panel on the right.
+    pub fn panel(mut self, panel: Panel) -> Self {
+        self.panels.push(panel);
+        self
+    }
+
+    /// Sets the projection.
+    pub fn view(mut self, view: View) -> Self {
+        self.view = view;
+        self
+    }
+
+    /// Size of the picture, pixels.
+    pub fn size(&self) -> (u32, u32) {
+        let n = self.panels.len().max(1) as u32;
+        (
+            n * PANEL_SIZE.0,
+            PANEL_SIZE.1 + WIREFRAME_BANDS.0 + WIREFRAME_BANDS.1,
+        )
+    }
+
+    /// Draws the panels on `root`: the scale is the largest at which every
+    /// panel fits its box with a margin, each panel centred in its box;
+    /// segments are drawn from the farthest to the nearest.
+    fn draw<'d, DB: DrawingBackend + 'd>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> Result<(), PlotError> {
+        register()?;
+        let finite = |p: &[f64; 3]| p.iter().all(|c| c.is_finite());
+        let extents: Vec<Option<[f64; 4]>> = self
+            .panels
+            .iter()
+            .map(|panel| {
+                let mut b = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+                let ends = panel.segments.iter().flat_map(|s| [s.from, s.to]);
+                for p in ends.chain(panel.points.iter().map(|p| p.0)).filter(finite) {
+                    let (u, v, _) = self.view.project(p);
+                    b = [b[0].min(u), b[1].max(u), b[2].min(v), b[3].max(v)];
+                }
+                (b[0] <= b[1]).then_some(b)
+            })
+            .collect();
+        if extents.iter().all(Option::is_none) {
+            return Err(PlotError::Empty);
+        }
+        // one scale for all panels: the largest extent fills 85 % of its box
+        let (w, h) = (f64::from(PANEL_SIZE.0), f64::from(PANEL_SIZE.1));
+        let scale = extents
+            .iter()
+            .flatten()
+            .map(|b| (0.85 * w / (b[1] - b[0])).min(0.85 * h / (b[3] - b[2])))
+            .filter(|s| s.is_finite())
+            .fold(f64::INFINITY, f64::min);
+        let scale = if scale.is_finite() { scale } else { 1.0 };
+
+        root.fill(&WHITE).map_err(|e| drawing_error(&e))?;
+        let (width, _) = self.size();
+        let title: TextStyle = ("sans-serif", 22).into();
+        let (tw, _) = root
+            .estimate_text_size(&self.title, &title)
+            .map_err(|e| drawing_error(&e))?;
+        root.draw(&Text::new(
+            self.title.clone(),
+            ((width as i32 - tw as i32) / 2, 14),
+            title,
+        ))
+        .map_err(|e| drawing_error(&e))?;
+
+        let top = WIREFRAME_BANDS.0 as i32;
+        for (k, (panel, extent)) in self.panels.iter().zip(&extents).enumerate() {
+            let left = k as i32 * PANEL_SIZE.0 as i32;
+            if let Some(b) = extent {
+                let (cu, cv) = (0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]));
+                let page = |p: [f64; 3]| {
+                    let (u, v, _) = self.view.project(p);
+                    (
+                        left + (0.5 * w + scale * (u - cu)).round() as i32,
+                        top + (0.5 * h - scale * (v - cv)).round() as i32,
+                    )
+                };
+                // far to near
+                let mut order: Vec<(f64, &Segment)> = panel
+                    .segments
+                    .iter()
+                    .filter(|s| finite(&s.from) && finite(&s.to))
+                    .map(|s| {
+                        let mid = [0, 1, 2].map(|i| 0.5 * (s.from[i] + s.to[i]));
+                        (self.view.project(mid).2, s)
+                    })
+                    .collect();
+                order.sort_by(|a, b| a.0.total_cmp(&b.0));
+                for (_, s) in order {
+                    let colour = COLOURS[s.group % COLOURS.len()];
+                    root.draw(&PathElement::new(
+                        vec![page(s.from), page(s.to)],
+                        colour.stroke_width(2),
+                    ))
+                    .map_err(|e| drawing_error(&e))?;
+                }
+                for (p, group) in panel.points.iter().filter(|p| finite(&p.0)) {
+                    let colour = COLOURS[group % COLOURS.len()];
+                    root.draw(&Circle::new(page(*p), 3, colour.filled()))
+                        .map_err(|e| drawing_error(&e))?;
+                }
+            }
+            let font: TextStyle = ("sans-serif", 16).into();
+            let (lw, _) = root
+                .estimate_text_size(&panel.label, &font)
+                .map_err(|e| drawing_error(&e))?;
+            let x = left + (PANEL_SIZE.0 as i32 - lw as i32) / 2;
+            root.draw(&Text::new(panel.label.clone(), (x, top + PANEL_SIZE.1 as i32), font))
+                .map_err(|e| drawing_error(&e))?;
+        }
+
+        // legend: a short line of each group's colour and its name
+        let font: TextStyle = ("sans-serif", 15).into();
+        let y = top + PANEL_SIZE.1 as i32 + 40;
+        let mut x = 20;
+        for (g, name) in self.groups.iter().enumerate() {
+            let colour = COLOURS[g % COLOURS.len()];
+            root.draw(&PathElement::new(
+                vec![(x, y + 8), (x + 30, y + 8)],
+                colour.stroke_width(3),
+            ))
+            .map_err(|e| drawing_error(&e))?;
+            root.draw(&Text::new(name.clone(), (x + 38, y), font.clone()))
+                .map_err(|e| drawing_error(&e))?;
+            let (nw, _) = root
+                .estimate_text_size(name, &font)
+                .map_err(|e| drawing_error(&e))?;
+            x += 38 + nw as i32 + 30;
+        }
+        root.present().map_err(|e| drawing_error(&e))?;
+        Ok(())
+    }
+
+    /// The drawing as SVG text.
+    pub fn to_svg(&self) -> Result<String, PlotError> {
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, self.size()).into_drawing_area();
+            self.draw(&root)?;
+        }
+        Ok(svg)
+    }
+
+    /// The drawing as RGB pixels, [`Wireframe::size`], row by row.
+    pub fn to_rgb(&self) -> Result<Vec<u8>, PlotError> {
+        let size = self.size();
+        let mut pixels = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
+            self.draw(&root)?;
+        }
+        Ok(pixels)
+    }
+
+    /// Writes the drawing as an SVG file.
+    pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
+        write_text(path, &self.to_svg()?)
+    }
+
+    /// Writes the drawing as a PNG file.
+    pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
+        write_png(path, &self.to_rgb()?, self.size())
     }
 }
 
@@ -550,6 +850,84 @@ mod tests {
         assert!(matches!(bare.to_svg(), Err(PlotError::Axis(_))));
         let svg = sample().event(1.0, "stage (b)").to_svg().unwrap();
         assert!(svg.contains("stage (b)"));
+    }
+
+    /// The isometric view draws the three unit axes with the same length
+    /// `√(2/3)` at 120° to one another, `z` straight up.
+    #[test]
+    fn isometric_projection_foreshortens_the_axes_alike() {
+        let view = View::isometric();
+        let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|a| {
+            let (u, v, _) = view.project(a);
+            (u, v)
+        });
+        for (u, v) in axes {
+            assert!((u.hypot(v) - (2.0f64 / 3.0).sqrt()).abs() < 1e-15);
+        }
+        for k in 0..3 {
+            let (a, b) = (axes[k], axes[(k + 1) % 3]);
+            let cos = (a.0 * b.0 + a.1 * b.1) / (2.0 / 3.0);
+            assert!((cos + 0.5).abs() < 1e-15, "cos {cos}");
+        }
+        assert!(axes[2].0.abs() < 1e-15 && axes[2].1 > 0.0);
+        // the viewer looks from (1, 1, 1): that corner is the nearest
+        assert!(view.project([1.0, 1.0, 1.0]).2 > view.project([0.0, 0.0, 0.0]).2);
+    }
+
+    fn square(label: &str, size: f64) -> Panel {
+        let corners = [[0.0, 0.0], [size, 0.0], [size, size], [0.0, size]];
+        Panel {
+            label: label.into(),
+            segments: (0..4)
+                .map(|k| {
+                    let (a, b) = (corners[k], corners[(k + 1) % 4]);
+                    Segment {
+                        from: [a[0], a[1], 0.0],
+                        to: [b[0], b[1], 0.0],
+                        group: k % 2,
+                    }
+                })
+                .collect(),
+            points: vec![([0.0, 0.0, 0.0], 2)],
+        }
+    }
+
+    #[test]
+    fn wireframe_draws_every_panel_at_one_scale() {
+        let drawing = Wireframe::new("Two squares", ["sides", "other sides", "corner"])
+            .panel(square("small", 1.0))
+            .panel(square("large", 2.0));
+        assert_eq!(drawing.size(), (2 * PANEL_SIZE.0, PANEL_SIZE.1 + 120));
+        let svg = drawing.to_svg().unwrap();
+        for s in ["Two squares", "small", "large", "sides", "other sides", "corner"] {
+            assert!(svg.contains(s), "missing {s:?}");
+        }
+        // 8 sides and 3 legend lines, 2 dots
+        let lines = svg.matches("<polyline").count() + svg.matches("<line").count();
+        assert!(lines >= 11, "{lines} lines");
+        assert!(svg.matches("<circle").count() >= 2);
+        // one scale: the large square spans twice the pixels of the small
+        let pixels = drawing.to_rgb().unwrap();
+        let (w, _) = drawing.size();
+        let columns = |range: std::ops::Range<u32>| {
+            // within the panels' band (the legend below is blue too)
+            let band = WIREFRAME_BANDS.0..WIREFRAME_BANDS.0 + PANEL_SIZE.1;
+            let blue = |x: u32| {
+                pixels.chunks(3).enumerate().any(|(i, p)| {
+                    let (px, py) = (i as u32 % w, i as u32 / w);
+                    px == x && band.contains(&py) && p == [31, 119, 180]
+                })
+            };
+            let xs: Vec<u32> = range.filter(|&x| blue(x)).collect();
+            xs.last().unwrap() - xs.first().unwrap()
+        };
+        // (to the width of the lines, 2 px, at both ends of both squares)
+        let small = columns(0..PANEL_SIZE.0) as f64;
+        let large = columns(PANEL_SIZE.0..2 * PANEL_SIZE.0) as f64;
+        assert!((large - 2.0 * small).abs() <= 8.0, "{small} {large}");
+        // nothing to draw
+        let empty = Wireframe::new("none", ["a"]).panel(Panel::default());
+        assert!(matches!(empty.to_svg(), Err(PlotError::Empty)));
     }
 
     #[test]

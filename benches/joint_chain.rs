@@ -12,7 +12,7 @@ mod common;
 use std::time::Instant;
 
 use unfold::analysis::newton::NewtonSolver;
-use unfold::so3::{self, Vec3};
+use unfold::so3::Vec3;
 
 use common::{chain, median, sizes};
 
@@ -30,12 +30,12 @@ fn main() {
         let model = chain(n);
         let mut solver = NewtonSolver::new(&model);
         let mut state = model.initial_state();
-        for (i, (x, q)) in state.x.iter_mut().zip(state.q.iter_mut()).enumerate() {
+        for i in 0..model.n_nodes() {
             let s = i as f64 / (2 * n) as f64;
-            *x += Vec3::new(-0.01 * s, 0.05 * s * s, 0.001 * s);
-            *q *= so3::exp(&Vec3::new(0.01 * s, 0.02 * s, 0.3 * s));
+            let dx = Vec3::new(-0.01 * s, 0.05 * s * s, 0.001 * s);
+            state.displace_node(i, &dx, &Vec3::new(0.01 * s, 0.02 * s, 0.3 * s));
         }
-        for (k, v) in state.extra.iter_mut().enumerate() {
+        for (k, v) in state.multipliers.iter_mut().enumerate() {
             *v = 1e-3 * (k % 7) as f64;
         }
         solver.assemble(&model, &state, 1.0, true);
@@ -58,7 +58,7 @@ fn main() {
             .expect("a joint");
         let k = joint.n_local();
         let (mut r, mut t) = (vec![0.0; k], vec![0.0; k * k]);
-        let ctx = model.context(1.0, true);
+        let ctx = model.context(1.0, unfold::elements::Need::STIFFNESS);
         let tj = Instant::now();
         let evals = 2000;
         for _ in 0..evals {
@@ -67,10 +67,7 @@ fn main() {
             joint.evaluate(
                 &ctx,
                 &state,
-                &mut unfold::elements::ElementOutput {
-                    residual: &mut r,
-                    tangent: &mut t,
-                },
+                &mut unfold::elements::ElementOutput::with_stiffness(&mut r, &mut t),
             );
         }
         let per_joint = tj.elapsed().as_secs_f64() / evals as f64;

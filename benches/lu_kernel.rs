@@ -25,7 +25,7 @@ use std::time::{Duration, Instant};
 use unfold::analysis::newton::NewtonSolver;
 use unfold::linalg::{LuKernel, SparseLu, SparseMatrix};
 use unfold::model::Model;
-use unfold::so3::{self, Vec3};
+use unfold::so3::Vec3;
 use unfold::state::State;
 
 use common::{cantilever, chain, grid, median};
@@ -35,12 +35,12 @@ use common::{cantilever, chain, grid, median};
 fn deformed(model: &Model) -> State {
     let mut state = model.initial_state();
     let n = state.x.len() as f64;
-    for (i, (x, q)) in state.x.iter_mut().zip(state.q.iter_mut()).enumerate() {
+    for i in 0..state.x.len() {
         let s = i as f64 / n;
-        *x += Vec3::new(-0.01 * s, 0.05 * s * s, 0.001 * s);
-        *q *= so3::exp(&Vec3::new(0.01 * s, 0.02 * s, 0.3 * s));
+        let dx = Vec3::new(-0.01 * s, 0.05 * s * s, 0.001 * s);
+        state.displace_node(i, &dx, &Vec3::new(0.01 * s, 0.02 * s, 0.3 * s));
     }
-    for (k, v) in state.extra.iter_mut().enumerate() {
+    for (k, v) in state.multipliers.iter_mut().enumerate() {
         *v = 1e-3 * (k % 7) as f64;
     }
     state
@@ -117,7 +117,7 @@ fn main() {
         let run = mast_cell::run(&design, &cell, None, false).expect("mast cell run");
         let state = run.outcome.state;
         let mut solver = NewtonSolver::new(&model);
-        solver.constraint_rank(&model, &state);
+        solver.constraint_rank(&model, &state, state.time);
         solver.assemble(&model, &state, state.time, true);
         report("mast cell (folded)", &solver);
     }

@@ -20,7 +20,7 @@ use unfold::analysis::newton::NewtonSolver;
 use unfold::assembly::{Assembler, TangentPattern};
 use unfold::dofs::DofMap;
 use unfold::linalg::SparseLu;
-use unfold::so3::{self, Vec3};
+use unfold::so3::Vec3;
 
 use common::{cantilever, median, sizes};
 
@@ -85,10 +85,10 @@ fn main() {
 
         // a deformed state, so that every geometric term is exercised
         let mut state = model.initial_state();
-        for (i, (x, q)) in state.x.iter_mut().zip(state.q.iter_mut()).enumerate() {
+        for i in 0..model.n_nodes() {
             let s = i as f64 / n as f64;
-            *x += Vec3::new(-0.01 * s, 0.05 * s * s, -0.03 * s);
-            *q *= so3::exp(&Vec3::new(0.1 * s, 0.2 * s, 0.05 * s));
+            let dx = Vec3::new(-0.01 * s, 0.05 * s * s, -0.03 * s);
+            state.displace_node(i, &dx, &Vec3::new(0.1 * s, 0.2 * s, 0.05 * s));
         }
         solver.assemble(&model, &state, 1.0, true);
         solver.analyze().expect("symbolic analysis");

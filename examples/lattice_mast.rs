@@ -29,7 +29,8 @@ use std::path::PathBuf;
 use unfold::analysis::StaticAnalysis;
 use unfold::elements::ElementKind;
 use unfold::io::run::{
-    signal_name, stop_on_signals, Interrupted, Recorder, SignalEvent, Silent, StopRequest,
+    format_time, signal_name, stop_on_signals, Interrupted, Recorder, SignalEvent, Silent,
+    StopRequest,
 };
 use unfold::model::builder::*;
 use unfold::model::input::ModelInput;
@@ -111,19 +112,63 @@ pub fn build(bays: usize) -> ModelInput {
     mast(bays).0.into_input()
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut args = std::env::args().skip(1);
-    let bays: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(8);
-    let out = PathBuf::from(args.next().unwrap_or_else(|| "results/lattice_mast".into()));
+/// Most bays: about 39 nodes and elements each, so that the mast stays
+/// well within the 500 000 of a model (docs/model-format.md, "Limits").
+const MAX_BAYS: usize = 10_000;
 
+const USAGE: &str = "usage: cargo run --release --example lattice_mast -- [BAYS] [OUTPUT_DIRECTORY]\n  BAYS: number of bays, 1 to 10000 (default 8)\n  OUTPUT_DIRECTORY: default results/lattice_mast";
+
+/// The number of bays and the output directory from the command-line
+/// arguments `args` (the program's name left out).
+pub fn arguments(mut args: impl Iterator<Item = String>) -> Result<(usize, PathBuf), String> {
+    let bays = match args.next() {
+        None => 8,
+        Some(a) => match a.parse::<usize>() {
+            Ok(n) if (1..=MAX_BAYS).contains(&n) => n,
+            _ => {
+                return Err(format!(
+                    "BAYS must be a whole number from 1 to {MAX_BAYS}, got \"{a}\""
+                ))
+            }
+        },
+    };
+    let out = PathBuf::from(args.next().unwrap_or_else(|| "results/lattice_mast".into()));
+    if let Some(extra) = args.next() {
+        return Err(format!("unexpected argument \"{extra}\""));
+    }
+    Ok((bays, out))
+}
+
+fn main() -> std::process::ExitCode {
+    let (bays, out) = match arguments(std::env::args().skip(1)) {
+        Ok(a) => a,
+        Err(message) => {
+            eprintln!("error: {message}\n{USAGE}");
+            return std::process::ExitCode::from(2);
+        }
+    };
+    match run(bays, &out) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::from(1)
+        }
+    }
+}
+
+/// Builds the mast, writes its model file, runs it into `out` and prints
+/// the tip motion.
+fn run(bays: usize, out: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     let (mast, tip) = mast(bays);
-    std::fs::create_dir_all(&out)?;
+    std::fs::create_dir_all(out)?;
     let file = out.join("lattice_mast.toml");
     std::fs::write(&file, mast.to_toml()?)?;
     println!("model written to {}", file.display());
 
-    let model = mast.build()?;
-    let mut analysis = StaticAnalysis::new(&model);
+    let model = std::sync::Arc::new(mast.build()?);
+    let settings = mast.analyses()?.remove(0);
+    let settings = settings.as_static().ok_or("a static analysis")?.clone();
+    let mut analysis = StaticAnalysis::new(model.clone(), settings);
     // loads are elements of the model too: count them apart
     let loads = model
         .elements
@@ -148,8 +193,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         SignalEvent::Ending(s) => eprintln!("{}: stopping at once", signal_name(s)),
     })?;
     let label = file.display().to_string();
-    let mut recorder = Recorder::create(&out, &label, &model, &analysis, Silent)?.with_stop(&stop);
-    let outcome = analysis.run(&mut recorder);
+    let mut recorder = Recorder::create(out, &label, &analysis, Silent)?.with_stop(&stop);
+    let outcome = analysis.run(model.initial_state(), &mut recorder);
     let report = recorder.finish(&outcome);
     println!("{}", report.last_line);
     if let Some(e) = report.output_errors.into_iter().next() {
@@ -157,7 +202,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(e) = outcome.error {
         if let Some(i) = Interrupted::of(&e) {
-            eprintln!("{i} at t = {}; results up to it are kept", outcome.time);
+            eprintln!(
+                "{i} at t = {}; results up to it are kept",
+                format_time(outcome.time)
+            );
             std::process::exit(i.exit_code().into());
         }
         return Err(e.into());

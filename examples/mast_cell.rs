@@ -34,6 +34,7 @@
 use std::error::Error;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use unfold::analysis::{IncrementInfo, NoObserver, Observer, StaticAnalysis, StaticOutcome};
@@ -438,8 +439,11 @@ pub fn assemble(d: &Design) -> Result<Assembly, Box<dyn Error>> {
     let (mut m, parts) = cell(d);
     // nothing depends on t: the equilibrium at t = 0 and one trivial increment
     m.analysis(Analysis::kinetostatic().initial_increment(1.0));
-    let model = m.build()?;
-    let outcome = StaticAnalysis::new(&model).run(&mut NoObserver);
+    let model = Arc::new(m.build()?);
+    let settings = m.analyses()?.remove(0);
+    let settings = settings.as_static().ok_or("a static analysis")?.clone();
+    let outcome =
+        StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut NoObserver);
     if let Some(e) = outcome.error {
         return Err(format!("assembly of the pretensioned cell: {e}").into());
     }
@@ -739,12 +743,14 @@ pub fn run_until(
     log: bool,
     stop: &StopRequest,
 ) -> Result<Run, Box<dyn Error>> {
-    let model = Model::from_input(&cell.input)?;
-    let mut analysis = StaticAnalysis::new(&model);
+    let model = Arc::new(Model::from_input(&cell.input)?);
+    let settings = cell.input.analyses()?.remove(0);
+    let settings = settings.as_static().ok_or("a static analysis")?.clone();
+    let mut analysis = StaticAnalysis::new(model.clone(), settings);
     let recorder = match out {
         Some(dir) => {
             let file = dir.join("mast_cell.toml").display().to_string();
-            Some(Recorder::create(dir, &file, &model, &analysis, Silent)?.with_stop(stop))
+            Some(Recorder::create(dir, &file, &analysis, Silent)?.with_stop(stop))
         }
         None => None,
     };
@@ -755,7 +761,7 @@ pub fn run_until(
         records: Vec::new(),
         log,
     };
-    let outcome = analysis.run(&mut observer);
+    let outcome = analysis.run(model.initial_state(), &mut observer);
     let records = observer.records;
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
     let average = |r: &mut dyn Iterator<Item = &Record>| {
@@ -871,11 +877,16 @@ fn main() -> Result<(), Box<dyn Error>> {
             .first()
             .map_or("results/mast_cell", |s| s.as_str()),
     );
-    let increments: usize = positional
-        .get(1)
-        .map(|s| s.parse())
-        .transpose()?
-        .unwrap_or(96);
+    let increments: usize = match positional.get(1) {
+        None => 96,
+        Some(a) => match a.parse::<usize>() {
+            Ok(n) if n > 0 => n,
+            _ => {
+                eprintln!("error: INCREMENTS must be a positive whole number, got \"{a}\"\nusage: cargo run --release --example mast_cell -- [OUTPUT_DIRECTORY] [INCREMENTS] [--drive-top | --lower-top]");
+                std::process::exit(2);
+            }
+        },
+    };
 
     let start = Instant::now();
     let cell = build_design(&design, increments)?;
@@ -954,7 +965,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     println!("results in {}", out.display());
     if let Some(e) = run.outcome.error {
         if let Some(i) = Interrupted::of(&e) {
-            eprintln!("{i} at t = {}; results up to it are kept", run.outcome.time);
+            eprintln!(
+                "{i} at t = {}; results up to it are kept",
+                unfold::io::run::format_time(run.outcome.time)
+            );
             std::process::exit(i.exit_code().into());
         }
         return Err(e.into());

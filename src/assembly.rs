@@ -1,13 +1,19 @@
-//! Assembly of the global residual and tangent.
+//! Assembly of the global residual and matrices.
 //!
 //! The sparsity pattern is built once from the element connectivity, by
-//! blocks of equations (a node's, an element's extra unknowns: see
-//! [`TangentPattern`]), with a map from every local tangent entry of every
-//! element to its position in the compressed-column value array, read off
-//! the block structure. Each evaluation then
+//! blocks of equations (a node's, an element's coordinates and
+//! multipliers: see [`TangentPattern`]), with a map from every local matrix
+//! entry of every element to its position in the compressed-column value
+//! array, read off the block structure. Each evaluation then
 //! 1. evaluates all elements in parallel, each into its own preallocated
-//!    slice of one buffer (no locks, no allocation);
-//! 2. scatters the local residuals and tangents through the maps.
+//!    slices (residual, stiffness, inertia matrix: no locks, no
+//!    allocation), and applies the optional per-node right factors to the
+//!    rotation columns of each local stiffness;
+//! 2. scatters the local residuals and matrices through the maps: the sum
+//!    of the stiffness and the inertia matrix into the assembler's own
+//!    matrix ([`Assembler::assemble`], the iteration matrix of statics and
+//!    dynamics), or each into a matrix of its own on the same pattern
+//!    ([`Assembler::assemble_split`], for modal analysis).
 //!
 //! Besides the residual `r`, assembly accumulates the *force flux*
 //! `Σₑ |rₑ|` at every dof: the magnitude of the forces flowing through it,
@@ -18,23 +24,28 @@ use crate::dofs::{DofMap, NO_EQUATION};
 use crate::elements::{Element, ElementOutput, EvalContext};
 use crate::linalg::SparseMatrix;
 use crate::model::Model;
+use crate::so3::Mat3;
 use crate::state::State;
 
 const NONE: u32 = u32::MAX;
 
 /// Global system storage and the maps that fill it.
 pub struct Assembler {
-    /// The tangent, in equation numbering.
+    /// The iteration matrix (stiffness plus inertia matrix), in equation
+    /// numbering.
     pub matrix: SparseMatrix,
     /// Residual at every dof (free or not): at fixed dofs it is the
     /// reaction.
     pub residual: Vec<f64>,
     /// Force flux at every dof.
     pub flux: Vec<f64>,
-    /// Start of each element's block in `buffer` (n² tangent then n
+    /// Start of each element's block in `buffer` (n² stiffness then n
     /// residual entries); one more entry for the end.
     offsets: Vec<usize>,
     buffer: Vec<f64>,
+    /// The elements' inertia matrices (n² each, at `tangent_offsets`);
+    /// allocated at the first assembly that asks for them.
+    inertia: Vec<f64>,
     /// Position in the matrix values of each local tangent entry, or NONE.
     tangent_map: Vec<u32>,
     /// Start of each element's entries in `tangent_map`.
@@ -48,8 +59,9 @@ pub struct Assembler {
 /// The sparsity pattern of the tangent, in equation numbering, built by
 /// blocks from the element graph.
 ///
-/// A *block* is a node (its free components) or the extra unknowns of an
-/// element: its equations are consecutive ([`DofMap::node_equations`]),
+/// A *block* is a node (its free components) or the coordinates and
+/// multipliers of an element: its equations are consecutive
+/// ([`DofMap::node_equations`], [`DofMap::element_equations`]),
 /// so the pattern is a block pattern. Block `b` couples with block `c`
 /// when an element has both; every column of block `b` then has the same
 /// rows: the equations of the blocks coupled with `b`, in equation order.
@@ -60,8 +72,8 @@ pub struct Assembler {
 /// block.
 pub struct TangentPattern {
     matrix: SparseMatrix,
-    /// Equations of each block: nodes first, then the extra unknowns of
-    /// each element.
+    /// Equations of each block: nodes first, then the coordinates and
+    /// multipliers of each element.
     blocks: Vec<[usize; 2]>,
     /// Start of each block column in `coupled` (one more for the end).
     coupled_ptr: Vec<usize>,
@@ -83,7 +95,7 @@ impl TangentPattern {
         let n_blocks = n_nodes + n_el;
         let blocks: Vec<[usize; 2]> = (0..n_nodes)
             .map(|i| dofs.node_equations(i))
-            .chain((0..n_el).map(|e| dofs.extra_equations(e)))
+            .chain((0..n_el).map(|e| dofs.element_equations(e)))
             .map(|r| [r.start, r.end])
             .collect();
         let is_empty = |b: usize| blocks[b][0] == blocks[b][1];
@@ -196,8 +208,8 @@ impl TangentPattern {
     }
 }
 
-/// Blocks of an element: its nodes, then its extra unknowns (block
-/// `extra_block`).
+/// Blocks of an element: its nodes, then its coordinates and multipliers
+/// (block `extra_block`).
 fn element_blocks(nodes: &[usize], extra_block: usize) -> impl Iterator<Item = usize> + '_ {
     nodes.iter().copied().chain(std::iter::once(extra_block))
 }
@@ -249,8 +261,8 @@ impl Assembler {
                 element_blocks.push(node);
                 local.extend((6 * node..6 * node + 6).map(|d| (d, dofs.equation(d), k)));
             }
-            let extra = dofs.element_extra_dofs(model, e);
-            if !extra.is_empty() {
+            let mut extra = dofs.element_extra_dofs(model, e).peekable();
+            if extra.peek().is_some() {
                 let k = element_blocks.len();
                 element_blocks.push(n_nodes + e);
                 local.extend(extra.map(|d| (d, dofs.equation(d), k)));
@@ -289,6 +301,7 @@ impl Assembler {
             flux: vec![0.0; dofs.n_dofs()],
             offsets,
             buffer: vec![0.0; o],
+            inertia: Vec::new(),
             tangent_map,
             tangent_offsets,
             residual_offsets,
@@ -297,33 +310,132 @@ impl Assembler {
     }
 
     /// Evaluates every element for `state` and assembles the residual, the
-    /// flux and (if `ctx.need_tangent`) the tangent.
+    /// flux and the matrices `ctx.need` asks for, summed into
+    /// [`Assembler::matrix`]: the stiffness, plus the inertia matrix
+    /// `w_d ∂r/∂v + w_m ∂r/∂v̇` when asked.
     pub fn assemble(&mut self, model: &Model, ctx: &EvalContext, state: &State) {
-        // evaluate elements in parallel, each into its own buffer slice
-        evaluate_range(&model.elements, &mut self.buffer, &self.offsets, ctx, state);
+        self.assemble_into(model, ctx, state, None, Target::Own);
+    }
+
+    /// As [`Assembler::assemble`], with the rotation columns of every local
+    /// stiffness multiplied on the right by the 3×3 factor of their node,
+    /// `K_{·Θᵢ} ← K_{·Θᵢ} Tᵢ` (the tangent operator of the generalised-α
+    /// update, docs/theory.md §12), before it is added to the inertia matrix.
+    /// The inertia matrix is not factored. `factors` has one entry per
+    /// node.
+    pub fn assemble_factored(
+        &mut self,
+        model: &Model,
+        ctx: &EvalContext,
+        state: &State,
+        factors: &[Mat3],
+    ) {
+        assert_eq!(factors.len(), model.n_nodes(), "one factor per node");
+        self.assemble_into(model, ctx, state, Some(factors), Target::Own);
+    }
+
+    /// Evaluates every element once and assembles the residual and the flux
+    /// (in [`Assembler::residual`], [`Assembler::flux`]), the stiffness
+    /// into `stiffness` and the inertia matrix into `inertia`, two matrices
+    /// with the pattern of [`Assembler::matrix`] (a clone of it). `ctx`
+    /// must ask for both: `ctx.need.inertia` gives the weights (`(0, 1)`
+    /// for the mass matrix).
+    pub fn assemble_split(
+        &mut self,
+        model: &Model,
+        ctx: &EvalContext,
+        state: &State,
+        stiffness: &mut SparseMatrix,
+        inertia: &mut SparseMatrix,
+    ) {
+        assert!(
+            ctx.need.stiffness && ctx.need.inertia.is_some(),
+            "a split assembly asks for both matrices"
+        );
+        assert!(
+            stiffness.nnz() == self.matrix.nnz() && inertia.nnz() == self.matrix.nnz(),
+            "matrices on the assembler's pattern"
+        );
+        self.assemble_into(model, ctx, state, None, Target::Split(stiffness, inertia));
+    }
+
+    fn assemble_into(
+        &mut self,
+        model: &Model,
+        ctx: &EvalContext,
+        state: &State,
+        factors: Option<&[Mat3]>,
+        target: Target,
+    ) {
+        let need = ctx.need;
+        let total = *self.tangent_offsets.last().unwrap_or(&0);
+        if need.inertia.is_some() && self.inertia.len() != total {
+            self.inertia = vec![0.0; total];
+        }
+        // evaluate elements in parallel, each into its own buffer slices
+        let inertia = need.inertia.map(|_| &mut self.inertia[..]);
+        let layout = Layout {
+            offsets: &self.offsets,
+            inertia_offsets: &self.tangent_offsets,
+        };
+        evaluate_range(
+            &model.elements,
+            &mut self.buffer,
+            inertia,
+            layout,
+            ctx,
+            state,
+            factors,
+        );
 
         // scatter
         self.residual.fill(0.0);
         self.flux.fill(0.0);
-        if ctx.need_tangent {
-            self.matrix.values_mut().fill(0.0);
-        }
-        let values = self.matrix.values_mut();
+        let (stiffness, inertia_matrix) = match target {
+            Target::Own => {
+                if need.any_matrix() {
+                    self.matrix.values_mut().fill(0.0);
+                }
+                (self.matrix.values_mut(), None)
+            }
+            Target::Split(k, d) => {
+                k.values_mut().fill(0.0);
+                d.values_mut().fill(0.0);
+                (k.values_mut(), Some(d.values_mut()))
+            }
+        };
+        let mut inertia_matrix = inertia_matrix;
         for e in 0..model.elements.len() {
             let start = self.offsets[e];
             let n = self.residual_offsets[e + 1] - self.residual_offsets[e];
             let block = &self.buffer[start..start + n * n + n];
-            let (tangent, residual) = block.split_at(n * n);
+            let (local_k, residual) = block.split_at(n * n);
             let rmap = &self.residual_map[self.residual_offsets[e]..self.residual_offsets[e + 1]];
             for (r, &d) in residual.iter().zip(rmap) {
                 self.residual[d as usize] += r;
                 self.flux[d as usize] += r.abs();
             }
-            if ctx.need_tangent {
-                let tmap = &self.tangent_map[self.tangent_offsets[e]..self.tangent_offsets[e + 1]];
-                for (k, &p) in tmap.iter().enumerate() {
+            if !need.any_matrix() {
+                continue;
+            }
+            let range = self.tangent_offsets[e]..self.tangent_offsets[e + 1];
+            let tmap = &self.tangent_map[range.clone()];
+            if need.stiffness {
+                for (&p, &v) in tmap.iter().zip(local_k) {
                     if p != NONE {
-                        values[p as usize] += tangent[k];
+                        stiffness[p as usize] += v;
+                    }
+                }
+            }
+            if need.inertia.is_some() {
+                let local_d = &self.inertia[range];
+                let values = match inertia_matrix.as_deref_mut() {
+                    Some(d) => d,
+                    None => &mut *stiffness,
+                };
+                for (&p, &v) in tmap.iter().zip(local_d) {
+                    if p != NONE {
+                        values[p as usize] += v;
                     }
                 }
             }
@@ -331,39 +443,115 @@ impl Assembler {
     }
 }
 
+/// Where an assembly puts its matrices.
+enum Target<'a> {
+    /// Their sum into the assembler's own matrix.
+    Own,
+    /// The stiffness and the inertia matrix into these two.
+    Split(&'a mut SparseMatrix, &'a mut SparseMatrix),
+}
+
+/// Where each element's slices start in the evaluation buffers (absolute
+/// offsets; entry 0 is the start of the slices given).
+#[derive(Clone, Copy)]
+struct Layout<'a> {
+    /// Stiffness and residual of each element (n² + n).
+    offsets: &'a [usize],
+    /// Inertia matrix of each element (n²).
+    inertia_offsets: &'a [usize],
+}
+
+impl<'a> Layout<'a> {
+    fn split(self, mid: usize) -> (Self, Self) {
+        (
+            Self {
+                offsets: &self.offsets[..=mid],
+                inertia_offsets: &self.inertia_offsets[..=mid],
+            },
+            Self {
+                offsets: &self.offsets[mid..],
+                inertia_offsets: &self.inertia_offsets[mid..],
+            },
+        )
+    }
+}
+
 /// Elements per task below which the evaluation runs sequentially.
 const SEQUENTIAL_CHUNK: usize = 256;
 
-/// Evaluates `elements` into `buffer`, whose layout is given by `offsets`
-/// (absolute, `offsets[0]` is the start of `buffer`), splitting the work
-/// recursively over rayon tasks.
+/// Evaluates `elements` into `buffer` (stiffness and residual) and
+/// `inertia` (when asked), whose layouts `layout` gives, splitting the work
+/// recursively over rayon tasks; applies `factors` to the rotation columns
+/// of each stiffness.
 fn evaluate_range(
     elements: &[Box<dyn Element>],
     buffer: &mut [f64],
-    offsets: &[usize],
+    inertia: Option<&mut [f64]>,
+    layout: Layout,
     ctx: &EvalContext,
     state: &State,
+    factors: Option<&[Mat3]>,
 ) {
     if elements.len() <= SEQUENTIAL_CHUNK {
-        let base = offsets[0];
+        let (base, ibase) = (layout.offsets[0], layout.inertia_offsets[0]);
+        let mut inertia = inertia;
         for (k, e) in elements.iter().enumerate() {
-            let block = &mut buffer[offsets[k] - base..offsets[k + 1] - base];
+            let block = &mut buffer[layout.offsets[k] - base..layout.offsets[k + 1] - base];
             let n = e.n_local();
-            let (tangent, residual) = block.split_at_mut(n * n);
+            let (stiffness, residual) = block.split_at_mut(n * n);
             residual.fill(0.0);
-            if ctx.need_tangent {
-                tangent.fill(0.0);
+            let stiffness = ctx.need.stiffness.then(|| {
+                stiffness.fill(0.0);
+                stiffness
+            });
+            let local_inertia = inertia.as_deref_mut().map(|d| {
+                let d = &mut d
+                    [layout.inertia_offsets[k] - ibase..layout.inertia_offsets[k + 1] - ibase];
+                d.fill(0.0);
+                d
+            });
+            let mut out = ElementOutput {
+                residual,
+                stiffness,
+                inertia: local_inertia,
+            };
+            e.evaluate(ctx, state, &mut out);
+            if let (Some(f), Some(k)) = (factors, out.stiffness) {
+                factor_rotation_columns(k, n, e.nodes(), f);
             }
-            e.evaluate(ctx, state, &mut ElementOutput { residual, tangent });
         }
         return;
     }
     let mid = elements.len() / 2;
-    let (left, right) = buffer.split_at_mut(offsets[mid] - offsets[0]);
+    let (left, right) = buffer.split_at_mut(layout.offsets[mid] - layout.offsets[0]);
+    let (il, ir) = match inertia {
+        Some(d) => {
+            let (l, r) = d.split_at_mut(layout.inertia_offsets[mid] - layout.inertia_offsets[0]);
+            (Some(l), Some(r))
+        }
+        None => (None, None),
+    };
+    let (ll, lr) = layout.split(mid);
     rayon::join(
-        || evaluate_range(&elements[..mid], left, &offsets[..=mid], ctx, state),
-        || evaluate_range(&elements[mid..], right, &offsets[mid..], ctx, state),
+        || evaluate_range(&elements[..mid], left, il, ll, ctx, state, factors),
+        || evaluate_range(&elements[mid..], right, ir, lr, ctx, state, factors),
     );
+}
+
+/// `K_{·Θᵢ} ← K_{·Θᵢ} Fᵢ` for every node `i` of an element: the three
+/// rotation columns of each node (local columns `6i+3..6i+6` of the
+/// column-major `n × n` matrix `k`) times the node's factor.
+fn factor_rotation_columns(k: &mut [f64], n: usize, nodes: &[usize], factors: &[Mat3]) {
+    for (i, &node) in nodes.iter().enumerate() {
+        let f = &factors[node];
+        let c0 = 6 * i + 3;
+        for r in 0..n {
+            let a = [k[c0 * n + r], k[(c0 + 1) * n + r], k[(c0 + 2) * n + r]];
+            for j in 0..3 {
+                k[(c0 + j) * n + r] = a[0] * f[(0, j)] + a[1] * f[(1, j)] + a[2] * f[(2, j)];
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -377,6 +565,11 @@ mod tests {
     /// joints with multipliers), hinge springs, a partly fixed node, a
     /// fully fixed node that no element touches, and a load.
     fn hinged_links() -> Model {
+        Model::from_input(&hinged_input()).expect("valid model")
+    }
+
+    /// The input of [`hinged_links`].
+    fn hinged_input() -> ModelInput {
         let mut m = ModelInput::new("hinged links");
         m.add_section("s", [2.1e8, 8.1e7, 8.1e7, 1.6e5, 2.1e5, 2.1e5]);
         for i in 0..3u64 {
@@ -407,7 +600,7 @@ mod tests {
         m.fix(99, &["all"]);
         m.fix(4, &["z", "rx"]);
         m.add_load(6, [0.0, 1.0, 0.0], [0.0; 3]);
-        Model::from_input(&m).expect("valid model")
+        m
     }
 
     /// The block pattern is the set of equation pairs of every element plus
@@ -442,6 +635,120 @@ mod tests {
         let stored: BTreeSet<_> = matrix.entries().map(|(r, c, _)| (r, c)).collect();
         assert_eq!(stored, expected);
         assert_eq!(matrix.nnz(), expected.len());
+    }
+
+    /// The combined assembly with per-node right factors on the rotation
+    /// columns of the element stiffnesses equals a dense assembly written
+    /// out independently: each element's `K_e`, its rotation columns times
+    /// the factor of their node, plus its inertia matrix `D_e` (beams with
+    /// mass and rotational inertia, a rigid body off its node, joints,
+    /// springs, a partly fixed node), scattered by the dof numbering; to
+    /// round-off (1e-14 of the largest entry). The factors are arbitrary
+    /// 3×3 matrices, so the rows of a node's three columns mix.
+    #[test]
+    fn factored_assembly_equals_the_elements_factored_one_by_one() {
+        use crate::elements::{ElementOutput, Need};
+        use crate::model::input::{InertiaInput, RigidBodyInput};
+        use crate::so3::{skew, Vec3};
+        let model = {
+            let mut m = hinged_input();
+            m.sections[0].mass_per_length = Some(0.4);
+            m.sections[0].inertia_per_length = Some([0.01, 0.02, 0.03]);
+            m.rigid_bodies.push(RigidBodyInput {
+                id: 50,
+                node: 3,
+                mass: 1.5,
+                inertia: Some(InertiaInput::Diagonal([0.1, 0.2, 0.3])),
+                center_of_mass: Some([0.02, -0.01, 0.03]),
+            });
+            Model::from_input(&m).expect("valid model")
+        };
+        let dofs = DofMap::new(&model);
+        let mut state = model.initial_state();
+        for i in 0..model.n_nodes() {
+            let s = i as f64;
+            let d = Vec3::new(0.01 * s.sin(), 0.02 * s.cos(), 0.005 * s);
+            state.displace_node(i, &d, &Vec3::new(0.3 * s.sin(), -0.2 * s, 0.1 * s.cos()));
+            state.velocity[i] = [s.sin(), s.cos(), 0.5, 20.0 * s.cos(), -15.0, 10.0 * s.sin()];
+            state.acceleration[i] = [3.0, -s, 2.0 * s.cos(), 100.0, 50.0 * s.sin(), -80.0];
+        }
+        for (k, l) in state.multipliers.iter_mut().enumerate() {
+            *l = 0.1 * (k as f64 - 4.0);
+        }
+        let factors: Vec<Mat3> = (0..model.n_nodes())
+            .map(|i| {
+                let v = Vec3::new((i as f64).sin(), 0.5, (2.0 * i as f64).cos());
+                Mat3::identity() + skew(&v) * 0.3 + v * v.transpose() * 0.1
+            })
+            .collect();
+        let ctx = EvalContext {
+            dynamics: true,
+            ..model.context(0.5, Need::with_inertia(30.0, 900.0))
+        };
+        let mut assembler = Assembler::new(&model, &dofs);
+        assembler.assemble_factored(&model, &ctx, &state, &factors);
+
+        // dense, element by element
+        let n = dofs.n_equations();
+        let mut dense = vec![0.0; n * n];
+        for (e, element) in model.elements.iter().enumerate() {
+            let nl = element.n_local();
+            let (mut r, mut k, mut d) = (vec![0.0; nl], vec![0.0; nl * nl], vec![0.0; nl * nl]);
+            element.evaluate(
+                &ctx,
+                &state,
+                &mut ElementOutput {
+                    residual: &mut r,
+                    stiffness: Some(&mut k),
+                    inertia: Some(&mut d),
+                },
+            );
+            let local = dofs.element_dofs(&model, e);
+            for (j, &dj) in local.iter().enumerate() {
+                let cj = dofs.equation(dj);
+                if cj == NO_EQUATION {
+                    continue;
+                }
+                for (i, &di) in local.iter().enumerate() {
+                    let ri = dofs.equation(di);
+                    if ri == NO_EQUATION {
+                        continue;
+                    }
+                    // (K F)_ij: column j of a node rotation mixes the node's
+                    // three rotation columns
+                    let kf = match (j < 6 * element.nodes().len(), j % 6) {
+                        (true, c) if c >= 3 => {
+                            let f = &factors[element.nodes()[j / 6]];
+                            let first = j - c + 3;
+                            (0..3)
+                                .map(|a| k[(first + a) * nl + i] * f[(a, c - 3)])
+                                .sum()
+                        }
+                        _ => k[j * nl + i],
+                    };
+                    dense[cj * n + ri] += kf + d[j * nl + i];
+                }
+            }
+        }
+        let scale = dense.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let mut worst = 0.0f64;
+        for (r, c, v) in assembler.matrix.entries() {
+            worst = worst.max((v - dense[c * n + r]).abs());
+            dense[c * n + r] = 0.0;
+        }
+        // nothing outside the pattern
+        assert!(dense.iter().all(|&v| v == 0.0));
+        assert!(worst <= 1e-14 * scale, "{worst:e} of {scale:e}");
+        // the factors matter: without them the matrix differs
+        let mut plain = Assembler::new(&model, &dofs);
+        plain.assemble(&model, &ctx, &state);
+        let diff = plain
+            .matrix
+            .values()
+            .iter()
+            .zip(assembler.matrix.values())
+            .fold(0.0f64, |w, (a, b)| w.max((a - b).abs()));
+        assert!(diff > 1e-3 * scale);
     }
 
     #[test]

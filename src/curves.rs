@@ -60,6 +60,41 @@ impl Function {
         }
     }
 
+    /// Smallest and largest `f(t)` for `t` in `[0, t_end]`, exactly
+    /// (both are reached).
+    pub fn range(&self, t_end: f64) -> (f64, f64) {
+        let (f0, f1) = (self.value(0.0), self.value(t_end));
+        let (mut lo, mut hi) = (f0.min(f1), f0.max(f1));
+        if let Self::Sine {
+            offset,
+            amplitude,
+            frequency,
+            phase,
+        } = *self
+        {
+            // the phase θ = 2π·frequency·t + phase sweeps [a, b]; sin θ = ±1
+            // where θ = ±π/2 + 2πk
+            let theta = std::f64::consts::TAU * frequency * t_end + phase;
+            let (a, b) = (phase.min(theta), phase.max(theta));
+            let reaches = |c: f64| {
+                let tau = std::f64::consts::TAU;
+                ((a - c) / tau).ceil() <= ((b - c) / tau).floor()
+            };
+            for (c, sign) in [
+                (std::f64::consts::FRAC_PI_2, 1.0),
+                (-std::f64::consts::FRAC_PI_2, -1.0),
+            ] {
+                if reaches(c) {
+                    let v = offset + sign * amplitude;
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+            }
+        }
+        // a linear function and a smooth step are monotone
+        (lo, hi)
+    }
+
     /// Largest `|f(t + h) − f(t)|` for `0 ≤ t ≤ t + h ≤ t_end` (an upper
     /// bound for a sine).
     pub fn largest_change(&self, h: f64, t_end: f64) -> f64 {
@@ -201,6 +236,29 @@ impl Curve {
         }
     }
 
+    /// Smallest and largest `f(t)` for `t` in `[0, t_end]` (both reached).
+    pub fn range(&self, t_end: f64) -> (f64, f64) {
+        match &self.function {
+            Some(f) => f.range(t_end),
+            None => {
+                // piecewise linear (or the ramp): the extremes are at the
+                // ends or at breakpoints
+                let mut values = vec![self.value(0.0), self.value(t_end)];
+                values.extend(
+                    self.points
+                        .iter()
+                        .filter(|p| p.0 > 0.0 && p.0 < t_end)
+                        .map(|p| p.1),
+                );
+                values
+                    .into_iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                        (lo.min(v), hi.max(v))
+                    })
+            }
+        }
+    }
+
     /// Largest `|f(t + h) − f(t)|` for `0 ≤ t ≤ t + h ≤ t_end`: what one
     /// increment `h` asks of a quantity following the curve (an upper bound
     /// for a sine).
@@ -225,6 +283,28 @@ impl Curve {
                     .fold(0.0, f64::max)
             }
         }
+    }
+
+    /// The largest step `h` (at most `t_end`) over which a quantity
+    /// `amplitude·f(t)` changes by at most `limit` anywhere in
+    /// `[0, t_end]`: bisection on [`Self::largest_change`], which grows
+    /// with `h`, to a relative 1e-9 (the `h` returned is on the safe
+    /// side). `t_end` when the whole range changes by less.
+    pub fn largest_step(&self, amplitude: f64, limit: f64, t_end: f64) -> f64 {
+        let change = |h: f64| amplitude.abs() * self.largest_change(h, t_end);
+        if t_end.is_nan() || t_end <= 0.0 || change(t_end) <= limit {
+            return t_end.max(0.0);
+        }
+        let (mut lo, mut hi) = (0.0, t_end);
+        while hi - lo > 1e-9 * hi {
+            let mid = 0.5 * (lo + hi);
+            if change(mid) <= limit {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
     }
 
     /// Whether `f` takes one value over `[0, t_end]`.
@@ -284,6 +364,91 @@ pub type CurveIndex = usize;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The range against a dense sampling of `[0, t_end]`: never narrower,
+    /// and wider by less than 1e-6 (the sampling steps of the sines' phase
+    /// are at most 1.3e-4 rad, so their samples fall short of the
+    /// extremes by at most 1e-8 of the amplitude).
+    #[test]
+    fn ranges_are_exact() {
+        let curves = [
+            Curve::ramp(),
+            Curve::constant(),
+            Curve::piecewise_linear("t", vec![(0.5, -2.0), (0.7, 3.0), (2.0, 1.0)]),
+            Curve::function(
+                "s",
+                Function::Sine {
+                    offset: 0.5,
+                    amplitude: -2.0,
+                    frequency: 0.3,
+                    phase: 0.2,
+                },
+            ),
+            Curve::function(
+                "s2",
+                Function::Sine {
+                    offset: 0.0,
+                    amplitude: 1.0,
+                    frequency: 2.0,
+                    phase: 0.0,
+                },
+            ),
+            Curve::function(
+                "st",
+                Function::SmoothStep {
+                    start: 0.2,
+                    end: 0.6,
+                    from: 1.0,
+                    to: -1.0,
+                },
+            ),
+            Curve::function(
+                "l",
+                Function::Linear {
+                    offset: 1.0,
+                    slope: -3.0,
+                },
+            ),
+        ];
+        for c in &curves {
+            let (lo, hi) = c.range(1.0);
+            let n = 100_000;
+            let (mut slo, mut shi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for i in 0..=n {
+                let v = c.value(i as f64 / n as f64);
+                slo = slo.min(v);
+                shi = shi.max(v);
+            }
+            assert!(
+                lo <= slo && hi >= shi,
+                "{}: {lo} {hi} vs {slo} {shi}",
+                c.name()
+            );
+            assert!(
+                slo - lo < 1e-6 && hi - shi < 1e-6,
+                "{}: {lo} {hi} vs {slo} {shi}",
+                c.name()
+            );
+        }
+    }
+
+    /// The largest step keeps the change within the limit and is the
+    /// largest that does: for the ramp `h = limit/amplitude`; for a table
+    /// the steepest segment sets it; a slow curve allows the whole range.
+    #[test]
+    fn largest_step_bounds_the_change() {
+        let ramp = Curve::ramp();
+        let h = ramp.largest_step(4.0 * std::f64::consts::PI, 0.5 * std::f64::consts::PI, 1.0);
+        assert!((h - 0.125).abs() <= 1e-9 * 0.125, "{h}");
+        let table =
+            Curve::piecewise_linear("t", vec![(0.0, 0.0), (0.5, 0.1), (0.6, 1.1), (1.0, 1.2)]);
+        // steepest segment: slope 10 over 0.1
+        let h = table.largest_step(1.0, 0.5, 1.0);
+        assert!((h - 0.05).abs() <= 1e-9, "{h}");
+        assert!(table.largest_change(h, 1.0) <= 0.5);
+        assert!(table.largest_change(h * (1.0 + 1e-6), 1.0) > 0.5);
+        assert_eq!(ramp.largest_step(1.0, 2.0, 1.0), 1.0);
+    }
 
     #[test]
     fn functions() {

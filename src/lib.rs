@@ -14,15 +14,20 @@
 //! - [`so3`]: finite rotations (exponential, logarithm, tangent operators);
 //! - [`model`]: the model definition (file schema, and the builders of
 //!   [`model::builder`] in Rust) and its validated form;
-//! - [`elements`]: beams, rigid bodies, springs, nodal loads;
+//! - [`state`]: positions, orientations, coordinates, multipliers and their
+//!   rates, and the one update rule `q ⊕ Δq`;
+//! - [`elements`]: beams, rigid bodies, springs, nodal loads (residual,
+//!   stiffness and inertia matrix from one evaluation);
 //! - [`dofs`], [`assembly`], [`linalg`]: numbering, sparse assembly, sparse
 //!   direct solver;
-//! - [`analysis`]: Newton–Raphson and the nonlinear static analysis;
+//! - [`analysis`]: Newton–Raphson, the step controller, the nonlinear
+//!   static analysis and its settings;
 //! - [`eigen`]: eigen-solvers of modal analysis (dense null-space and
 //!   shift-invert Lanczos);
 //! - [`io`]: model files in, results (CSV, JSON, VTK) out.
 //!
 //! ```
+//! use std::sync::Arc;
 //! use unfold::analysis::{NoObserver, StaticAnalysis};
 //! use unfold::model::builder::*;
 //!
@@ -33,8 +38,10 @@
 //! m.add(BeamLine::between(root, tip, 8, s).orientation([0.0, 0.0, 1.0]));
 //! m.fix(root, Dofs::ALL);
 //! m.add(Load::force(tip, [0.0, 0.0, -1.0]));
-//! let model = m.build().unwrap();
-//! let outcome = StaticAnalysis::new(&model).run(&mut NoObserver);
+//! let model = Arc::new(m.build().unwrap());
+//! // the analysis settings live beside the model: statics from t = 0 to 1
+//! let settings = Analysis::statics().settings().unwrap();
+//! let outcome = StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut NoObserver);
 //! assert!(outcome.error.is_none());
 //! // tip deflection ≈ P L³/3EI = 8/3e5, within 1 % with 8 elements
 //! let tip = outcome.state.x[model.node(tip)].z;
@@ -42,8 +49,9 @@
 //! ```
 //!
 //! The same model can be read from a model file
-//! ([`io::model_file::read_model`], docs/model-format.md), or written as
-//! the file schema [`model::input::ModelInput`] directly.
+//! ([`io::model_file::read_model`], docs/model-format.md, which gives the
+//! model and its analyses), or written as the file schema
+//! [`model::input::ModelInput`] directly.
 
 #![warn(missing_docs)]
 #![allow(non_snake_case)]

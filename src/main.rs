@@ -1,30 +1,51 @@
 //! `unfold`: command-line front end.
 //!
 //! ```text
-//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii]
+//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii] [--restart FILE]
 //! unfold check MODEL.toml
 //! ```
+//! A model file with a sequence of analyses (`[[analysis]]`) runs them in
+//! order, each from the final state of the one before, into one set of
+//! result files. A modal analysis (`type = "modal"`) linearises about the
+//! state it is given and leaves it unchanged; its first frequencies are
+//! printed on stderr. A dynamic analysis (`type = "dynamic"`) integrates
+//! the motion from the state it is given (with the velocities it has) and
+//! adds velocities and energies to the results; its last line gives its
+//! steps and its energy balance error. A static analysis after a dynamic
+//! one seeks an equilibrium at rest: it starts with zero velocities. Every run writes `restart.json` (the state at its
+//! last converged step) into its output directory; `--restart FILE`
+//! continues a run from such a file (docs/results.md, "Restart files").
 //! Exit codes: 0 success; 1 the analysis stopped before its end (results
 //! written so far are kept) or results could not be written (each error
 //! names its file; the output directory in use by another run); 2 the
 //! command line or the model file is invalid, including a model whose
 //! tangent is singular from the start (a mechanism or an unrestrained
-//! structure); 128 + the signal number (130 SIGINT, 143 SIGTERM, 129
+//! structure), a modal analysis of a model without mass and initial
+//! velocities that the joints do not allow; 128 + the signal number (130 SIGINT, 143 SIGTERM, 129
 //! SIGHUP) the run was interrupted, with consistent results up to the last
 //! converged increment and `summary.json` saying `interrupted`.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use unfold::analysis::preflight;
 use unfold::analysis::statics::StaticError;
-use unfold::analysis::{IncrementInfo, NewtonFailure, StaticAnalysis};
+use unfold::analysis::{
+    AnalysisSettings, DynamicAnalysis, DynamicError, IncrementInfo, ModalAnalysis, ModalError,
+    ModalOutcome, ModalSettings, NewtonFailure, StaticAnalysis,
+};
 use unfold::io::model_file::read_model;
-use unfold::io::run::{signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest};
+use unfold::io::restart::{fingerprint, Restart, RestartError, RestartWriter, Resume};
+use unfold::io::results::AnalysisEnd;
+use unfold::io::run::{
+    format_time, signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest,
+};
 use unfold::io::vtk::Encoding;
+use unfold::model::input::ModelInput;
 use unfold::model::Model;
 
 // `println!` and `eprintln!` that ignore a failed write instead of
@@ -73,6 +94,10 @@ enum Command {
         /// Write the VTK grids as text instead of compressed binary.
         #[arg(long)]
         vtk_ascii: bool,
+        /// Continue from a restart file of an earlier run of this model
+        /// (its `restart.json`, or a `restart-<t>.json`).
+        #[arg(long, value_name = "FILE")]
+        restart: Option<PathBuf>,
     },
     /// Check a model file and print its size, without running it.
     Check {
@@ -97,10 +122,21 @@ fn main() -> ExitCode {
             quiet,
             threads,
             vtk_ascii,
+            restart,
         } => {
             if let Some(n) = threads {
+                if n == 0 {
+                    eprintln!(
+                        "error: --threads 0: give at least 1 (or leave it out to use every core)"
+                    );
+                    return ExitCode::from(EXIT_INPUT);
+                }
+                let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+                if n > cores {
+                    eprintln!("warning: --threads {n}: more threads than the {cores} cores available, which only slows the run down");
+                }
                 if let Err(e) = rayon::ThreadPoolBuilder::new()
-                    .num_threads(n.max(1))
+                    .num_threads(n)
                     .build_global()
                 {
                     eprintln!("error: --threads: {e}");
@@ -113,12 +149,19 @@ fn main() -> ExitCode {
                     .map_or("model".into(), |s| s.to_string_lossy().into_owned());
                 Path::new("results").join(stem)
             });
+            if out.exists() && !out.is_dir() {
+                eprintln!(
+                    "error: --out {}: is a file; results are written into a directory (created if missing)",
+                    out.display()
+                );
+                return ExitCode::from(EXIT_INPUT);
+            }
             let encoding = if vtk_ascii {
                 Encoding::Ascii
             } else {
                 Encoding::Binary
             };
-            run(&model, &out, quiet, encoding)
+            run(&model, &out, quiet, encoding, restart.as_deref())
         }
     }
 }
@@ -138,16 +181,46 @@ fn print_warnings(path: &Path, model: &Model) {
 /// (analysis::preflight): exit code 2, with the message a run would give,
 /// when one fails.
 fn check(path: &Path) -> ExitCode {
-    let model = match read_model(path) {
-        Ok((_, model)) => model,
+    let (model, analyses) = match read_model(path) {
+        Ok(file) => (file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
     print_warnings(path, &model);
-    match preflight::check(&model) {
+    if !supported(path, &analyses) {
+        return ExitCode::from(EXIT_INPUT);
+    }
+    if analyses.iter().any(|a| a.as_modal().is_some()) && !ModalAnalysis::has_mass(&model) {
+        eprintln!(
+            "error: {}: modal analysis: {}",
+            path.display(),
+            ModalError::NoMass
+        );
+        return ExitCode::from(EXIT_INPUT);
+    }
+    let Some(first_static) = analyses.iter().find_map(|a| a.as_static()) else {
+        // modal analyses only: nothing to solve before them
+        println!(
+            "{}: valid model: {}; {} unknowns",
+            path.display(),
+            describe(&model),
+            ModalAnalysis::new(model.clone(), ModalSettings::lowest(1)).n_equations()
+        );
+        if analyses.iter().any(|a| a.as_dynamic().is_some()) {
+            for line in model.load_history() {
+                println!("load history: {line}");
+            }
+        }
+        print_plan(&analyses);
+        return ExitCode::SUCCESS;
+    };
+    match preflight::check(&model, first_static) {
         Ok(report) => {
+            for w in &report.warnings {
+                eprintln!("warning: {}: {w}", path.display());
+            }
             println!(
                 "{}: valid model: {}; {} unknowns",
                 path.display(),
@@ -163,6 +236,7 @@ fn check(path: &Path) -> ExitCode {
                     report.redundant_constraints
                 );
             }
+            print_plan(&analyses);
             ExitCode::SUCCESS
         }
         Err(e) => {
@@ -170,6 +244,91 @@ fn check(path: &Path) -> ExitCode {
             ExitCode::from(EXIT_INPUT)
         }
     }
+}
+
+/// Whether every analysis of `plan` is one this tool runs (static,
+/// kinematic, dynamic, modal); if not, after an error message.
+fn supported(path: &Path, plan: &[AnalysisSettings]) -> bool {
+    let all = !plan.is_empty()
+        && plan
+            .iter()
+            .all(|a| a.as_static().is_some() || a.as_modal().is_some() || a.as_dynamic().is_some());
+    if !all {
+        eprintln!(
+            "error: {}: an analysis of this model is not one this version runs",
+            path.display()
+        );
+    }
+    all
+}
+
+/// One line per modal and dynamic analysis of `plan`, for `unfold check`.
+fn print_plan(plan: &[AnalysisSettings]) {
+    for (k, a) in plan.iter().enumerate() {
+        if let Some(d) = a.as_dynamic() {
+            println!(
+                "analysis {}: dynamic to t = {}: time step {} ({}), min_step {}, max_step {}, rho_infinity {}",
+                k + 1,
+                format_time(d.end_time),
+                format_time(d.time_step),
+                if d.adaptive {
+                    format!("adaptive, error tolerance {}", d.error_tolerance)
+                } else {
+                    "fixed".to_string()
+                },
+                format_time(d.min_step),
+                format_time(d.max_step),
+                d.rho_infinity
+            );
+        }
+        if let Some(m) = a.as_modal() {
+            let mut what = format!("{} modes", m.modes);
+            if let Some(f) = m.shift {
+                what += &format!(" nearest {f} Hz");
+            }
+            if let Some((lo, hi)) = m.frequency_range {
+                what += &format!(" in [{lo}, {hi}] Hz");
+            }
+            println!(
+                "analysis {}: modal at t = {}: {what}, solver {}",
+                k + 1,
+                m.time,
+                unfold::io::modes::solver_name(m.solver)
+            );
+        }
+    }
+}
+
+/// Prints the first frequencies of a modal analysis on stderr.
+fn print_modes(outcome: &ModalOutcome) {
+    const SHOWN: usize = 10;
+    eprintln!(
+        "modal analysis at t = {}: {} modes ({} rigid-body or mechanism), {} unknowns, {:.3} s",
+        outcome.time,
+        outcome.modes.len(),
+        outcome.zero_modes,
+        outcome.unknowns,
+        outcome.wall_time
+    );
+    for (k, m) in outcome.modes.iter().take(SHOWN).enumerate() {
+        eprintln!(
+            "  mode {:3}  {:>14.6e} Hz  {:>14.6e} rad/s{}",
+            k + 1,
+            m.frequency,
+            m.angular_frequency,
+            if m.is_zero() { "  (zero mode)" } else { "" }
+        );
+    }
+    if outcome.modes.len() > SHOWN {
+        eprintln!("  ... {} more in modes.csv", outcome.modes.len() - SHOWN);
+    }
+}
+
+/// An analysis of the plan, ready to run.
+enum Planned {
+    Static(Box<StaticAnalysis>),
+    Dynamic(Box<DynamicAnalysis>),
+    Modal(Box<ModalAnalysis>),
 }
 
 /// Shows a run in the terminal: log lines (unless quiet) above a progress
@@ -196,16 +355,30 @@ impl Console for Terminal {
     fn progress(&mut self, info: &IncrementInfo) {
         self.bar
             .set_position((1000.0 * info.time / self.end_time).round() as u64);
-        self.bar.set_message(format!("t = {:.4}", info.time));
+        self.bar.set_message(format!(
+            "t = {:.4} / {}",
+            info.time,
+            format_time(self.end_time)
+        ));
     }
 
     fn finish(&mut self, text: &str) {
         self.bar.finish_and_clear();
         println!("{text}");
     }
+
+    fn warning(&mut self, text: &str) {
+        self.bar.suspend(|| eprintln!("warning: {text}"));
+    }
 }
 
-fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
+fn run(
+    path: &Path,
+    out: &Path,
+    quiet: bool,
+    encoding: Encoding,
+    restart: Option<&Path>,
+) -> ExitCode {
     // from now on SIGINT, SIGTERM and SIGHUP stop the run after the
     // current increment, with consistent result files
     let stop = StopRequest::new();
@@ -225,15 +398,95 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
         );
     }
 
-    let (_, model) = match read_model(path) {
-        Ok(m) => m,
+    let (input, mut model, plan) = match read_model(path) {
+        Ok(file) => (file.input, file.model, file.analyses),
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(EXIT_INPUT);
         }
     };
+    // the start-of-run checks (those of `check`) for the first analysis,
+    // before any result file
+    let checked = match plan.first().and_then(|a| a.as_static()) {
+        Some(first) => preflight::check(&model, first).map(Some),
+        None => Ok(None),
+    };
+    if let (Ok(Some(report)), Some(m)) = (&checked, Arc::get_mut(&mut model)) {
+        m.warnings.extend(report.warnings.iter().cloned());
+    }
     print_warnings(path, &model);
-    let mut analysis = StaticAnalysis::new(&model);
+    if !supported(path, &plan) {
+        return ExitCode::from(EXIT_INPUT);
+    }
+    let label = path.display().to_string();
+    if let (Err(e), Some(first)) = (&checked, plan.first().and_then(|a| a.as_static())) {
+        // invalid input: summary.json alone says why
+        eprintln!("error: {}: {e}", path.display());
+        let analysis = StaticAnalysis::new(model.clone(), first.clone());
+        let rejected = unfold::io::results::write_rejected(
+            out,
+            &label,
+            &model,
+            &analysis,
+            &plan,
+            &e.to_string(),
+            restart,
+        );
+        if let Err(w) = rejected {
+            eprintln!("error: cannot write results: {w}");
+        }
+        return ExitCode::from(EXIT_INPUT);
+    }
+    // a restart: the analysis it continues and its start state
+    let (first, start, continued) = match restart.map(|r| resume(r, &input, &model, &plan)) {
+        None => (0, model.initial_state(), None),
+        Some(Ok(resume)) => (
+            resume.analysis,
+            resume.state,
+            resume.continues.then_some(resume.motion),
+        ),
+        Some(Err(e)) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_INPUT);
+        }
+    };
+    let restarts = RestartWriter::new(out, &input).starting_at(start.time);
+    let restart_note = restart.map(|r| {
+        format!(
+            "restarted from {} at t = {} in analysis {} of {}",
+            r.display(),
+            format_time(start.time),
+            first + 1,
+            plan.len()
+        )
+    });
+    // whether a dynamic analysis comes before each analysis of the run
+    let after_motion: Vec<bool> = (first..plan.len())
+        .map(|k| plan[..k].iter().any(|a| a.as_dynamic().is_some()))
+        .collect();
+    let plan = &plan[first..];
+    let mut analyses = plan.iter().enumerate().filter_map(|(k, a)| {
+        if let Some(s) = a.as_static() {
+            Some(Planned::Static(Box::new(StaticAnalysis::new(
+                model.clone(),
+                s.clone(),
+            ))))
+        } else if let Some(d) = a.as_dynamic() {
+            let analysis = DynamicAnalysis::new(model.clone(), d.clone());
+            // a restart inside this analysis keeps its velocities and
+            // accelerations
+            Some(Planned::Dynamic(Box::new(match continued {
+                Some(motion) if k == 0 => analysis.continued(motion),
+                _ => analysis,
+            })))
+        } else {
+            a.as_modal()
+                .map(|m| Planned::Modal(Box::new(ModalAnalysis::new(model.clone(), m.clone()))))
+        }
+    });
+    let Some(first_planned) = analyses.next() else {
+        return ExitCode::SUCCESS;
+    };
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] [{bar:40}] {msg}")
@@ -243,48 +496,195 @@ fn run(path: &Path, out: &Path, quiet: bool, encoding: Encoding) -> ExitCode {
     let terminal = Terminal {
         bar,
         quiet,
-        end_time: model.settings.end_time,
+        end_time: plan.last().map_or(1.0, |a| a.end_time()),
     };
-    let label = path.display().to_string();
-    let mut recorder = match Recorder::create(out, &label, &model, &analysis, terminal) {
-        Ok(r) => r.with_stop(&stop).with_vtk_encoding(encoding),
+    let recorder = match &first_planned {
+        Planned::Static(a) => Recorder::create_sequence(out, &label, a, plan, terminal),
+        Planned::Dynamic(a) => Recorder::create_dynamic_first(out, &label, a, plan, terminal),
+        Planned::Modal(a) => Recorder::create_modal_first(out, &label, a, plan, terminal),
+    };
+    let mut recorder = match recorder {
+        Ok(r) => r
+            .with_stop(&stop)
+            .with_vtk_encoding(encoding)
+            .with_restart(restarts, first),
         Err(e) => {
             eprintln!("error: cannot write results: {e}");
             return ExitCode::from(EXIT_FAILED);
         }
     };
-    let outcome = analysis.run(&mut recorder);
-    let report = recorder.finish(&outcome);
+    if let Some(note) = restart_note {
+        recorder.line(&note);
+    }
+    // the analyses in order, each from the final state of the one before;
+    // none after one that failed
+    let mut state = start;
+    // the last static or dynamic analysis: how it ended, and its error
+    let mut last: Option<AnalysisEnd> = None;
+    let mut failure: Option<Failure> = None;
+    let mut modal_error: Option<ModalError> = None;
+    let mut modal_output_error = false;
+    for (k, planned) in std::iter::once(first_planned).chain(analyses).enumerate() {
+        match planned {
+            Planned::Static(mut analysis) => {
+                if k > 0 {
+                    recorder.open_static(&analysis, state.time);
+                }
+                // an equilibrium after a motion is at rest: the velocities
+                // a later dynamic analysis starts with are zero
+                if after_motion[k] {
+                    bring_to_rest(&mut state);
+                }
+                let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
+                state = std::mem::take(&mut outcome.state);
+                let end = AnalysisEnd::from(&outcome);
+                recorder.end_analysis(&end);
+                last = Some(end);
+                if let Some(e) = outcome.error.take() {
+                    failure = Some(Failure::Static(e));
+                    break;
+                }
+            }
+            Planned::Dynamic(mut analysis) => {
+                if k > 0 {
+                    recorder.open_dynamic(&analysis, state.time);
+                }
+                let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
+                state = std::mem::take(&mut outcome.state);
+                let end = AnalysisEnd::from(&outcome);
+                recorder.end_analysis(&end);
+                last = Some(end);
+                if let Some(e) = outcome.error.take() {
+                    failure = Some(Failure::Dynamic(e));
+                    break;
+                }
+            }
+            Planned::Modal(mut analysis) => {
+                let mut outcome = analysis.run(std::mem::take(&mut state), &mut recorder);
+                if let Err(e) = recorder.record_modal(None, &analysis, &outcome) {
+                    eprintln!("error: cannot write results: {e}");
+                    modal_output_error = true;
+                }
+                state = std::mem::take(&mut outcome.state);
+                if let Some(e) = outcome.error.take() {
+                    eprintln!(
+                        "error: {}: modal analysis at t = {}: {e}",
+                        path.display(),
+                        state.time
+                    );
+                    modal_error = Some(e);
+                    break;
+                }
+                print_modes(&outcome);
+                if modal_output_error {
+                    break;
+                }
+            }
+        }
+    }
+    let report = recorder.finish_after(last.as_ref(), &state);
 
     for e in &report.output_errors {
         eprintln!("error: cannot write results: {e}");
     }
+    // what the result files hold: up to the last step written
+    let kept = match report.last_output_time {
+        Some(t) => format!(
+            "results up to t = {} are kept in {}",
+            format_time(t),
+            out.display()
+        ),
+        None => format!("no result step was written in {}", out.display()),
+    };
     if let Some(i) = report.interrupted {
         eprintln!(
-            "{}: {i} at t = {}; results up to it are kept in {}",
+            "{}: {i} at t = {}; {kept}",
             path.display(),
-            outcome.time,
-            out.display()
+            format_time(state.time)
         );
         return ExitCode::from(i.exit_code());
     }
-    if let Some(e) = &outcome.error {
-        eprintln!("error: {}: {e}", path.display());
-        // a model that is singular from the start is invalid input
-        if let StaticError::Initial(NewtonFailure::Singular { .. })
-        | StaticError::Indeterminate { .. } = e
-        {
-            return ExitCode::from(EXIT_INPUT);
-        }
-        eprintln!(
-            "note: results up to t = {:.6} are kept in {}",
-            outcome.time,
-            out.display()
-        );
+    match modal_error {
+        Some(ModalError::NoMass) => return ExitCode::from(EXIT_INPUT),
+        Some(_) => return ExitCode::from(EXIT_FAILED),
+        None => {}
+    }
+    if modal_output_error {
         return ExitCode::from(EXIT_FAILED);
+    }
+    match &failure {
+        Some(Failure::Static(e)) => {
+            eprintln!("error: {}: {e}", path.display());
+            // a model that is singular from the start is invalid input
+            if let StaticError::Initial {
+                failure: NewtonFailure::Singular { .. },
+                ..
+            }
+            | StaticError::Indeterminate { .. } = e
+            {
+                return ExitCode::from(EXIT_INPUT);
+            }
+            eprintln!("note: {kept}");
+            return ExitCode::from(EXIT_FAILED);
+        }
+        Some(Failure::Dynamic(e)) => {
+            eprintln!(
+                "error: {}: dynamic analysis at t = {}: {e}",
+                path.display(),
+                format_time(state.time)
+            );
+            // initial velocities the joints forbid, or a model without
+            // mass or stiffness somewhere, are invalid input
+            if let DynamicError::InconsistentVelocity { .. }
+            | DynamicError::Initial {
+                failure: NewtonFailure::Singular { .. },
+                ..
+            } = e
+            {
+                return ExitCode::from(EXIT_INPUT);
+            }
+            eprintln!("note: {kept}");
+            return ExitCode::from(EXIT_FAILED);
+        }
+        None => {}
     }
     if !report.output_errors.is_empty() {
         return ExitCode::from(EXIT_FAILED);
     }
     ExitCode::SUCCESS
+}
+
+/// Sets the velocities and accelerations of `state` to zero.
+fn bring_to_rest(state: &mut unfold::state::State) {
+    for v in [
+        &mut state.velocity,
+        &mut state.acceleration,
+        &mut state.pseudo_acceleration,
+    ] {
+        v.fill([0.0; 6]);
+    }
+    for v in [
+        &mut state.coordinate_rates,
+        &mut state.coordinate_accelerations,
+        &mut state.coordinate_pseudo_accelerations,
+    ] {
+        v.fill(0.0);
+    }
+}
+
+/// Why the static or dynamic analysis of a run stopped early.
+enum Failure {
+    Static(StaticError),
+    Dynamic(DynamicError),
+}
+
+/// Reads the restart file `path` and finds where the run of `model`
+/// continues from it.
+fn resume(
+    path: &Path,
+    input: &ModelInput,
+    model: &Model,
+    plan: &[AnalysisSettings],
+) -> Result<Resume, RestartError> {
+    Restart::read(path)?.resume(path, &fingerprint(input), model, plan)
 }

@@ -94,7 +94,7 @@ fn degrees_and_radians_give_the_same_model() {
         assert!(model.reference_q[n1].angle_to(&z30) < 1e-12);
         let x20 = so3::exp(&Vec3::new(PI / 9.0, 0.0, 0.0));
         assert!(outcome.state.q[n2].angle_to(&x20) < 1e-12, "{unit:?}");
-        let ctx = model.context(outcome.time, false);
+        let ctx = model.context(outcome.time, unfold::elements::Need::RESIDUAL);
         let driver = model
             .elements
             .iter()

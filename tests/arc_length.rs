@@ -4,33 +4,18 @@
 
 mod common;
 
-use unfold::analysis::{CutbackInfo, IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
+use unfold::analysis::observers::{History, OnIncrement};
+use unfold::analysis::{IncrementInfo, StaticOutcome};
 use unfold::joints::JointType;
 use unfold::model::input::{JointInput, ModelInput};
 use unfold::model::Model;
 use unfold::so3::Vec3;
 use unfold::state::State;
 
-/// Keeps (t, apex deflection) at every converged increment.
+/// (t, apex deflection) at every converged increment.
 #[derive(Default)]
 struct Path {
     points: Vec<(f64, f64)>,
-    apex: usize,
-    height: f64,
-}
-
-impl Observer for Path {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        s: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.points
-            .push((info.time, self.height - s.x[self.apex].y));
-        Ok(())
-    }
 }
 
 /// The von Mises truss: two pin-jointed bars from supports at (±b, 0) to
@@ -75,13 +60,15 @@ fn von_mises_truss_is_followed_through_its_limit_point() {
     m.analysis.displacement_tolerance = Some(1e-10);
     m.analysis.rotation_tolerance = Some(1e-10);
 
-    let model = Model::from_input(&m).expect("valid model");
-    let mut path = Path {
-        apex: model.node_index(3).unwrap(),
-        height: h,
-        ..Default::default()
-    };
-    let outcome = StaticAnalysis::new(&model).run(&mut path);
+    let model = std::sync::Arc::new(Model::from_input(&m).expect("valid model"));
+    let apex = model.node_index(3).unwrap();
+    let mut path = Path::default();
+    let outcome = common::analysis(&model, &m).run(
+        model.initial_state(),
+        &mut OnIncrement(|i: &IncrementInfo, _: &Model, s: &State| {
+            path.points.push((i.time, h - s.x[apex].y))
+        }),
+    );
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     assert_eq!(outcome.time, 1.0);
 
@@ -123,28 +110,9 @@ fn von_mises_truss_is_followed_through_its_limit_point() {
 
 /// Load parameter and the displacement of one node at every converged
 /// increment, and the cut-backs.
-#[derive(Default)]
 struct Trace {
-    node: usize,
     points: Vec<(f64, Vec3)>,
     cutbacks: usize,
-}
-
-impl Observer for Trace {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        model: &Model,
-        s: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        let u = s.x[self.node] - model.reference_x[self.node];
-        self.points.push((info.time, u));
-        Ok(())
-    }
-    fn cutback(&mut self, _: &CutbackInfo) {
-        self.cutbacks += 1;
-    }
 }
 
 /// A planar frame in the x–y plane from `nodes` (id, position) and
@@ -160,7 +128,7 @@ fn planar_frame(
     loaded: u64,
     load: f64,
     end_time: f64,
-) -> (Model, StaticOutcome, Trace) {
+) -> (std::sync::Arc<Model>, StaticOutcome, Trace) {
     let mut m = ModelInput::new("planar frame");
     m.add_section("s", section);
     for &(id, [x, y]) in nodes {
@@ -178,12 +146,17 @@ fn planar_frame(
     m.analysis.end_time = end_time;
     m.analysis.initial_increment = Some(0.5);
     m.analysis.max_increment = Some(2.0);
-    let model = Model::from_input(&m).expect("valid model");
-    let mut trace = Trace {
-        node: model.node_index(loaded).unwrap(),
-        ..Default::default()
+    let model = std::sync::Arc::new(Model::from_input(&m).expect("valid model"));
+    let node = model.node_index(loaded).unwrap();
+    let mut history = History::with_states();
+    let outcome = common::analysis(&model, &m).run(model.initial_state(), &mut history);
+    let points = history.steps();
+    let trace = Trace {
+        points: points
+            .map(|(i, s)| (i.time, s.x[node] - model.reference_x[node]))
+            .collect(),
+        cutbacks: history.cutbacks.len(),
     };
-    let outcome = StaticAnalysis::new(&model).run(&mut trace);
     (model, outcome, trace)
 }
 

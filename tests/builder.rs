@@ -78,10 +78,12 @@ fn the_written_model_file_reads_back_and_runs_the_same() {
     let text = m.to_toml().unwrap();
     let back = parse_model(&text, std::path::Path::new("arm.toml")).unwrap();
     assert_eq!(&back, m.input());
-    let built = m.build().unwrap();
-    let read = unfold::model::Model::from_input(&back).unwrap();
-    let a = StaticAnalysis::new(&built).run(&mut NoObserver);
-    let b = StaticAnalysis::new(&read).run(&mut NoObserver);
+    let built = std::sync::Arc::new(m.build().unwrap());
+    let read = std::sync::Arc::new(unfold::model::Model::from_input(&back).unwrap());
+    let settings = m.analyses().unwrap()[0].as_static().unwrap().clone();
+    let a = StaticAnalysis::new(built.clone(), settings.clone())
+        .run(built.initial_state(), &mut NoObserver);
+    let b = StaticAnalysis::new(read.clone(), settings).run(read.initial_state(), &mut NoObserver);
     assert!(a.error.is_none(), "{:?}", a.error);
     assert_eq!(a.state, b.state);
     assert_eq!(built.node(hand), read.node(hand));
@@ -155,4 +157,33 @@ fn one_diagonal_section() {
     let section = Section::diagonal(1.0, 2.0, 3.0, 4.0, 5.0, 6.0).into_input("s");
     assert_eq!(input.sections[0], section);
     assert_eq!(section.ei3, Some(6.0));
+}
+
+/// A sequence of analyses written by the builder is an array of
+/// `[[analysis]]` tables, read back to the same definition and the same
+/// settings, each starting where the one before ends (default increments
+/// a tenth of each span); a single analysis is still written as one
+/// `[analysis]` table.
+#[test]
+fn a_sequence_of_analyses_round_trips() {
+    let (mut m, ..) = arm();
+    m.analysis(Analysis::kinetostatic().end_time(1.0));
+    let one = m.to_toml().unwrap();
+    assert!(
+        one.contains("\n[analysis]\n") && !one.contains("[[analysis]]"),
+        "{one}"
+    );
+    m.then(Analysis::kinematic().end_time(3.0).output_times([1.5, 2.0]));
+    let text = m.to_toml().unwrap();
+    assert_eq!(text.matches("[[analysis]]").count(), 2, "{text}");
+    let back = parse_model(&text, std::path::Path::new("arm.toml")).unwrap();
+    assert_eq!(&back, m.input());
+    let settings = back.analyses().unwrap();
+    assert_eq!(settings.len(), 2);
+    let second = settings[1].as_static().unwrap();
+    assert!(second.kinematic);
+    assert_eq!(second.end_time, 3.0);
+    assert_eq!(second.initial_increment, 0.2);
+    assert_eq!(second.output_times, vec![1.5, 2.0]);
+    assert_eq!(settings, m.analyses().unwrap());
 }

@@ -242,13 +242,13 @@ fn mechanism_is_reported_as_singular_with_its_dof() {
 
 #[test]
 fn bad_values_in_analysis_and_supports() {
-    let text = format!("{CANTILEVER}\n[analysis]\ntype = \"dynamic\"\nend_time = -1.0\n");
+    let text = format!("{CANTILEVER}\n[analysis]\ntype = \"transient\"\nend_time = -1.0\n");
     assert_rejected(
         "bad_analysis",
         &text,
         &[
             "analysis",
-            "unknown analysis type \"dynamic\"",
+            "unknown analysis type \"transient\"",
             "end_time must be positive",
         ],
     );
@@ -615,8 +615,9 @@ fn load_history_is_explicit_and_visible() {
 
 /// A driver value meant in degrees: read in radians, 90 rad over ten
 /// increments asks for 9 rad per increment (more than half a turn): a
-/// warning names the driver and suggests `unit = "deg"`; with it, the
-/// hinge turns by π/2 in ten increments without a cut-back.
+/// warning names the driver and suggests `unit = "deg"`, and load control
+/// limits the increments to a quarter turn each; with the unit, the hinge
+/// turns by π/2 in ten increments without a cut-back.
 #[test]
 fn angles_in_degrees() {
     let dir = scratch("degrees");
@@ -628,7 +629,12 @@ fn angles_in_degrees() {
             && err.contains("unit = \"deg\""),
         "{err}"
     );
-    assert!(!out.contains(" 0 cut-backs"), "{out}");
+    // load control limits its increments to a quarter turn each
+    // (π/2 / 90 = 1.745e-2) rather than cutting them back
+    assert!(
+        out.contains("note: load increments limited to 1.7453e-2") && out.contains(" 0 cut-backs"),
+        "{out}"
+    );
     let (code, out, err) = run_model(&dir, "deg.toml", &pendulum("90", Some("deg"), kinematic));
     assert_eq!(code, 0, "{err}");
     assert!(!err.contains("warning"), "{err}");
@@ -923,4 +929,751 @@ fn out_of_range_element_forces_are_named() {
         "{err}"
     );
     assert_eq!(err.lines().count(), 1, "{err}");
+}
+
+/// Runs `unfold check` on `text` written as `name` in a scratch directory:
+/// (exit code, stdout, stderr).
+fn check_model(name: &str, text: &str) -> (i32, String, String) {
+    let dir = scratch(name);
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    unfold(&["check", path.to_str().unwrap()])
+}
+
+/// Asserts that `check` accepts `text` (exit 0) with a warning containing
+/// every fragment, or with no warning at all if `fragments` is empty.
+fn assert_warned(name: &str, text: &str, fragments: &[&str]) {
+    let (code, out, err) = check_model(name, text);
+    assert_eq!(code, 0, "{name}: {out}{err}");
+    if fragments.is_empty() {
+        assert!(!err.contains("warning"), "{name}: {err}");
+    }
+    for f in fragments {
+        assert!(
+            err.contains("warning: ") && err.contains(f),
+            "{name}: warning lacks «{f}»: {err}"
+        );
+    }
+}
+
+/// Angles without a unit that look like degrees are warned about, naming
+/// the entity and suggesting `unit = "deg"`: a driven angle beyond a full
+/// turn (30 rad for a pendulum meant to swing 30°), a node's or a
+/// prescribed rotation vector longer than half a turn, a joint spring's
+/// free angle or table angles beyond a full turn. `unit = "rad"` says the
+/// radians are meant and silences them; `unit = "deg"` converts.
+#[test]
+fn angles_that_look_like_degrees_are_warned_about() {
+    let kinematic = "[analysis]\ntype = \"kinematic\"\n";
+    let hint = "If it is in degrees, write unit = \"deg\" (unit = \"rad\" confirms radians)";
+    assert_warned(
+        "driver_30",
+        &pendulum("30", None, kinematic),
+        &[
+            "driver 3: drives its angle up to 30.0000 rad (1718.9°), more than a full turn",
+            hint,
+        ],
+    );
+    assert_warned(
+        "driver_30_rad",
+        &pendulum("30", Some("rad"), kinematic),
+        &[],
+    );
+    assert_warned(
+        "driver_30_deg",
+        &pendulum("30", Some("deg"), kinematic),
+        &[],
+    );
+    // a full turn written to a few digits is a full turn
+    assert_warned("driver_2pi", &pendulum("6.2832", None, kinematic), &[]);
+
+    let node = CANTILEVER.replace(
+        "id = 3\nx = [1.0, 0.0, 0.0]",
+        "id = 3\nx = [1.0, 0.0, 0.0]\nrotation = [0.0, 0.0, 90.0]",
+    );
+    assert_warned(
+        "node_rotation",
+        &node,
+        &[
+            "node 3: rotation has the length 90.0000 rad (5156.6°), more than half a turn",
+            hint,
+        ],
+    );
+    assert_warned(
+        "node_rotation_rad",
+        &node.replace(
+            "rotation = [0.0, 0.0, 90.0]",
+            "rotation = [0.0, 0.0, 90.0]\nunit = \"rad\"",
+        ),
+        &[],
+    );
+
+    // 4 rad in ten increments: not too fast per increment, but more than
+    // half a turn in all
+    let prescribed =
+        format!("{CANTILEVER}\n[[prescribed]]\nnode = 3\nrotation = [4.0, 0.0, 0.0]\n");
+    assert_warned(
+        "prescribed_rotation",
+        &prescribed,
+        &[
+            "prescribed[1] (node 3): rotation reaches 4.0000 rad (229.2°), more than half a turn",
+            hint,
+        ],
+    );
+    assert_warned(
+        "prescribed_rotation_rad",
+        &prescribed.replace("[4.0, 0.0, 0.0]\n", "[4.0, 0.0, 0.0]\nunit = \"rad\"\n"),
+        &[],
+    );
+
+    let spring = |body: &str| {
+        hinged(&format!(
+            "[[joints]]\nid = 30\ntype = \"revolute\"\nnodes = [3, 4]\naxis = [0, 1, 0]\n\n[[joint_springs]]\nid = 31\njoint = 30\n{body}\n"
+        ))
+    };
+    assert_warned(
+        "free_value",
+        &spring("stiffness = 1.0\nfree_value = 90.0"),
+        &[
+            "joint spring 31: free_value is 90.0000 rad (5156.6°), more than a full turn",
+            hint,
+        ],
+    );
+    assert_warned(
+        "free_value_rad",
+        &spring("stiffness = 1.0\nfree_value = 90.0\nunit = \"rad\""),
+        &[],
+    );
+    assert_warned(
+        "spring_table",
+        &spring("table = [[-90.0, -1.0], [90.0, 1.0]]"),
+        &[
+            "joint spring 31: the angles of its table reach 90.0000 rad",
+            hint,
+        ],
+    );
+    // a slide is a length: no warning
+    assert_warned(
+        "slide_spring",
+        &spring("stiffness = 1.0\nfree_value = 90.0").replace("\"revolute\"", "\"prismatic\""),
+        &[],
+    );
+}
+
+/// A prescribed rotation changing by more than half a turn over the
+/// largest increment is warned about, as a driver is (within an increment
+/// the analysis cannot tell it from the same rotation less a turn: 4π in
+/// two increments gave no torque at all), with the increment load control
+/// takes instead: a quarter turn, (π/2)/4π of t.
+#[test]
+fn a_prescribed_rotation_too_fast_for_an_increment_is_warned_about() {
+    let text = format!(
+        "{CANTILEVER}\n[[prescribed]]\nnode = 3\nrotation = [12.566370614359172, 0.0, 0.0]\nunit = \"rad\"\n\n[analysis]\ninitial_increment = 0.5\n"
+    );
+    assert_warned(
+        "prescribed_fast",
+        &text,
+        &[
+            "prescribed[1] (node 3): turns the node by up to 6.2832 rad (360.0°) in one increment of t = 0.5 (max_increment): more than half a turn",
+            "load increments are limited to 1.250e-1 (a quarter turn each).",
+        ],
+    );
+    let (_, _, err) = check_model("prescribed_fast_again", &text);
+    assert!(
+        !err.contains("unit = \"deg\""),
+        "unit given: no hint: {err}"
+    );
+    assert_warned(
+        "prescribed_slow",
+        &text.replace("initial_increment = 0.5", "initial_increment = 0.25"),
+        &[],
+    );
+}
+
+/// A beam's natural length `L(1 + ε f(t))` must stay positive: an initial
+/// axial strain of −1 or below (with its curve) is an error naming the
+/// beam or the line; an initial curvature that turns one element's ends
+/// by half a turn or more is one too (the relative rotation of an
+/// element's ends is at most π).
+#[test]
+fn initial_strains_that_no_beam_can_take_are_rejected() {
+    let strained = |strain: &str, extra: &str| {
+        CANTILEVER.replace(
+            "[[beams]]\nid = 2\nnodes = [2, 3]\nsection = \"s\"\n",
+            &format!("[[beams]]\nid = 2\nnodes = [2, 3]\nsection = \"s\"\ninitial_strain = {strain}\n{extra}"),
+        )
+    };
+    assert_rejected(
+        "strain_minus_one",
+        &strained("[-1.0, 0.0, 0.0, 0.0, 0.0, 0.0]", ""),
+        &[
+            "beam 2: initial axial strain -1 must stay above -1",
+            "natural length",
+        ],
+    );
+    assert_rejected(
+        "strain_minus_two",
+        &strained("[-2.0, 0.0, 0.0, 0.0, 0.0, 0.0]", ""),
+        &["beam 2: initial axial strain -2 must stay above -1"],
+    );
+    // −0.5 times a curve reaching 3: −1.5 at the end
+    let curved = strained(
+        "[-0.5, 0.0, 0.0, 0.0, 0.0, 0.0]",
+        "initial_strain_curve = \"c\"\n\n[[curves]]\nname = \"c\"\npoints = [[0.0, 0.0], [1.0, 3.0]]\n",
+    );
+    assert_rejected(
+        "strain_curve",
+        &curved,
+        &["beam 2: initial axial strain -0.5 (times curve \"c\": down to -1.5) must stay above -1"],
+    );
+    // the same curve going negative leaves a positive strain: valid
+    let (code, _, err) = check_model(
+        "strain_lengthens",
+        &curved.replace("[1.0, 3.0]", "[1.0, -3.0]"),
+    );
+    assert_eq!(code, 0, "{err}");
+    let line = CANTILEVER.replace(
+        "[[beams]]\nid = 1\nnodes = [1, 2]\nsection = \"s\"\n\n[[beams]]\nid = 2\nnodes = [2, 3]\nsection = \"s\"\n",
+        "[[beam_lines]]\nnodes = [1, 3]\nelements = 4\nsection = \"s\"\nfirst_node = 10\ninitial_strain = [-1.5, 0.0, 0.0, 0.0, 0.0, 0.0]\n",
+    )
+    .replace("[[nodes]]\nid = 2\nx = [0.5, 0.0, 0.0]\n", "");
+    assert_rejected(
+        "strain_line",
+        &line,
+        &["beam_lines[1] (nodes 1 to 3): initial axial strain -1.5 must stay above -1"],
+    );
+    // 7 rad/m over 0.5 m: 3.5 rad, more than π, on one element; the same
+    // over four elements of 0.25 m and 1.75 rad each is fine
+    assert_rejected(
+        "curvature",
+        &strained("[0.0, 0.0, 0.0, 0.0, 0.0, 7.0]", ""),
+        &["beam 2: its initial twist and curvature [0.0, 0.0, 7.0] turn its end sections by 3.5000 rad over its length 0.5", "divide it into more elements"],
+    );
+    let (code, _, err) = check_model(
+        "curvature_meshed",
+        &line.replace(
+            "[-1.5, 0.0, 0.0, 0.0, 0.0, 0.0]",
+            "[0.0, 0.0, 0.0, 0.0, 0.0, 7.0]",
+        ),
+    );
+    assert_eq!(code, 0, "{err}");
+}
+
+/// Conflicting input is not resolved silently: a component both fixed by
+/// a support and prescribed is an error (the clamp moved); a component
+/// fixed twice, and gravity in a model without mass, are warnings.
+#[test]
+fn conflicting_supports_and_loads_are_named() {
+    let moved = format!("{CANTILEVER}\n[[prescribed]]\nnode = 1\ndof = \"x\"\nvalue = 0.1\n");
+    assert_rejected(
+        "prescribed_on_fixed",
+        &moved,
+        &["prescribed[1] (node 1): component x of node 1 is also fixed by a support"],
+    );
+    let turned = format!("{CANTILEVER}\n[[prescribed]]\nnode = 1\nrotation = [0.1, 0.0, 0.0]\n");
+    assert_rejected(
+        "prescribed_rotation_on_fixed",
+        &turned,
+        &["prescribed[1] (node 1): the rotation of node 1 is prescribed, but rx, ry, rz are also fixed by a support"],
+    );
+    // a free component of a supported node may be prescribed
+    let free = CANTILEVER.replace("fixed = [\"all\"]", "fixed = [\"y\", \"z\", \"rotations\"]")
+        + "\n[[prescribed]]\nnode = 1\ndof = \"x\"\nvalue = 0.1\n";
+    assert_warned("prescribed_free_component", &free, &[]);
+
+    let twice = format!("{CANTILEVER}\n[[supports]]\nnode = 1\nfixed = [\"x\", \"rz\"]\n");
+    assert_warned(
+        "support_twice",
+        &twice,
+        &["supports[2] (node 1): fixes x, rz again, already fixed by supports[1]"],
+    );
+    assert_warned(
+        "support_twice_in_one",
+        &CANTILEVER.replace("fixed = [\"all\"]", "fixed = [\"all\", \"x\"]"),
+        &["supports[1] (node 1): fixes x again, already fixed by this entry"],
+    );
+    assert_warned(
+        "gravity_without_mass",
+        &format!("{CANTILEVER}\n[gravity]\nacceleration = [0.0, 0.0, -9.81]\n"),
+        &["gravity: acts on no mass"],
+    );
+    assert_warned(
+        "gravity_with_mass",
+        &format!("{CANTILEVER}\n[[point_masses]]\nid = 10\nnode = 3\nmass = 1.0\n\n[gravity]\nacceleration = [0.0, 0.0, -9.81]\n"),
+        &[],
+    );
+}
+
+/// Every misspelt key of a file is reported in one go, each with its line
+/// (the file is read again without it); a top-level key written after a
+/// table header, which TOML puts into that table, gets a hint naming the
+/// table. A misspelt required key is reported once, not again as missing.
+#[test]
+fn every_misspelt_key_is_reported_with_its_line() {
+    let text = CANTILEVER
+        .replace("EA = 1.0e7", "EAA = 1.0e7")
+        .replace("[[supports]]", "[[support]]")
+        .replace("id = 2\nx = [0.5", "idd = 2\nx = [0.5")
+        + "\n[analysis]\ntype = \"static\"\ntitle = \"late\"\n";
+    let dir = scratch("typos");
+    let (code, out, err) = run_model(&dir, "typos.toml", &text);
+    assert_eq!(code, 2, "{out}{err}");
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("typos.toml: TOML parse error"))
+        .collect();
+    assert_eq!(lines.len(), 4, "{err}");
+    for (fragment, line) in [
+        ("unknown field `EAA`", "line 6"),
+        ("unknown field `idd`", "line 18"),
+        ("unknown field `support`", "line 35"),
+        ("unknown field `title`", "line 45"),
+    ] {
+        assert!(err.contains(fragment), "lacks {fragment}: {err}");
+        assert!(
+            lines.iter().any(|l| l.contains(line)),
+            "lacks {line}: {err}"
+        );
+    }
+    // in the order of the file, the missing `id` not reported
+    let at = |f: &str| err.find(f).unwrap();
+    assert!(
+        at("`EAA`") < at("`idd`")
+            && at("`idd`") < at("`support`")
+            && at("`support`") < at("`title`")
+    );
+    assert!(!err.contains("missing field"), "{err}");
+    assert!(
+        err.contains(
+            "hint: `title` is a top-level key, but here it is read as a key of [analysis]"
+        ) && err.contains("write top-level keys before the first header"),
+        "{err}"
+    );
+    // the hint names an entry of an array of tables too
+    let (_, _, err) = check_model(
+        "late_key",
+        &CANTILEVER.replace(
+            "id = 3\nx = [1.0, 0.0, 0.0]",
+            "id = 3\nx = [1.0, 0.0, 0.0]\ntitle = \"t\"",
+        ),
+    );
+    assert!(err.contains("read as a key of [[nodes]] entry 3"), "{err}");
+    // a wrong type ends the report (tables are read in the order of their
+    // names: beams, sections, supports): what follows could be its
+    // consequence
+    let (code, _, err) = check_model(
+        "wrong_type",
+        &CANTILEVER
+            .replace(
+                "nodes = [1, 2]\nsection",
+                "nodes = [1, 2]\norientaton = [0.0, 1.0, 0.0]\nsection",
+            )
+            .replace("EA = 1.0e7", "EA = \"big\"")
+            .replace("[[supports]]", "[[support]]"),
+    );
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("`orientaton`") && err.contains("invalid type"),
+        "{err}"
+    );
+    assert!(!err.contains("`support`"), "{err}");
+}
+
+/// Reads the stderr and the file list of a run into `dir/out`.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir.join("out"))
+        .map(|entries| {
+            entries
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    names
+}
+
+/// A model rejected by the start-of-run checks (a mechanism in statics,
+/// an undriven kinematic mechanism) exits with 2 before any result is
+/// written: no empty CSV file, no grid folder, no "failed … results in"
+/// line; `summary.json` alone says why. The results of an earlier run in
+/// the directory are removed, since they are not this model's.
+#[test]
+fn a_model_rejected_at_the_start_leaves_only_its_summary() {
+    let dir = scratch("rejected");
+    let (code, _, err) = run_model(&dir, "ok.toml", CANTILEVER);
+    assert_eq!(code, 0, "{err}");
+    assert!(listing(&dir).contains(&"nodes.csv".to_string()));
+    let pinned = CANTILEVER.replace("fixed = [\"all\"]", "fixed = [\"translations\"]");
+    let (code, out, err) = run_model(&dir, "pinned.toml", &pinned);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("singular tangent"), "{err}");
+    assert!(
+        !out.contains("failed") && !err.contains("results in"),
+        "{out}{err}"
+    );
+    assert_eq!(listing(&dir), vec!["summary.json".to_string()]);
+    let summary = std::fs::read_to_string(dir.join("out/summary.json")).unwrap();
+    assert!(
+        summary.contains("\"status\": \"failed\"") && summary.contains("singular tangent"),
+        "{summary}"
+    );
+
+    let dir = scratch("rejected_kinematic");
+    let link = "[analysis]\ntype = \"kinematic\"\n\n[[nodes]]\nid = 1\nx = [0.0, 0.0, 0.0]\n\n[[joints]]\nid = 1\ntype = \"revolute\"\nnodes = [1]\naxis = [0, 0, 1]\n";
+    let (code, out, err) = run_model(&dir, "link.toml", link);
+    assert_eq!(code, 2, "{err}");
+    assert!(!out.contains("failed"), "{out}");
+    assert_eq!(listing(&dir), vec!["summary.json".to_string()]);
+}
+
+/// The lock file of the output directory is removed when a run ends,
+/// whether it completed or failed; one left by a killed process (its pid
+/// dead, its lock released by the system) does not block the next run.
+#[test]
+fn the_lock_file_goes_when_the_run_ends() {
+    let dir = scratch("lock");
+    let (code, _, err) = run_model(&dir, "ok.toml", CANTILEVER);
+    assert_eq!(code, 0, "{err}");
+    assert!(!dir.join("out/.unfold.lock").exists());
+    let diverging = CANTILEVER.replace("force = [0.0, 0.0, -1.0]", "force = [0.0, 0.0, -5.0e3]")
+        + "\n[analysis]\ninitial_increment = 0.05\nmax_iterations = 3\nmin_increment = 0.01\n";
+    let (code, _, err) = run_model(&dir, "diverge.toml", &diverging);
+    assert_eq!(code, 1, "{err}");
+    assert!(!dir.join("out/.unfold.lock").exists());
+    // a stale lock file naming a process that no longer runs
+    std::fs::write(dir.join("out/.unfold.lock"), "4194304").unwrap();
+    let (code, _, err) = run_model(&dir, "ok.toml", CANTILEVER);
+    assert_eq!(code, 0, "{err}");
+    assert!(!dir.join("out/.unfold.lock").exists());
+}
+
+/// Command-line values that cannot be meant: `--threads 0` is an error,
+/// more threads than cores a warning; `--out` naming a file is an error
+/// saying so (it was "out/vtk: Not a directory").
+#[test]
+fn command_line_values_are_checked() {
+    let dir = scratch("threads");
+    let model = dir.join("ok.toml");
+    std::fs::write(&model, CANTILEVER).unwrap();
+    let out = dir.join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        unfold(&args)
+    };
+    let (code, _, err) = run(&["--threads", "0"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--threads 0: give at least 1"), "{err}");
+    let (code, _, err) = run(&["--threads", "4096"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("warning: --threads 4096: more threads than the") && err.contains("cores"),
+        "{err}"
+    );
+    let file = dir.join("afile");
+    std::fs::write(&file, "").unwrap();
+    let (code, _, err) = unfold(&[
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(&format!("--out {}: is a file", file.display()))
+            && !err.contains("Not a directory"),
+        "{err}"
+    );
+}
+
+/// An over-driven mechanism (the four-bar with a second driver on the
+/// rocker): `check` warns that the driver's equation is redundant with the
+/// joints and the other drivers, names it, and says the run stops if they
+/// contradict; the run warns the same and stops at its first increment.
+/// The four-bar with its one driver gets no such warning.
+#[test]
+fn an_over_driven_mechanism_is_warned_about() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/four_bar.toml"),
+    )
+    .unwrap();
+    let (code, out, err) = check_model("four_bar_one_driver", &text);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(!err.contains("redundant"), "{err}");
+    let over = format!("{text}\n[[drivers]]\nid = 11\njoint = 4\nvalue = 1.0\n");
+    let (code, out, err) = check_model("four_bar_two_drivers", &over);
+    assert_eq!(code, 0, "{out}{err}");
+    let warning = "driver 11: equation 1 is redundant with the joints and the other drivers at t = 0: the driver repeats or contradicts what they impose";
+    assert!(
+        err.contains(warning) && err.contains("the run stops at its first increment"),
+        "{err}"
+    );
+    let dir = scratch("over_driven");
+    let (code, _, err) = run_model(&dir, "over.toml", &over);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains(warning), "{err}");
+    assert!(
+        err.contains("inconsistent constraints at t = ") && err.contains("driver 11 equation 1"),
+        "{err}"
+    );
+}
+
+/// A sequence of analyses (`[[analysis]]`): the cantilever loaded to
+/// t = 1, then (from that state) to t = 2, runs both in order into one set
+/// of result files: steps numbered 0, 1, 2, ... across both analyses
+/// (the second analysis's equilibrium at its start, the state already
+/// written as the first one's last step, is not written again), increments
+/// numbered on, time going on from 1 to 2, and `summary.json` listing each
+/// analysis. Its end state is that of one analysis from 0 to 2 in the same
+/// increments: the same nodes.csv row of the tip at the last step, to
+/// 1e-12 of the tip's displacement (the same equilibrium to round-off; the
+/// written zeros differ at 1e-20).
+#[test]
+fn a_sequence_of_analyses_runs_into_one_set_of_results() {
+    let dir = scratch("sequence");
+    let text = format!(
+        "{CANTILEVER}\n[[analysis]]\nend_time = 1.0\ninitial_increment = 0.25\n\n[[analysis]]\nend_time = 2.0\ninitial_increment = 0.25\n"
+    );
+    let (code, out, err) = run_model(&dir, "sequence.toml", &text);
+    assert_eq!(code, 0, "stdout {out}\nstderr {err}");
+    assert!(
+        out.contains("analysis 2 of 2: static from t = 1 to t = 2"),
+        "{out}"
+    );
+    let steps = std::fs::read_to_string(dir.join("out/steps.csv")).unwrap();
+    let rows: Vec<Vec<String>> = steps
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    // steps 0..=8, increments 0..=8, t from 0 to 2 by 0.25
+    assert_eq!(rows.len(), 9, "{steps}");
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row[0], k.to_string(), "{steps}");
+        assert_eq!(row[1], k.to_string(), "{steps}");
+        let t: f64 = row[2].parse().unwrap();
+        assert!((t - 0.25 * k as f64).abs() < 1e-12, "{steps}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["status"], "completed");
+    assert_eq!(summary["increments"], 8);
+    assert_eq!(summary["final_time"], 2.0);
+    assert_eq!(summary["end_time"], 2.0);
+    assert_eq!(summary["output_steps"], 9);
+    let analyses = summary["analyses"].as_array().unwrap();
+    assert_eq!(analyses.len(), 2);
+    assert_eq!(analyses[1]["start_time"], 1.0);
+    assert_eq!(analyses[1]["end_time"], 2.0);
+    assert_eq!(analyses[1]["increments"], 4);
+    let last_rows = |nodes: &str| -> Vec<f64> {
+        let row = nodes
+            .lines()
+            .find(|l| l.starts_with("8,") && l.split(',').nth(2) == Some("3"))
+            .expect("the tip at step 8");
+        row.split(',').skip(3).map(|v| v.parse().unwrap()).collect()
+    };
+    let sequence_tip = last_rows(&std::fs::read_to_string(dir.join("out/nodes.csv")).unwrap());
+
+    // one analysis from 0 to 2
+    let one = scratch("sequence-one");
+    let text = format!("{CANTILEVER}\n[analysis]\nend_time = 2.0\ninitial_increment = 0.25\n");
+    let (code, _, err) = run_model(&one, "one.toml", &text);
+    assert_eq!(code, 0, "{err}");
+    let one_tip = last_rows(&std::fs::read_to_string(one.join("out/nodes.csv")).unwrap());
+    let u = (sequence_tip[3].powi(2) + sequence_tip[5].powi(2)).sqrt();
+    let worst = sequence_tip
+        .iter()
+        .zip(&one_tip)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(worst <= 1e-12 * u, "{sequence_tip:?} vs {one_tip:?}");
+}
+
+/// A sequence whose analyses do not go forward in time, or that gives the
+/// model's constraint scaling again, is rejected naming the analysis.
+#[test]
+fn a_sequence_must_go_forward() {
+    let text = format!(
+        "{CANTILEVER}\n[[analysis]]\nend_time = 1.0\n\n[[analysis]]\nend_time = 0.5\nconstraint_scale = 3.0\n"
+    );
+    assert_rejected(
+        "backwards",
+        &text,
+        &[
+            "analysis[2]: end_time must be after the end of the analysis before it (t = 1), got 0.5",
+            "analysis[2]: constraint_scale belongs to the model",
+        ],
+    );
+    let text = CANTILEVER.replace(
+        "title = \"two-element cantilever\"",
+        "title = \"two-element cantilever\"\nanalysis = []",
+    );
+    assert_rejected("no_analysis", &text, &["at least one [[analysis]] table"]);
+}
+
+/// The twisted cantilever of the new-user trial (L = 2, GJ = 5920, ten
+/// elements, end rotation 4π about the axis), with increments of
+/// `increment` asked for.
+fn twisted_cantilever(increment: f64) -> String {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/twisted_cantilever.toml"
+    );
+    std::fs::read_to_string(path)
+        .expect("the twisted cantilever")
+        .replace(
+            "initial_increment = 0.5\n",
+            &format!("initial_increment = {increment}\n"),
+        )
+}
+
+/// The torque of a prescribed end rotation of two full turns is
+/// `GJ·4π/L` = 37 196.46 (uniform torsion) whether increments of 0.5 or of
+/// 0.1 are asked for: increments of 0.5 (a full turn each) gave no torque
+/// at all, as a full turn cannot be told from none within an increment;
+/// load control now takes increments of a quarter turn at most, notes it,
+/// and the builder's warning says so. Reaction moment at the clamp, last
+/// step of reactions.csv, to 1e-6 of the torque.
+#[test]
+fn a_prescribed_rotation_of_two_turns_gives_its_torque_whatever_the_increment() {
+    let torque = 5.92e3 * 4.0 * std::f64::consts::PI / 2.0;
+    for (increment, tag) in [(0.5, "two"), (0.1, "ten")] {
+        let dir = scratch(&format!("twist_{tag}"));
+        let (code, out, err) = run_model(&dir, "twist.toml", &twisted_cantilever(increment));
+        assert_eq!(code, 0, "{out}{err}");
+        if increment == 0.5 {
+            assert!(
+                err.contains("load increments are limited to 1.250e-1 (a quarter turn each)"),
+                "{err}"
+            );
+            assert!(
+                out.contains("note: load increments limited to 1.2500e-1"),
+                "{out}"
+            );
+        }
+        let reactions = std::fs::read_to_string(dir.join("out/reactions.csv")).unwrap();
+        let last = reactions.lines().rev().find(|l| l.contains(",1,")).unwrap();
+        // step,time,node,Fx,Fy,Fz,Mx,My,Mz
+        let mx: f64 = last.split(',').nth(6).unwrap().parse().unwrap();
+        println!("{increment}: reaction moment {mx} against {torque}");
+        assert!((mx.abs() - torque).abs() <= 1e-6 * torque, "{last}");
+    }
+}
+
+/// A rotational spring whose relative rotation passes half a turn stops
+/// the run (exit 1) naming the spring and the increment (its law m = Kψ
+/// holds below half a turn: beyond, ψ = log(…) measures the rotation the
+/// other way round and the moment turns the wrong way); the results up to
+/// the last increment before are kept.
+#[test]
+fn a_rotational_spring_past_half_a_turn_stops_the_run() {
+    let rollup = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/cantilever_rollup.toml"),
+    )
+    .unwrap();
+    let spring = format!(
+        "{rollup}\n[[springs]]\nid = 100\nkind = \"rotational\"\nnodes = [11]\nstiffness = 1.0\n"
+    );
+    let dir = scratch("spring_half_turn");
+    let (code, out, err) = run_model(&dir, "rs.toml", &spring);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(
+        err.contains(
+            "spring 100, between t = 0.5 and t = 0.6: its relative rotation passed half a turn"
+        ) && err.contains("a rotational spring's law m = K ψ holds below half a turn only"),
+        "{err}"
+    );
+    assert!(err.contains("results up to t = 0.5 are kept"), "{err}");
+    let summary = std::fs::read_to_string(dir.join("out/summary.json")).unwrap();
+    assert!(summary.contains("\"status\": \"failed\""), "{summary}");
+}
+
+/// Kinematic increments show the largest constraint violation relative to
+/// its tolerance at each iteration (converged: at most 1), not the
+/// relative residual, which without loads stays near 1 (the four-bar
+/// printed 9.7e-1 5.0e-1 6.8e-1 0.0e0); static increments keep the
+/// relative residuals.
+#[test]
+fn kinematic_increments_show_the_constraint_violation() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/four_bar.toml");
+    let dir = scratch("kinematic_lines");
+    let (code, out, err) = unfold(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out
+        .lines()
+        .filter(|l| l.starts_with("increment "))
+        .collect();
+    assert_eq!(lines.len(), 73, "{out}");
+    for line in &lines {
+        let (_, values) = line
+            .split_once("constraint violations (× tolerance): ")
+            .unwrap_or_else(|| panic!("{line}"));
+        let values: Vec<f64> = values.split(' ').map(|v| v.parse().unwrap()).collect();
+        assert!(*values.last().unwrap() <= 1.0, "{line}");
+        assert_eq!(values.len(), line_iterations(line) + 1, "{line}");
+    }
+    // the first increment starts far from the constraints (the crank
+    // turned by its driver, the rest not yet)
+    assert!(
+        lines[1].contains("e8") || lines[1].contains("e9"),
+        "{}",
+        lines[1]
+    );
+    let dir = scratch("static_lines");
+    let (code, out, _) = run_model(&dir, "c.toml", CANTILEVER);
+    assert_eq!(code, 0);
+    assert!(out.contains("relative residuals: "), "{out}");
+    assert!(!out.contains("constraint violations"), "{out}");
+}
+
+/// The number of iterations an increment line gives.
+fn line_iterations(line: &str) -> usize {
+    line.split("iterations")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|s| s.parse().ok())
+        .unwrap()
+}
+
+/// The shallow clamped arch of the new-user trial under load control in
+/// increments of 0.05 warns on stderr, in log.txt and in summary.json
+/// about the increments across which the tangent's determinant changed
+/// sign, among them increment 2 (t = 0.05 to 0.1), across the limit load
+/// t ≈ 0.0845; the run goes on (exit 0).
+#[test]
+fn the_run_warns_about_limit_points_passed() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/shallow_arch.toml");
+    let text = &std::fs::read_to_string(path).expect("the arch model");
+    let dir = scratch("arch_limit");
+    let (code, out, err) = run_model(&dir, "arch.toml", text);
+    assert_eq!(code, 0, "{out}{err}");
+    let warning = "warning: increment 2 (t = 0.05 to 0.1): the determinant of the tangent stiffness changed sign within this increment";
+    assert!(
+        err.contains(warning) && err.contains("control = \"arc_length\""),
+        "{err}"
+    );
+    let log = std::fs::read_to_string(dir.join("out/log.txt")).unwrap();
+    assert!(log.contains(warning), "{log}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    let warnings = summary["warnings"].as_array().unwrap();
+    assert!(
+        warnings.iter().any(|w| w
+            .as_str()
+            .unwrap()
+            .starts_with("increment 2 (t = 0.05 to 0.1)")),
+        "{warnings:?}"
+    );
 }

@@ -9,29 +9,15 @@ mod common;
 use std::f64::consts::PI;
 
 use common::node;
-use unfold::analysis::{IncrementInfo, NewtonFailure, Observer, StaticAnalysis, StaticOutcome};
+use std::sync::Arc;
+
+use unfold::analysis::observers::History;
+use unfold::analysis::{NewtonFailure, StaticOutcome};
 use unfold::elements::{Element, ElementKind, ElementOutput, EvalContext};
 use unfold::model::input::{BeamLineInput, ModelInput};
 use unfold::model::Model;
 use unfold::so3;
 use unfold::state::State;
-
-/// Keeps the iterations of every converged increment.
-#[derive(Default)]
-struct Iterations(Vec<usize>);
-
-impl Observer for Iterations {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        _: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.0.push(info.iterations);
-        Ok(())
-    }
-}
 
 /// A straight line of `n` beam elements from node 1 at `a` to node 2 at
 /// `b`; interior nodes get ids 3, 4, ... in order from `a`.
@@ -60,10 +46,12 @@ fn line(
 
 /// Runs `model`, returning the outcome and the iterations of every
 /// increment after the initial equilibrium.
-fn run_model(model: &Model) -> (StaticOutcome, Vec<usize>) {
-    let mut iterations = Iterations::default();
-    let outcome = StaticAnalysis::new(model).run(&mut iterations);
-    (outcome, iterations.0[1..].to_vec())
+fn run_model(model: Model, input: &ModelInput) -> (Arc<Model>, StaticOutcome, Vec<usize>) {
+    let model = Arc::new(model);
+    let mut history = History::new();
+    let outcome = common::analysis(&model, input).run(model.initial_state(), &mut history);
+    let iterations = history.increments[1..].iter().map(|i| i.iterations);
+    (model, outcome, iterations.collect())
 }
 
 /// The cantilever of the README and the crate example: 2 m, 10 elements,
@@ -86,7 +74,7 @@ fn cantilever(p: f64, scale: f64) -> ModelInput {
 /// Tip deflection (along z) and the iterations of every increment.
 fn tip_deflection(input: &ModelInput) -> (f64, Vec<usize>) {
     let model = Model::from_input(input).expect("valid model");
-    let (outcome, iterations) = run_model(&model);
+    let (model, outcome, iterations) = run_model(model, input);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     let tip = node(&model, 2);
     (
@@ -203,7 +191,7 @@ fn a_changed_load_is_never_accepted_without_a_correction() {
     ];
     for (name, input) in models {
         let model = Model::from_input(&input).expect("valid model");
-        let (outcome, iterations) = run_model(&model);
+        let (_, outcome, iterations) = run_model(model, &input);
         assert!(outcome.error.is_none(), "{name}: {:?}", outcome.error);
         println!("{name}: iterations {iterations:?}");
         assert!(
@@ -246,8 +234,8 @@ impl Element for BreakingSpring {
             // reference position of the tip: (2, 0, 0)
             let u = x[c] - if c == 0 { 2.0 } else { 0.0 };
             out.residual[c] += k * u * r_factor;
-            if ctx.need_tangent {
-                out.tangent[c * 6 + c] += k * k_factor;
+            if let Some(t) = out.stiffness.as_deref_mut() {
+                t[c * 6 + c] += k * k_factor;
             }
         }
     }
@@ -259,14 +247,15 @@ impl Element for BreakingSpring {
 #[test]
 fn non_finite_values_name_the_element() {
     for (in_tangent, what) in [(false, "residual"), (true, "tangent")] {
-        let mut model = Model::from_input(&cantilever(10.0, 1.0)).expect("valid model");
+        let input = cantilever(10.0, 1.0);
+        let mut model = Model::from_input(&input).expect("valid model");
         let tip = node(&model, 2);
         model.push_element(Box::new(BreakingSpring {
             id: 77,
             node: [tip],
             in_tangent,
         }));
-        let (outcome, _) = run_model(&model);
+        let (_, outcome, _) = run_model(model, &input);
         let error = outcome.error.expect("the run must stop").to_string();
         println!("{error}");
         assert!(
@@ -318,7 +307,7 @@ fn slender_rollup_converges_in_few_iterations() {
     m.analysis.initial_increment = Some(0.125);
     m.analysis.max_increment = Some(0.125);
     let model = Model::from_input(&m).expect("valid model");
-    let (outcome, iterations) = run_model(&model);
+    let (model, outcome, iterations) = run_model(model, &m);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     println!(
         "iterations per increment {iterations:?}, translation corrections {}",

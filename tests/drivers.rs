@@ -1,48 +1,40 @@
 //! Drivers with an acting window: released after it, taking over the
 //! coordinate where they find it when they start late.
 
-use unfold::analysis::{IncrementInfo, Observer, StaticAnalysis};
-use unfold::elements::ElementKind;
+use std::sync::Arc;
+
+use unfold::analysis::observers::OnIncrement;
+use unfold::analysis::{IncrementInfo, StaticAnalysis};
+use unfold::elements::{ElementKind, Need};
 use unfold::joints::JointType;
 use unfold::model::input::{DriverInput, JointInput, JointSpringInput, ModelInput};
 use unfold::model::Model;
 use unfold::state::State;
 
-/// (t, hinge angle, load of driver 1, load of driver 2) at every increment.
-#[derive(Default)]
-struct History(Vec<(f64, f64, f64, f64)>);
-
-impl Observer for History {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        model: &Model,
-        s: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        let ctx = model.context(info.time, false);
-        let mut row = (info.time, 0.0, 0.0, 0.0);
-        let mut v = [0.0; 9];
-        for e in &model.elements {
-            match (e.kind(), e.id()) {
-                (ElementKind::Joint, _) => {
-                    e.results(&ctx, s, &mut v);
-                    row.1 = v[0];
-                }
-                (ElementKind::Driver, 10) => {
-                    e.results(&ctx, s, &mut v[..3]);
-                    row.2 = v[2];
-                }
-                (ElementKind::Driver, 11) => {
-                    e.results(&ctx, s, &mut v[..3]);
-                    row.3 = v[2];
-                }
-                _ => {}
+/// (t, hinge angle, load of driver 1, load of driver 2) at a converged
+/// state.
+fn row(t: f64, model: &Model, s: &State) -> (f64, f64, f64, f64) {
+    let ctx = model.context(t, Need::RESIDUAL);
+    let mut row = (t, 0.0, 0.0, 0.0);
+    let mut v = [0.0; 9];
+    for e in &model.elements {
+        match (e.kind(), e.id()) {
+            (ElementKind::Joint, _) => {
+                e.results(&ctx, s, &mut v);
+                row.1 = v[0];
             }
+            (ElementKind::Driver, 10) => {
+                e.results(&ctx, s, &mut v[..3]);
+                row.2 = v[2];
+            }
+            (ElementKind::Driver, 11) => {
+                e.results(&ctx, s, &mut v[..3]);
+                row.3 = v[2];
+            }
+            _ => {}
         }
-        self.0.push(row);
-        Ok(())
     }
+    row
 }
 
 /// A rigid link hinged to the ground with a torsion spring k. Driver 10
@@ -94,12 +86,16 @@ fn driver_acts_in_its_window_only() {
     // the link's node has no stiffness of its own besides the joints:
     // ground it in translation so that only the hinge turns
     m.fix(1, &["x", "y", "z"]);
-    let model = Model::from_input(&m).expect("valid model");
-    let mut h = History::default();
-    let outcome = StaticAnalysis::new(&model).run(&mut h);
+    let model = Arc::new(Model::from_input(&m).expect("valid model"));
+    let mut rows = Vec::new();
+    let settings = m.analyses().unwrap()[0].as_static().unwrap().clone();
+    let outcome = StaticAnalysis::new(model.clone(), settings).run(
+        model.initial_state(),
+        &mut OnIncrement(|i: &IncrementInfo, m: &Model, s: &State| rows.push(row(i.time, m, s))),
+    );
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
-    assert_eq!(h.0.len(), 13, "12 increments and the initial state");
-    for &(t, angle, load1, load2) in &h.0 {
+    assert_eq!(rows.len(), 13, "12 increments and the initial state");
+    for &(t, angle, load1, load2) in &rows {
         let (expected, l1, l2) = if t <= 1.0 {
             (0.5 * t, k * 0.5 * t, 0.0)
         } else if t < 2.0 {
@@ -160,27 +156,19 @@ curve = "stroke"
 "#;
     let input = unfold::io::model_file::parse_model(text, std::path::Path::new("smooth.toml"))
         .expect("valid model file");
-    let model = Model::from_input(&input).expect("valid model");
-    #[derive(Default)]
-    struct Angles(Vec<(f64, f64)>);
-    impl Observer for Angles {
-        fn increment(
-            &mut self,
-            info: &IncrementInfo,
-            model: &Model,
-            s: &State,
-            _: &[f64],
-        ) -> std::io::Result<()> {
+    let model = Arc::new(Model::from_input(&input).expect("valid model"));
+    let mut angles = Vec::new();
+    let settings = input.analyses().unwrap()[0].as_static().unwrap().clone();
+    let outcome = StaticAnalysis::new(model.clone(), settings).run(
+        model.initial_state(),
+        &mut OnIncrement(|i: &IncrementInfo, m: &Model, s: &State| {
             let mut v = [0.0; 9];
-            model.elements[0].results(&model.context(info.time, false), s, &mut v);
-            self.0.push((info.time, v[0]));
-            Ok(())
-        }
-    }
-    let mut a = Angles::default();
-    let outcome = StaticAnalysis::new(&model).run(&mut a);
+            m.elements[0].results(&m.context(i.time, Need::RESIDUAL), s, &mut v);
+            angles.push((i.time, v[0]));
+        }),
+    );
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
-    for (t, angle) in a.0 {
+    for (t, angle) in angles {
         let tau = ((t - 0.5) / 1.0f64).clamp(0.0, 1.0);
         let expected = 1.2 * tau.powi(3) * (10.0 - 15.0 * tau + 6.0 * tau * tau);
         assert!(

@@ -1,5 +1,5 @@
 //! Validation of the eigen-solvers of modal analysis (`src/eigen.rs`,
-//! docs/theory.md §12) against closed-form spectra of spring–mass chains,
+//! docs/theory.md §14) against closed-form spectra of spring–mass chains,
 //! with supports, constraints, massless unknowns and rigid-body modes, and
 //! the dense solver against Lanczos on a beam-like finite-element pencil.
 //!

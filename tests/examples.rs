@@ -64,3 +64,31 @@ fn rust_built_mast_round_trips_and_runs() {
     let top = model.node_index(301).unwrap();
     assert!(outcome.state.x[top].x > model.reference_x[top].x);
 }
+
+/// The lattice mast's command line: a number of bays from 1 to 10 000, an
+/// output directory; anything else is a usage error (0 bays ran a mast
+/// without members, with its loads on clamped nodes).
+#[test]
+fn lattice_mast_arguments_are_checked() {
+    let args = |a: &[&str]| lattice_mast::arguments(a.iter().map(|s| s.to_string()));
+    assert_eq!(
+        args(&[]).unwrap(),
+        (8, std::path::PathBuf::from("results/lattice_mast"))
+    );
+    assert_eq!(args(&["3", "out"]).unwrap(), (3, "out".into()));
+    for bad in [
+        &["0"][..],
+        &["abc"],
+        &["-3"],
+        &["1e3"],
+        &["10001"],
+        &["2", "out", "more"],
+    ] {
+        let e = args(bad).unwrap_err();
+        assert!(
+            e.contains("BAYS must be a whole number from 1 to 10000")
+                || e.contains("unexpected argument"),
+            "{bad:?}: {e}"
+        );
+    }
+}

@@ -6,8 +6,8 @@
 
 mod common;
 
-use unfold::analysis::{NoObserver, StaticAnalysis};
-use unfold::elements::{Element, ElementKind, ElementOutput, EvalContext};
+use unfold::analysis::NoObserver;
+use unfold::elements::{Element, ElementKind, ElementOutput, EvalContext, Offsets};
 use unfold::model::input::{Id, ModelInput};
 use unfold::model::Model;
 use unfold::state::State;
@@ -16,7 +16,7 @@ use unfold::state::State;
 struct TieZ {
     nodes: [usize; 2],
     z0: [f64; 2],
-    /// Offset of λ in `state.extra`.
+    /// Offset of λ in `state.multipliers`.
     extra: usize,
 }
 
@@ -30,23 +30,26 @@ impl Element for TieZ {
     fn nodes(&self) -> &[usize] {
         &self.nodes
     }
-    fn n_extra(&self) -> usize {
+    fn n_multipliers(&self) -> usize {
         1
     }
-    fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
+    fn set_offsets(&mut self, offsets: Offsets) {
+        self.extra = offsets.multipliers;
+    }
+    fn evaluate(&self, _ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         let n = self.n_local(); // 13: two nodes and λ
-        let lambda = state.extra[self.extra];
+        let lambda = state.multipliers[self.extra];
         let [a, b] = self.nodes;
         let phi = (state.x[b].z - self.z0[1]) - (state.x[a].z - self.z0[0]);
         // r = ∂(λΦ)/∂q and the constraint equation Φ
         out.residual[2] -= lambda;
         out.residual[8] += lambda;
         out.residual[12] += phi;
-        if ctx.need_tangent {
-            out.tangent[12 * n + 2] -= 1.0;
-            out.tangent[12 * n + 8] += 1.0;
-            out.tangent[2 * n + 12] -= 1.0;
-            out.tangent[8 * n + 12] += 1.0;
+        if let Some(t) = out.stiffness.as_deref_mut() {
+            t[12 * n + 2] -= 1.0;
+            t[12 * n + 8] += 1.0;
+            t[2 * n + 12] -= 1.0;
+            t[8 * n + 12] += 1.0;
         }
     }
 }
@@ -72,16 +75,17 @@ fn tied_cantilevers_share_the_load_through_a_multiplier() {
     m.analysis.initial_increment = Some(1.0);
     let mut model = Model::from_input(&m).unwrap();
     let (a, b) = (model.node_index(2).unwrap(), model.node_index(4).unwrap());
-    model.elements.push(Box::new(TieZ {
+    model.push_element(Box::new(TieZ {
         nodes: [a, b],
         z0: [0.0, 0.0],
         extra: 0,
     }));
 
-    let mut analysis = StaticAnalysis::new(&model);
+    let model = std::sync::Arc::new(model);
+    let mut analysis = common::analysis(&model, &m);
     // 2 × 10 elements: 22 nodes, 2 clamped → 120 node unknowns, plus λ
     assert_eq!(analysis.n_equations(), 121);
-    let outcome = analysis.run(&mut NoObserver);
+    let outcome = analysis.run(model.initial_state(), &mut NoObserver);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
 
     let s = &outcome.state;
@@ -89,10 +93,10 @@ fn tied_cantilevers_share_the_load_through_a_multiplier() {
     let (wa, wb) = (-s.x[a].z, -s.x[b].z);
     println!(
         "tips {wa:.6e} {wb:.6e}, expected {expected:.6e}, λ = {:.6}",
-        s.extra[0]
+        s.multipliers[0]
     );
     assert!((wa - wb).abs() < 1e-9 * expected, "the tie is violated");
     assert!((wa - expected).abs() < 5e-3 * expected);
     // the multiplier is the force passed from the loaded beam to the other
-    assert!((s.extra[0].abs() - p / 2.0).abs() < 1e-6 * p);
+    assert!((s.multipliers[0].abs() - p / 2.0).abs() < 1e-6 * p);
 }

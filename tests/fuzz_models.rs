@@ -309,7 +309,28 @@ fn check(text: &str, path: &Path) -> Result<Model, String> {
         }
         .to_string()
     })?;
-    preflight::check(&model).map_err(|e| format!("{}: {e}", path.display()))?;
+    let invalid = |e| {
+        unfold::io::model_file::ModelFileError::Invalid {
+            path: path.to_path_buf(),
+            errors: e,
+        }
+        .to_string()
+    };
+    let analyses = input.analyses().map_err(invalid)?;
+    // as `unfold check`: the mass of a model with modal analyses, then the
+    // preflight of the first static analysis, if any
+    if analyses.iter().any(|a| a.as_modal().is_some())
+        && !unfold::analysis::ModalAnalysis::has_mass(&model)
+    {
+        return Err(format!(
+            "{}: modal analysis: {}",
+            path.display(),
+            unfold::analysis::ModalError::NoMass
+        ));
+    }
+    if let Some(settings) = analyses.iter().find_map(|a| a.as_static()) {
+        preflight::check(&model, settings).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
     Ok(model)
 }
 

@@ -25,7 +25,7 @@ mod common;
 
 use std::f64::consts::{PI, TAU};
 
-use unfold::analysis::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer, StaticAnalysis};
+use unfold::analysis::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer};
 use unfold::elements::ElementKind;
 use unfold::joints::JointType;
 use unfold::model::input::{
@@ -88,10 +88,11 @@ impl Observer for Path {
 }
 
 /// Builds and runs `input`, asserting that it reaches its end time.
-fn solve(input: &ModelInput) -> (Model, Path) {
+fn solve(input: &ModelInput) -> (std::sync::Arc<Model>, Path) {
     let model = Model::from_input(input).unwrap_or_else(|e| panic!("invalid model: {e}"));
+    let model = std::sync::Arc::new(model);
     let mut path = Path::default();
-    let outcome = StaticAnalysis::new(&model).run(&mut path);
+    let outcome = common::analysis(&model, input).run(model.initial_state(), &mut path);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
     (model, path)
 }
@@ -113,7 +114,11 @@ fn results(model: &Model, state: &State, kind: ElementKind, id: Id) -> Vec<f64> 
         .find(|e| e.kind() == kind && e.id() == id)
         .unwrap_or_else(|| panic!("no {} {id}", kind.name()));
     let mut out = vec![0.0; e.result_names().len()];
-    e.results(&model.context(state.time, false), state, &mut out);
+    e.results(
+        &model.context(state.time, unfold::elements::Need::RESIDUAL),
+        state,
+        &mut out,
+    );
     out
 }
 

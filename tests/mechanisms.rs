@@ -26,8 +26,9 @@
 use std::f64::consts::{FRAC_PI_4, PI, TAU};
 
 use unfold::analysis::newton::NewtonSolver;
+use unfold::analysis::observers::History;
 use unfold::analysis::statics::StaticError;
-use unfold::analysis::{IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
+use unfold::analysis::{StaticAnalysis, StaticOutcome};
 use unfold::elements::ElementKind;
 use unfold::joints::JointType;
 use unfold::model::input::{AnalysisInput, DriverInput, Id, JointInput, ModelInput};
@@ -47,45 +48,13 @@ const LIMIT: f64 = 1e-8;
 // helpers
 // ---------------------------------------------------------------------
 
-/// Records every converged state and the notes of the analysis.
-#[derive(Default)]
-struct Path {
-    increments: Vec<IncrementInfo>,
-    states: Vec<State>,
-    notes: Vec<String>,
-}
-
-impl Observer for Path {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.increments.push(info.clone());
-        self.states.push(state.clone());
-        Ok(())
-    }
-
-    fn note(&mut self, text: &str) {
-        self.notes.push(text.to_string());
-    }
-}
-
-impl Path {
-    /// Newton iterations over the converged increments (increment 0
-    /// included).
-    fn iterations(&self) -> usize {
-        self.increments.iter().map(|i| i.iterations).sum()
-    }
-}
-
 /// Builds and runs a model, keeping every converged state.
-fn simulate(input: &ModelInput) -> (Model, StaticOutcome, Path) {
-    let model = Model::from_input(input).expect("valid model");
-    let mut path = Path::default();
-    let outcome = StaticAnalysis::new(&model).run(&mut path);
+fn simulate(input: &ModelInput) -> (std::sync::Arc<Model>, StaticOutcome, History) {
+    let model = std::sync::Arc::new(Model::from_input(input).expect("valid model"));
+    let mut path = History::with_states();
+    let settings = input.analyses().unwrap()[0].as_static().unwrap().clone();
+    let outcome =
+        StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut path);
     (model, outcome, path)
 }
 
@@ -156,7 +125,11 @@ fn result(model: &Model, state: &State, kind: ElementKind, id: Id, k: usize) -> 
         .find(|e| e.kind() == kind && e.id() == id)
         .expect("element exists");
     let mut out = vec![f64::NAN; e.result_names().len()];
-    e.results(&model.context(state.time, false), state, &mut out);
+    e.results(
+        &model.context(state.time, unfold::elements::Need::RESIDUAL),
+        state,
+        &mut out,
+    );
     out[k]
 }
 
@@ -166,7 +139,7 @@ fn redundant_count(model: &Model) -> usize {
     let mut state = model.initial_state();
     model.apply_prescribed(&mut state, 0.0);
     NewtonSolver::new(model)
-        .constraint_rank(model, &state)
+        .constraint_rank(model, &state, 0.0)
         .redundant
         .len()
 }
@@ -246,7 +219,7 @@ fn four_bar(drive: bool) -> ModelInput {
     let pa = Vec3::new(a * FB_THETA2.cos(), a * FB_THETA2.sin(), 0.0);
     let pb = o4 + Vec3::new(c * theta4.cos(), c * theta4.sin(), 0.0);
     let mut m = ModelInput::new("planar four-bar, crank-rocker");
-    m.analysis = kinematic(72);
+    m.analysis = kinematic(72).into();
     m.add_node(1, o2.into());
     m.add_node(2, ((o2 + pa) / 2.0).into());
     m.add_node(3, ((pa + pb) / 2.0).into());
@@ -391,7 +364,7 @@ fn slider_crank() -> ModelInput {
     let pin = Vec3::new(r * SC_THETA.cos(), r * SC_THETA.sin(), 0.0);
     let slider = Vec3::new(slider_x(SC_THETA), -e, 0.0);
     let mut m = ModelInput::new("offset slider-crank");
-    m.analysis = kinematic(72);
+    m.analysis = kinematic(72).into();
     m.add_node(1, [0.0; 3]);
     m.add_node(2, ((pin + slider) / 2.0).into());
     m.add_node(3, slider.into());
@@ -567,7 +540,7 @@ fn bricard() -> (ModelInput, Vec<(Vec3, Vec3)>, f64, f64) {
         a,
     );
     let mut m = ModelInput::new("threefold-symmetric Bricard linkage");
-    m.analysis = kinematic(72);
+    m.analysis = kinematic(72).into();
     let axes: Vec<(Vec3, Vec3)> = f[..6]
         .iter()
         .map(|(r, p)| (*p, r.column(2).into_owned()))

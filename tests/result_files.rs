@@ -13,10 +13,16 @@ use std::process::Command;
 use vtk_reader::Grid;
 
 fn run_example(name: &str) -> PathBuf {
+    run_example_into(name, name)
+}
+
+/// Runs an example into a directory of its own, named by `tag` (tests
+/// that run at the same time need different ones).
+fn run_example_into(name: &str, tag: &str) -> PathBuf {
     let model = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("examples")
         .join(name);
-    let out = std::env::temp_dir().join(format!("unfold-results-{}-{name}", std::process::id()));
+    let out = std::env::temp_dir().join(format!("unfold-results-{}-{tag}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let status = Command::new(env!("CARGO_BIN_EXE_unfold"))
         .args([
@@ -552,4 +558,36 @@ fn earlier_results_are_removed_and_other_files_kept() {
         "mine"
     );
     assert!(out.join("vtk/mine.vtu").exists());
+}
+
+/// `dofs` in summary.json counts the equations solved, after the
+/// redundant constraint equations are removed (docs/results.md): for the
+/// four-bar of 3-D hinges, 39 unknowns in the first log line, 3 of them
+/// redundant (the planar loop), 36 solved. The last line counts the
+/// iterations of the initial equilibrium apart from the average per
+/// increment.
+#[test]
+fn summary_counts_the_equations_solved() {
+    let out = run_example_into("four_bar.toml", "dofs");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    let first = log.lines().next().unwrap();
+    assert!(first.contains("; 39 unknowns;"), "{first}");
+    assert_eq!(summary["redundant_constraints"], 3);
+    assert_eq!(summary["dofs"], 36);
+    assert!(!out.join(".unfold.lock").exists());
+
+    let out = run_example_into("cantilever_rollup.toml", "last_line");
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let initial = summary["increment_log"][0]["iterations"].as_u64().unwrap();
+    let last = log.lines().last().unwrap();
+    let expected = format!(
+        "completed: 10 increments, {} iterations ({initial} for the initial equilibrium; {:.2} per increment), 0 cut-backs, t = 1, ",
+        summary["iterations"],
+        summary["average_iterations"].as_f64().unwrap()
+    );
+    assert!(last.starts_with(&expected), "{last}\nexpected {expected}");
 }

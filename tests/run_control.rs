@@ -365,3 +365,62 @@ fn a_write_failing_mid_run_leaves_every_file_with_the_same_steps() {
     assert_eq!(s["output_steps"].as_u64().unwrap() as usize, steps);
     assert!(s["final_time"].as_f64().unwrap() >= last);
 }
+
+/// After a write failure the note on stderr gives the time of the last
+/// step actually written (the files stop there), not that of the
+/// increment whose step could not be written; and the lock file is gone.
+#[test]
+fn the_note_after_a_write_failure_gives_the_last_step_written() {
+    let dir = scratch("fsize-note");
+    let model = dir.join("model.toml");
+    // as above: nodes.csv passes the limit in the fourth step
+    std::fs::write(&model, rollup(400, 0.05)).unwrap();
+    let out = dir.join("out");
+    let limit = 300_000;
+    let mut command = Command::new(env!("CARGO_BIN_EXE_unfold"));
+    command.args([
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // SAFETY: setrlimit is async-signal-safe
+    unsafe {
+        command.pre_exec(move || {
+            let l = libc::rlimit {
+                rlim_cur: limit,
+                rlim_max: limit,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &l) == 0 {
+                Ok(())
+            } else {
+                Err(std::io::Error::last_os_error())
+            }
+        });
+    }
+    let result = command.output().unwrap();
+    let err = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(1), "{err}");
+    let (_, last) = assert_consistent(&out);
+    let final_time = summary(&out)["final_time"].as_f64().unwrap();
+    assert!(
+        final_time > last,
+        "the failed step is after the last written"
+    );
+    let note = err
+        .lines()
+        .find(|l| l.starts_with("note: results up to t = "))
+        .unwrap_or_else(|| panic!("no note: {err}"));
+    let t: f64 = note["note: results up to t = ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    // the note prints six decimals
+    assert!(
+        (t - last).abs() < 1e-6,
+        "note {t}, last step written {last}: {err}"
+    );
+    assert!(!out.join(".unfold.lock").exists());
+}

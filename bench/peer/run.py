@@ -199,6 +199,7 @@ def equal_accuracy(label, run_at, reference, first_step, tolerance, halvings, re
                 "newton_iterations": run.newton_iterations,
                 "jacobians": run.jacobians,
                 "final": run.positions[-1].tolist(),
+                "energy_final": float(run.energy[-1]) if getattr(run, "energy", np.zeros(0)).size else None,
                 "tried": tried,
             }
     return {"ok": False, "tried": tried}
@@ -234,8 +235,15 @@ def main():
     ap.add_argument("--halvings", type=int, default=10, help="most halvings of the step")
     ap.add_argument("--recompute-references", action="store_true", help="ignore the cached references")
     ap.add_argument("--no-unfold", action="store_true", help="run Exudyn only")
+    ap.add_argument(
+        "--unfold-residual-tolerance",
+        type=float,
+        default=unfold_side.RESIDUAL_TOLERANCE,
+        help=f"unfold's Newton residual tolerance (default {unfold_side.RESIDUAL_TOLERANCE:g}, as Exudyn's; 0: unfold's own default)",
+    )
     args = ap.parse_args()
 
+    unfold_side.RESIDUAL_TOLERANCE = args.unfold_residual_tolerance or None
     problems = [p.strip() for p in args.problems.split(",") if p.strip()]
     sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
     for p in problems:
@@ -248,6 +256,11 @@ def main():
         f"exudyn {exudyn_side.version()}; {os.cpu_count()} cores; {args.threads} thread(s) per code"
     )
     log(f"  generalized-alpha, rho_inf = {RHO_INFINITY}; outputs every {OUTPUT_PERIOD} s")
+    rt = unfold_side.RESIDUAL_TOLERANCE
+    log(
+        f"  Newton relative tolerance: Exudyn {exudyn_side.NEWTON_RELATIVE_TOLERANCE:g}, "
+        f"unfold {rt:g}" + (" (residual relative to the force flux)" if rt else " (its default)")
+    )
 
     log(f"  load average at the start: {' '.join(f'{x:.1f}' for x in os.getloadavg())}")
     if args.no_unfold:
@@ -259,7 +272,7 @@ def main():
         except unfold_side.ModelError as e:
             raise SystemExit(f"error: {e}")
         if unfold_ok:
-            log(f"  unfold: {unfold_side.binary()} ({unfold_side.version()})")
+            log(f"  unfold: {unfold_side.describe()}")
         else:
             log("  unfold: dynamic analysis not available")
             log(f"    ({why})")
@@ -271,6 +284,7 @@ def main():
         "exudyn": exudyn_side.version(),
         "threads": args.threads,
         "rho_infinity": RHO_INFINITY,
+        "unfold_residual_tolerance": unfold_side.RESIDUAL_TOLERANCE,
         "unfold_available": unfold_ok,
         "unfold_unavailable_because": why,
         "load_average_start": os.getloadavg(),
@@ -303,13 +317,22 @@ def main():
             )
             case["unfold"] = None
             if unfold_ok:
-                uref = unfold_side.run_pendulum(n, P.reference_step, threads=args.threads)
+                uref = unfold_side.run_pendulum(n, P.reference_step, threads=args.threads, reference=True)
+                if uref.ok and uref.cutbacks:
+                    log(f"    unfold: reference run (h = {P.reference_step:g} s): {uref.message}")
                 if not uref.ok:
                     log(f"    unfold: reference run (h = {P.reference_step:g} s) failed: {uref.message}")
                     case["unfold"] = {"ok": False, "tried": [], "message": uref.message}
                 else:
                     case["references_differ"] = max_distance(uref.positions, exu_refs[n])
                     log(f"    references of the two codes differ by {case['references_differ']:.2e} m")
+                    case["unfold_reference_final"] = uref.positions[-1].tolist()
+                    if uref.energy.size:
+                        case["unfold_reference_energy"] = float(uref.energy[-1])
+                        log(
+                            f"    unfold reference at t = {P.end_time:g} s: tip {uref.positions[-1].tolist()}, "
+                            f"T + V = {uref.energy[-1]:.3e} J (0 at the start)"
+                        )
                     case["unfold"] = equal_accuracy(
                         "unfold",
                         lambda h, n=n: unfold_side.run_pendulum(n, h, threads=args.threads),
@@ -319,6 +342,12 @@ def main():
                         args.halvings,
                         args.repeat,
                     )
+            u = case["unfold"]
+            if u and u.get("ok") and u.get("energy_final") is not None and "unfold_reference_energy" in case:
+                log(
+                    f"    unfold at the equal-accuracy step: T + V = {u['energy_final']:.3e} J at t = {P.end_time:g} s "
+                    f"(reference {case['unfold_reference_energy']:.3e} J; m g L/2 = {P.rho_A * P.length * 9.81 / 2:.3f} J)"
+                )
             results["cases"].append(case)
             rows.append((f"pendulum {n}", case))
 
@@ -351,6 +380,12 @@ def main():
                 args.halvings,
                 args.repeat,
             )
+        for side in ("exudyn", "unfold"):
+            r = case[side]
+            if r and r["ok"]:
+                d = float(np.linalg.norm(np.array(r["final"]) - ref[-1]))
+                r["final_error"] = d
+                log(f"    {side}: centre of mass at t = {T.end_time:g} s {r['final']} ({d:.2e} m from the reference)")
         results["cases"].append(case)
         rows.append(("heavy top", case))
 

@@ -24,7 +24,8 @@ pub const REDUNDANT: f64 = 1e-8;
 /// Result of the rank analysis.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ConstraintRank {
-    /// Redundant multipliers, as indices into the extra block of the state.
+    /// Redundant multipliers, as indices into
+    /// [`crate::state::State::multipliers`].
     pub redundant: Vec<usize>,
     /// Number of free unknowns that are not multipliers.
     pub n_unknowns: usize,
@@ -124,10 +125,9 @@ pub fn analyse(dofs: &DofMap, matrix: &SparseMatrix, multiplier: &[bool]) -> Con
             }
         }
     }
-    let n_extra_start = dofs.n_dofs() - extra_count(dofs);
     let mut redundant: Vec<usize> = redundant_eq
         .iter()
-        .map(|&eq| dofs.dof(eq) - n_extra_start)
+        .filter_map(|&eq| dofs.multiplier_index(dofs.dof(eq)))
         .collect();
     redundant.sort_unstable();
     let mut freedom: Vec<(usize, f64)> = (0..n)
@@ -141,11 +141,4 @@ pub fn analyse(dofs: &DofMap, matrix: &SparseMatrix, multiplier: &[bool]) -> Con
         rank,
         freedom,
     }
-}
-
-/// Number of extra dofs of the numbering.
-fn extra_count(dofs: &DofMap) -> usize {
-    (0..dofs.n_dofs())
-        .filter(|&d| dofs.kind(d) == crate::dofs::DofKind::Extra)
-        .count()
 }

@@ -1,18 +1,39 @@
-//! Analyses: algorithms that turn a [`crate::model::Model`] and an initial
-//! [`crate::state::State`] into a sequence of converged states.
+//! Analyses: algorithms that take a [`crate::model::Model`] (shared,
+//! `Arc<Model>`), their settings ([`AnalysisSettings`], beside the model)
+//! and a start [`crate::state::State`], and return a sequence of converged
+//! states and the final one. A first analysis starts from
+//! [`crate::model::Model::initial_state`], a later one from the final state
+//! of the one before (a preload, then a deployment, then ...).
+//!
+//! Every incremental analysis is driven by the one step controller of
+//! [`control`]: step sizes, landing on output times and on `end_time`,
+//! cut-backs, events, changes of the active constraints.
 //!
 //! An analysis reports its progress to an [`Observer`]: every Newton
-//! iteration, every converged increment (with the state, for output) and
-//! every cut-back. The library never prints; the command-line tool turns
-//! these events into log lines, a progress bar and result files.
+//! iteration, every converged increment (with the state, for output), every
+//! cut-back and every event. The library never prints; the command-line
+//! tool turns these events into log lines, a progress bar and result files.
 
 pub mod constraints;
+pub mod control;
+pub mod dynamics;
+pub mod energy;
+pub mod impact;
+pub mod modal;
 pub mod newton;
+pub mod observers;
 pub mod preflight;
+pub mod settings;
 pub mod statics;
 
+pub use control::EventFunction;
+pub use dynamics::{Continuation, DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
+pub use energy::{Energies, EnergyBalance};
+pub use impact::LockInfo;
+pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
-pub use statics::{StaticAnalysis, StaticOutcome};
+pub use settings::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
+pub use statics::{StaticAnalysis, StaticOutcome, Step, LIMIT_POINT_WARNING};
 
 use crate::model::Model;
 use crate::state::State;
@@ -63,6 +84,19 @@ pub struct CutbackInfo {
     pub reason: NewtonFailure,
 }
 
+/// A step that landed on an event ([`EventFunction`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EventInfo {
+    /// Increment that landed on it.
+    pub increment: usize,
+    /// Load parameter (time) of the event.
+    pub time: f64,
+    /// The event's name.
+    pub name: String,
+    /// The event function there (within its tolerance of zero).
+    pub value: f64,
+}
+
 /// Receives the events of an analysis. Every method has an empty default.
 pub trait Observer {
     /// After each residual evaluation of a Newton iteration.
@@ -82,11 +116,42 @@ pub trait Observer {
         Ok(())
     }
 
+    /// The energies of a dynamic analysis at its converged step, just
+    /// before that step is reported to [`Observer::increment`].
+    fn energies(&mut self, _energies: &energy::Energies) {}
+
     /// When an increment is cut back.
     fn cutback(&mut self, _info: &CutbackInfo) {}
 
+    /// After the increment that landed on an event (reported to
+    /// [`Observer::increment`] first).
+    fn event(&mut self, _info: &EventInfo) {}
+
+    /// After the step on which a latch locked (reported to
+    /// [`Observer::increment`], with the post-impact state, first).
+    fn lock(&mut self, _info: &LockInfo) {}
+
     /// A remark worth showing the user (redundant constraints removed).
     fn note(&mut self, _text: &str) {}
+
+    /// After a converged increment that the analysis finds suspect (a
+    /// limit or bifurcation point passed under load control, docs/theory.md
+    /// §9): the analysis goes on, but its results may not be those
+    /// meant.
+    fn warning(&mut self, _info: &WarningInfo) {}
+}
+
+/// A suspect converged increment ([`Observer::warning`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WarningInfo {
+    /// The increment.
+    pub increment: usize,
+    /// Load parameter at its start.
+    pub from: f64,
+    /// Load parameter reached.
+    pub time: f64,
+    /// What is suspect, and what to do.
+    pub message: String,
 }
 
 /// An observer that ignores everything.

@@ -18,21 +18,26 @@
 //!
 //! Convergence (§7.1) requires at least one correction in the increment
 //! and all of
-//! - **residual**: for forces and for moments separately,
-//!   `‖(|r| − c ρ)⁺‖₂ ≤ ε_r ‖flux‖₂`: the part of each equation's residual
-//!   above its round-off floor, `ρᵢ = ε Σⱼ |Kᵢⱼ| sⱼ` (`sⱼ` the size of
-//!   unknown `j`: `|x| + ℓ` of its node, `ℓ` the length of its elements,
-//!   1 rad, or `|λ|`), against the flux `Σₑ|rₑ|` of the forces flowing
-//!   through the dofs (reactions included);
-//! - **constraints**: the equations of extra unknowns (the constraints of
+//! - **residual**: for forces, for moments and for the generalised forces
+//!   of coordinates separately, `‖(|r| − c ρ)⁺‖₂ ≤ ε_r ‖flux‖₂`: the part of
+//!   each equation's residual above its round-off floor,
+//!   `ρᵢ = ε Σⱼ |Kᵢⱼ| sⱼ` (`sⱼ` the size of unknown `j`: `|x| + ℓ` of its
+//!   node, `ℓ` the length of its elements, 1 rad, or the value of a
+//!   coordinate or multiplier), against the flux `Σₑ|rₑ|` of the forces
+//!   flowing through the dofs (reactions included); a coordinate's
+//!   generalised force counts divided by the length a unit of it spans
+//!   ([`DofKind::Coordinate`]), against the force flux;
+//! - **constraints**: the equations of multipliers (the constraints of
 //!   joints) hold, above their round-off floor, to `ε_u D` for distances and
 //!   `ε_θ` for angles, where `D = max|Δx|` is the largest translation of the
 //!   increment so far;
 //! - **correction**: the next correction, estimated as the last one times
 //!   the residual ratio, `|Δq_{k+1}| ≈ |Δq_k| ρ_k/ρ_{k−1}` (exact in the
 //!   quadratic regime; this saves the iteration that would only confirm
-//!   convergence), is below `ε_u D` for translations and `ε_θ` for
-//!   rotations, each above its own round-off (`c ε (|x| + ℓ)`, `c ε`);
+//!   convergence), is below `ε_u D` for translations and coordinates
+//!   (times their length), `ε_θ` for rotations, and `ε_r` times the flux of
+//!   its group for the force `k Δλ` of a multiplier, each above its own
+//!   round-off (`c ε (|x| + ℓ)`, `c ε`, `c ε |c|`, `c ε |kλ|`);
 //!
 //! or else the residual has stopped decreasing within `PLATEAU_FACTOR`
 //! of its round-off floor (it is at its round-off plateau).
@@ -46,12 +51,14 @@
 //! is found before the analysis starts.
 
 use super::constraints::{self, ConstraintRank};
+use super::settings::StaticSettings;
+use super::statics::StaticError;
 use super::{IterationInfo, Observer};
 use crate::assembly::Assembler;
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
-use crate::elements::ExtraKind;
-use crate::linalg::{smallest_relative_pivot, SolveError, SparseLu};
-use crate::model::{Model, StaticSettings, COMPONENT_NAMES};
+use crate::elements::{ConstraintKind, ElementOutput, Need};
+use crate::linalg::{smallest_relative_pivot, DeterminantSign, LuKernel, SolveError, SparseLu};
+use crate::model::{Model, COMPONENT_NAMES};
 use crate::so3::{self, Vec3};
 use crate::state::State;
 
@@ -136,10 +143,13 @@ pub struct ConvergenceNorms {
     pub flux_force: f64,
     /// `‖flux‖₂` over all rotation dofs.
     pub flux_moment: f64,
-    /// `max(‖e_F‖/‖flux_F‖, ‖e_M‖/‖flux_M‖)`, where `eᵢ = (|rᵢ| − c ρᵢ)⁺`
-    /// is the part of each residual above its round-off floor: the residual
-    /// criterion holds when this is at most `ε_r`; 0 when every residual is
-    /// at round-off.
+    /// `‖r/ℓ‖₂` over free coordinate equations (generalised forces divided
+    /// by the length a unit of the coordinate spans: forces).
+    pub residual_coordinate: f64,
+    /// `max(‖e_F‖/‖flux_F‖, ‖e_M‖/‖flux_M‖, ‖e_C/ℓ‖/‖flux_F‖)`, where
+    /// `eᵢ = (|rᵢ| − c ρᵢ)⁺` is the part of each residual above its
+    /// round-off floor: the residual criterion holds when this is at most
+    /// `ε_r`; 0 when every residual is at round-off.
     pub relative_residual: f64,
     /// Largest constraint violation above round-off, relative to its
     /// tolerance (`ε_u·D` for distances, `D` the largest translation of the
@@ -205,6 +215,13 @@ pub enum NewtonFailure {
         /// Relative pivot size.
         pivot: f64,
     },
+    /// The step converged, but its estimated local error is above the
+    /// tolerance (the step controller shrinks it).
+    #[error("local error estimate {error:.3e} times its tolerance")]
+    ErrorEstimate {
+        /// Error relative to the tolerance.
+        error: f64,
+    },
 }
 
 impl NewtonFailure {
@@ -216,7 +233,7 @@ impl NewtonFailure {
             | Self::NonFinite { iteration, .. }
             | Self::NoArcRoot { iteration }
             | Self::PathReversed { iteration } => *iteration,
-            Self::Singular { .. } => 0,
+            Self::Singular { .. } | Self::ErrorEstimate { .. } => 0,
         }
     }
 }
@@ -280,10 +297,18 @@ pub struct NewtonSolver {
     /// solve always makes one correction, even from equilibrium, so that a
     /// singular model (a mechanism) is caught at the start.
     tangent_checked: bool,
-    /// What each extra unknown is (multiplier or coordinate).
-    extra_kinds: Vec<ExtraKind>,
     /// Multipliers of redundant constraints, left out of the system.
     redundant: Vec<usize>,
+    /// Whether the constraints of each element were active at the last
+    /// rank analysis.
+    active: Vec<bool>,
+    /// Scaling of the constraint equations (their multipliers' `k`).
+    scaling: crate::elements::ConstraintScaling,
+    /// Sign of the tangent's determinant (docs/theory.md §9): the
+    /// workspace, and the sign of the last Newton system factored by the
+    /// simplicial kernel.
+    determinant: DeterminantSign,
+    newton_sign: Option<f64>,
 }
 
 impl NewtonSolver {
@@ -292,13 +317,6 @@ impl NewtonSolver {
         let dofs = DofMap::new(model);
         let assembler = Assembler::new(model, &dofs);
         let n = dofs.n_equations();
-        let ctx = model.context(0.0, false);
-        let extra_kinds = model
-            .elements
-            .iter()
-            .flat_map(|e| (0..e.n_extra()).map(move |k| (e, k)))
-            .map(|(e, k)| e.extra_kind(&ctx, k))
-            .collect();
         let free_size = free_size(model, &dofs);
         let node_lengths = node_lengths(model);
         Self {
@@ -322,8 +340,11 @@ impl NewtonSolver {
             translation_count: 0,
             closest_approach_count: 0,
             tangent_checked: false,
-            extra_kinds,
             redundant: Vec::new(),
+            active: Vec::new(),
+            scaling: model.scaling,
+            determinant: DeterminantSign::default(),
+            newton_sign: None,
         }
     }
 
@@ -344,24 +365,32 @@ impl NewtonSolver {
 
     /// Whether each equation is a multiplier's.
     fn multiplier_equations(&self) -> Vec<bool> {
-        let first_extra = self.dofs.n_dofs() - self.extra_kinds.len();
         (0..self.dofs.n_equations())
-            .map(|eq| {
-                let d = self.dofs.dof(eq);
-                d >= first_extra
-                    && matches!(
-                        self.extra_kinds[d - first_extra],
-                        ExtraKind::Multiplier { .. }
-                    )
-            })
+            .map(|eq| matches!(self.dofs.equation_kind(eq), DofKind::Multiplier(_)))
             .collect()
     }
 
-    /// Rank analysis of the constraints at `state` (docs/joints.md §5):
-    /// redundant constraints are removed from the numbering (their
-    /// multipliers stay zero) and the free motions are counted.
-    pub fn constraint_rank(&mut self, model: &Model, state: &State) -> ConstraintRank {
-        self.assemble(model, state, state.time, true);
+    /// Rank analysis of the constraints at `state` and `time`
+    /// (docs/joints.md §5): redundant constraints are removed from the
+    /// numbering (their multipliers stay zero) and the free motions are
+    /// counted. Run at the start of an analysis, and again whenever the
+    /// set of active constraints changes ([`Self::active_set_changed`]):
+    /// the numbering is then rebuilt from the model's, with the redundant
+    /// constraints of now.
+    pub fn constraint_rank(&mut self, model: &Model, state: &State, time: f64) -> ConstraintRank {
+        self.active.clear();
+        self.active.extend(
+            model
+                .elements
+                .iter()
+                .map(|e| e.n_multipliers() > 0 && e.constraints_active(time, state)),
+        );
+        if !self.redundant.is_empty() {
+            // back to the full numbering
+            self.redundant.clear();
+            self.renumber(model);
+        }
+        self.assemble(model, state, time, true);
         let rank = constraints::analyse(
             &self.dofs,
             &self.assembler.matrix,
@@ -369,13 +398,51 @@ impl NewtonSolver {
         );
         self.redundant.clone_from(&rank.redundant);
         if !rank.redundant.is_empty() {
-            self.dofs = DofMap::with_suppressed(model, &rank.redundant);
-            self.assembler = Assembler::new(model, &self.dofs);
-            self.lu = None;
-            self.held_entries = None;
-            self.resize();
+            self.renumber(model);
         }
         rank
+    }
+
+    /// Numbers the unknowns again, without the redundant multipliers.
+    fn renumber(&mut self, model: &Model) {
+        self.dofs = DofMap::with_suppressed(model, &self.redundant);
+        self.assembler = Assembler::new(model, &self.dofs);
+        self.lu = None;
+        self.newton_sign = None;
+        self.held_entries = None;
+        self.resize();
+    }
+
+    /// Whether the constraints acting at `time` in `state` are not those of
+    /// the last rank analysis (a driver's window opened or closed). No
+    /// allocation.
+    pub fn active_set_changed(&self, model: &Model, state: &State, time: f64) -> bool {
+        model
+            .elements
+            .iter()
+            .zip(&self.active)
+            .any(|(e, &was)| e.n_multipliers() > 0 && e.constraints_active(time, state) != was)
+    }
+
+    /// Multipliers removed as redundant by the last rank analysis.
+    pub fn redundant_count(&self) -> usize {
+        self.redundant.len()
+    }
+
+    /// The error of a kinematic analysis whose constraints leave the
+    /// motions `rank.freedom` free, naming the least constrained unknowns.
+    pub fn indeterminate(&self, model: &Model, rank: &ConstraintRank) -> StaticError {
+        let free = rank.degrees_of_freedom();
+        let dofs: Vec<String> = rank
+            .freedom
+            .iter()
+            .take(free.min(6))
+            .map(|&(d, _)| self.dof_label(model, d))
+            .collect();
+        StaticError::Indeterminate {
+            free,
+            dofs: dofs.join(", "),
+        }
     }
 
     /// Residual at every dof after the last evaluation: at fixed dofs, the
@@ -396,33 +463,48 @@ impl NewtonSolver {
         self.closest_approach_count
     }
 
+    /// The numbering, the assembler and the sparse LU of the current
+    /// numbering, for an analysis that forms its own iteration matrix on
+    /// the same pattern (dynamics). The LU's symbolic analysis is kept
+    /// between calls and dropped when the numbering changes.
+    pub(crate) fn system(&mut self) -> (&DofMap, &mut Assembler, &mut Option<SparseLu>) {
+        self.fresh = false;
+        (&self.dofs, &mut self.assembler, &mut self.lu)
+    }
+
+    /// The assembler (its last residual, flux and matrix).
+    pub(crate) fn assembler(&self) -> &Assembler {
+        &self.assembler
+    }
+
     /// Number of stored entries of the system matrix.
     pub fn nnz(&self) -> usize {
         self.assembler.matrix.nnz()
     }
 
-    /// Describes a dof for messages: `node 5 rz`, `spring 3 unknown 1`.
+    /// Describes a dof for messages: `node 5 rz`, `joint 3 unknown 1`
+    /// (the element's coordinates, then its multipliers, from 1).
     pub fn dof_label(&self, model: &Model, dof: usize) -> String {
-        match self.dofs.node_component(dof) {
-            Some((node, c)) => format!("node {} {}", model.node_ids[node], COMPONENT_NAMES[c]),
-            None => {
-                // find the element owning the extra unknown
-                let mut k = dof - 6 * model.n_nodes();
-                for e in &model.elements {
-                    if k < e.n_extra() {
-                        return format!("{} {} unknown {}", e.kind().name(), e.id(), k + 1);
-                    }
-                    k -= e.n_extra();
-                }
-                format!("dof {dof}")
+        if let Some((node, c)) = self.dofs.node_component(dof) {
+            return format!("node {} {}", model.node_ids[node], COMPONENT_NAMES[c]);
+        }
+        // the element owning the coordinate or multiplier
+        for (i, e) in model.elements.iter().enumerate() {
+            if let Some(k) = self
+                .dofs
+                .element_extra_dofs(model, i)
+                .position(|d| d == dof)
+            {
+                return format!("{} {} unknown {}", e.kind().name(), e.id(), k + 1);
             }
         }
+        format!("dof {dof}")
     }
 
     /// Assembles residual (and tangent if asked) at `state` and `time`.
     pub fn assemble(&mut self, model: &Model, state: &State, time: f64, need_tangent: bool) {
         self.fresh = false;
-        let ctx = model.context(time, need_tangent);
+        let ctx = model.context(time, Need::stiffness(need_tangent));
         self.assembler.assemble(model, &ctx, state);
     }
 
@@ -441,65 +523,62 @@ impl NewtonSolver {
         if self.redundant.is_empty() {
             return None;
         }
-        let ctx = model.context(state.time, true);
+        let ctx = model.context(state.time, Need::STIFFNESS);
         let mut worst: Option<(String, f64)> = None;
-        let mut offset = 0;
-        for e in &model.elements {
-            let ne = e.n_extra();
+        for (i, e) in model.elements.iter().enumerate() {
+            let (nm, o) = (e.n_multipliers(), model.offsets(i));
             let mine: Vec<usize> = self
                 .redundant
                 .iter()
-                .filter(|&&k| k >= offset && k < offset + ne)
-                .map(|&k| k - offset)
+                .filter(|&&k| k >= o.multipliers && k < o.multipliers + nm)
+                .map(|&k| k - o.multipliers)
                 .collect();
-            if !mine.is_empty() {
-                let n = e.n_local();
-                let mut r = vec![0.0; n];
-                let mut t = vec![0.0; n * n];
-                e.evaluate(
-                    &ctx,
-                    state,
-                    &mut crate::elements::ElementOutput {
-                        residual: &mut r,
-                        tangent: &mut t,
-                    },
-                );
-                // sizes of the element's unknowns, for the round-off floor
-                let nodes = e.nodes();
-                let size: Vec<f64> = (0..n)
-                    .map(|j| match j {
-                        j if j < 6 * nodes.len() && j % 6 < 3 => {
-                            let node = nodes[j / 6];
-                            state.x[node].norm() + self.node_lengths[node]
-                        }
-                        j if j < 6 * nodes.len() => 1.0,
-                        j => state.extra[offset + j - 6 * nodes.len()].abs(),
-                    })
-                    .collect();
-                for k in mine {
-                    if let ExtraKind::Multiplier { scale, angular } = e.extra_kind(&ctx, k) {
-                        let tol = if angular {
-                            settings.rotation_tolerance
-                        } else {
-                            settings.displacement_tolerance * self.last_motion
-                        };
-                        let row = 6 * nodes.len() + k;
-                        // tangent in column-major order: K_ij at j·n + i
-                        let floor: f64 = FLOOR_FACTOR
-                            * f64::EPSILON
-                            * (0..n).map(|j| t[j * n + row].abs() * size[j]).sum::<f64>();
-                        let excess = (r[row].abs() - floor).max(0.0) / scale;
-                        let v = if excess == 0.0 { 0.0 } else { excess / tol };
-                        if v > 1.0 && worst.as_ref().is_none_or(|w| v > w.1) {
-                            worst = Some((
-                                format!("{} {} equation {}", e.kind().name(), e.id(), k + 1),
-                                v,
-                            ));
-                        }
+            if mine.is_empty() {
+                continue;
+            }
+            let n = e.n_local();
+            let mut r = vec![0.0; n];
+            let mut t = vec![0.0; n * n];
+            e.evaluate(
+                &ctx,
+                state,
+                &mut ElementOutput::with_stiffness(&mut r, &mut t),
+            );
+            // sizes of the element's unknowns, for the round-off floor
+            let nodes = e.nodes();
+            let (nq, nc) = (6 * nodes.len(), e.n_coordinates());
+            let size: Vec<f64> = (0..n)
+                .map(|j| match j {
+                    j if j < nq && j % 6 < 3 => {
+                        let node = nodes[j / 6];
+                        state.x[node].norm() + self.node_lengths[node]
                     }
+                    j if j < nq => 1.0,
+                    j if j < nq + nc => state.coordinates[o.coordinates + j - nq].abs(),
+                    j => state.multipliers[o.multipliers + j - nq - nc].abs(),
+                })
+                .collect();
+            for k in mine {
+                let kind = e.multiplier_kind(k);
+                let scale = ctx.scaling.of(kind).0;
+                let tol = match kind {
+                    ConstraintKind::Angle => settings.rotation_tolerance,
+                    ConstraintKind::Distance => settings.displacement_tolerance * self.last_motion,
+                };
+                let row = nq + nc + k;
+                // tangent in column-major order: K_ij at j·n + i
+                let floor: f64 = FLOOR_FACTOR
+                    * f64::EPSILON
+                    * (0..n).map(|j| t[j * n + row].abs() * size[j]).sum::<f64>();
+                let excess = (r[row].abs() - floor).max(0.0) / scale;
+                let v = if excess == 0.0 { 0.0 } else { excess / tol };
+                if v > 1.0 && worst.as_ref().is_none_or(|w| v > w.1) {
+                    worst = Some((
+                        format!("{} {} equation {}", e.kind().name(), e.id(), k + 1),
+                        v,
+                    ));
                 }
             }
-            offset += ne;
         }
         worst
     }
@@ -510,18 +589,12 @@ impl NewtonSolver {
     /// every unknown would produce, with `sⱼ = |x| + ℓ` of the node for
     /// translations (its position is known to `ε|x|`, and its elements
     /// compute strains of order 1 from lengths `ℓ`), 1 (rad) for rotations
-    /// and `|λ|` for extra unknowns.
+    /// and the magnitude of the value for coordinates and multipliers.
     /// Local to each equation: neither the extent of the model nor a stiff
     /// part elsewhere changes it.
-    fn round_off_floor(&mut self, model: &Model, state: &State) {
-        let n_nodes = model.n_nodes();
+    fn round_off_floor(&mut self, state: &State) {
         for (eq, s) in self.size.iter_mut().enumerate() {
-            let d = self.dofs.dof(eq);
-            *s = match self.dofs.kind(d) {
-                DofKind::Translation => state.x[d / 6].norm() + self.node_lengths[d / 6],
-                DofKind::Rotation => 1.0,
-                DofKind::Extra => state.extra[d - 6 * n_nodes].abs(),
-            };
+            *s = unknown_size(&self.dofs, &self.node_lengths, state, self.dofs.dof(eq));
         }
         self.floor.fill(0.0);
         for (row, col, v) in self.assembler.matrix.entries() {
@@ -535,29 +608,28 @@ impl NewtonSolver {
         self.step
             .iter()
             .enumerate()
-            .filter(|&(eq, _)| self.dofs.kind(self.dofs.dof(eq)) == DofKind::Translation)
+            .filter(|&(eq, _)| self.dofs.equation_kind(eq) == DofKind::Translation)
             .fold(0.0f64, |m, (_, v)| m.max(v.abs()))
     }
 
     /// Residual, flux and constraint norms of the last assembly
     /// (docs/theory.md §7.1), with `distance_tol` the tolerance of distance
-    /// constraints.
+    /// constraints. Each kind of unknown has its group: forces
+    /// (translations), moments (rotations), the generalised forces of
+    /// coordinates divided by their lengths (forces, against the force
+    /// flux: the one element owning a coordinate makes its own flux equal
+    /// to its residual), and the constraints.
     fn norms(&self, settings: &StaticSettings, distance_tol: f64, factor: f64) -> ConvergenceNorms {
-        let (mut rf, mut rm, mut ef, mut em, mut ff, mut fm, mut rc) =
-            (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0f64);
+        let (mut rf, mut rm, mut rq, mut ef, mut em, mut eq_c, mut ff, mut fm, mut rc) =
+            (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0f64);
         let res = &self.assembler.residual;
         let flux = &self.assembler.flux;
-        let first_extra = self.dofs.n_dofs() - self.extra_kinds.len();
-        // flux over every dof, fixed ones included (reactions)
+        // flux over every node dof, fixed ones included (reactions)
         for (dof, f) in flux.iter().enumerate() {
             match self.dofs.kind(dof) {
                 DofKind::Translation => ff += f * f,
                 DofKind::Rotation => fm += f * f,
-                DofKind::Extra => {
-                    if self.extra_kinds[dof - first_extra] == ExtraKind::Coordinate {
-                        ff += f * f;
-                    }
-                }
+                DofKind::Coordinate { .. } | DofKind::Multiplier(_) => {}
             }
         }
         // residual and its part above round-off over free equations
@@ -574,22 +646,19 @@ impl NewtonSolver {
                     rm += r * r;
                     em += e * e;
                 }
-                DofKind::Extra => match self.extra_kinds[dof - first_extra] {
-                    ExtraKind::Multiplier { scale, angular } => {
-                        if e > 0.0 {
-                            let t = if angular {
-                                settings.rotation_tolerance
-                            } else {
-                                distance_tol
-                            };
-                            rc = rc.max(e / scale / t);
-                        }
+                DofKind::Coordinate { length } => {
+                    rq += (r / length).powi(2);
+                    eq_c += (e / length).powi(2);
+                }
+                DofKind::Multiplier(kind) => {
+                    if e > 0.0 {
+                        let t = match kind {
+                            ConstraintKind::Angle => settings.rotation_tolerance,
+                            ConstraintKind::Distance => distance_tol,
+                        };
+                        rc = rc.max(e / self.scaling.of(kind).0 / t);
                     }
-                    ExtraKind::Coordinate => {
-                        rf += r * r;
-                        ef += e * e;
-                    }
-                },
+                }
             }
         }
         // e > 0 implies a non-zero flux (flux ≥ |r| at every dof)
@@ -599,7 +668,10 @@ impl NewtonSolver {
             residual_moment: rm.sqrt(),
             flux_force: ff.sqrt(),
             flux_moment: fm.sqrt(),
-            relative_residual: rel(ef.sqrt(), ff.sqrt()).max(rel(em.sqrt(), fm.sqrt())),
+            residual_coordinate: rq.sqrt(),
+            relative_residual: rel(ef.sqrt(), ff.sqrt())
+                .max(rel(em.sqrt(), fm.sqrt()))
+                .max(rel(eq_c.sqrt(), ff.sqrt())),
             residual_constraint: rc,
             displacement_correction: 0.0,
             rotation_correction: 0.0,
@@ -608,30 +680,38 @@ impl NewtonSolver {
 
     /// Whether the next correction, estimated as the last one (in
     /// `self.rhs`) times `ratio`, is below `ε_u D` for translations and
-    /// `ε_θ` for rotations, above the round-off of each unknown.
+    /// coordinates (times their length), `ε_θ` for rotations, and
+    /// `ε_r ‖flux‖` of its group for the force `k Δλ` of a multiplier, each
+    /// above the round-off of the unknown.
     fn correction_converged(
         &self,
         state: &State,
         settings: &StaticSettings,
         ratio: f64,
         motion: f64,
+        norms: &ConvergenceNorms,
     ) -> bool {
         let (tol_x, tol_theta) = (
             settings.displacement_tolerance * motion,
             settings.rotation_tolerance + FLOOR_FACTOR * f64::EPSILON,
         );
+        let round_off = FLOOR_FACTOR * f64::EPSILON;
         self.rhs.iter().enumerate().all(|(eq, &delta)| {
             let d = self.dofs.dof(eq);
             let next = delta.abs() * ratio;
+            let size = || unknown_size(&self.dofs, &self.node_lengths, state, d);
             match self.dofs.kind(d) {
-                DofKind::Translation => {
-                    next - FLOOR_FACTOR
-                        * f64::EPSILON
-                        * (state.x[d / 6].norm() + self.node_lengths[d / 6])
-                        <= tol_x
-                }
+                DofKind::Translation => next - round_off * size() <= tol_x,
                 DofKind::Rotation => next <= tol_theta,
-                DofKind::Extra => true,
+                DofKind::Coordinate { length } => (next - round_off * size()) * length <= tol_x,
+                DofKind::Multiplier(kind) => {
+                    let flux = match kind {
+                        ConstraintKind::Distance => norms.flux_force,
+                        ConstraintKind::Angle => norms.flux_moment,
+                    };
+                    let k = self.scaling.of(kind).0;
+                    (next - round_off * size()) * k <= settings.residual_tolerance * flux
+                }
             }
         })
     }
@@ -657,7 +737,7 @@ impl NewtonSolver {
         if !std::mem::take(&mut self.fresh) {
             self.assemble(model, state, time, true);
         }
-        self.round_off_floor(model, state);
+        self.round_off_floor(state);
         let motion = self.motion();
         // before the first correction D = 0: constraints are reported
         // against the previous increment's translation
@@ -701,7 +781,7 @@ impl NewtonSolver {
                 };
                 let converged = norms.relative_residual <= tol
                     && norms.residual_constraint <= 1.0
-                    && self.correction_converged(state, settings, ratio, motion);
+                    && self.correction_converged(state, settings, ratio, motion, &norms);
                 // or at the round-off plateau: stopped decreasing, within
                 // PLATEAU_FACTOR of round-off
                 let plateau = || {
@@ -822,7 +902,7 @@ impl NewtonSolver {
             // update: x ← x + Δx, R ← R exp(ΔΘ~), extras additively, then
             // the positions brought in line with the rotations (§7.2)
             let before = self.translation_residual();
-            self.update(model, state);
+            self.update(state);
             if dth > 0.0 {
                 self.translation_correction(model, state, time, before, true);
             }
@@ -838,8 +918,8 @@ impl NewtonSolver {
     /// Each node continues its last relative motion on the group, in its
     /// material frame: `g_pred = g_n (g_{n−1}⁻¹ g_n)^s`, i.e.
     /// `R_pred = R_n exp(s ψ)`, `x_pred = x_n + R_n Tᵀ(sψ) s T⁻ᵀ(ψ) b` with
-    /// `ψ = log(R_{n−1}ᵀ R_n)`, `b = R_{n−1}ᵀ (x_n − x_{n−1})`; extra
-    /// unknowns are extrapolated linearly. A rigid motion of an element is
+    /// `ψ = log(R_{n−1}ᵀ R_n)`, `b = R_{n−1}ᵀ (x_n − x_{n−1})`;
+    /// coordinates and multipliers are extrapolated linearly. A rigid motion of an element is
     /// continued exactly, so its length does not change (a linear
     /// extrapolation of positions would stretch every turning element by
     /// the square of its rotation).
@@ -887,13 +967,19 @@ impl NewtonSolver {
                 turn = turn.max(psi_s.norm());
             }
         }
-        let n_nodes = model.n_nodes();
-        for (k, v) in state.extra.iter_mut().enumerate() {
-            let eq = self.dofs.equation(6 * n_nodes + k);
-            if eq != NO_EQUATION {
-                let delta = scale * (*v - previous.extra[k]);
-                *v += delta;
-                self.step[eq] = delta;
+        let (first_c, first_m) = (self.dofs.first_coordinate(), self.dofs.first_multiplier());
+        let extras = [
+            (first_c, &mut state.coordinates, &previous.coordinates),
+            (first_m, &mut state.multipliers, &previous.multipliers),
+        ];
+        for (first, values, before) in extras {
+            for (k, v) in values.iter_mut().enumerate() {
+                let eq = self.dofs.equation(first + k);
+                if eq != NO_EQUATION {
+                    let delta = scale * (*v - before[k]);
+                    *v += delta;
+                    self.step[eq] = delta;
+                }
             }
         }
         if turn > PREDICTOR_TURN {
@@ -928,7 +1014,7 @@ impl NewtonSolver {
         }
         self.assemble(model, state, time, true);
         self.fresh = true;
-        self.round_off_floor(model, state);
+        self.round_off_floor(state);
         let floor = FLOOR_FACTOR * self.translation_norm(&self.floor);
         let flux = self.translation_norm_dofs(&self.assembler.flux);
         let r = self.translation_residual();
@@ -943,7 +1029,7 @@ impl NewtonSolver {
             Err(_) => f64::INFINITY,
         };
         if dx <= RUNAWAY_CORRECTION * self.free_size {
-            self.update(model, state);
+            self.update(state);
             self.translation_count += 1;
             if add {
                 for (r, w) in self.rhs.iter_mut().zip(&self.work) {
@@ -957,7 +1043,8 @@ impl NewtonSolver {
     }
 
     /// Weights of the arc-length norm, by equation (docs/theory.md §9):
-    /// `w_x` for translations, 1 for rotations, 0 for extra unknowns, with
+    /// `w_x` for translations (times their length for coordinates), 1 for
+    /// rotations, 0 for multipliers, with
     /// `w_x = ‖q_t,θ‖/‖q_t,x‖` from the first tangent predictor (set by
     /// [`NewtonSolver::tangent_arc`]; 1 before it or if either part is
     /// zero), so that translations and rotations weigh alike in the first
@@ -965,10 +1052,11 @@ impl NewtonSolver {
     /// stiffness of its parts.
     fn arc_weights(&self) -> Vec<f64> {
         (0..self.dofs.n_equations())
-            .map(|eq| match self.dofs.kind(self.dofs.dof(eq)) {
+            .map(|eq| match self.dofs.equation_kind(eq) {
                 DofKind::Translation => self.translation_weight,
                 DofKind::Rotation => 1.0,
-                DofKind::Extra => 0.0,
+                DofKind::Coordinate { length } => self.translation_weight * length,
+                DofKind::Multiplier(_) => 0.0,
             })
             .collect()
     }
@@ -987,7 +1075,7 @@ impl NewtonSolver {
     ) {
         let h = 1e-7 * t.abs().max(1.0);
         r0.clone_from(&self.assembler.residual);
-        let ctx = model.context(t + h, false);
+        let ctx = model.context(t + h, Need::RESIDUAL);
         self.assembler.assemble(model, &ctx, state);
         for (eq, o) in out.iter_mut().enumerate() {
             let d = self.dofs.dof(eq);
@@ -1013,10 +1101,10 @@ impl NewtonSolver {
         // translations weighted to balance rotations in this predictor
         let (mut nx, mut nth) = (0.0f64, 0.0f64);
         for (eq, v) in self.rhs.iter().enumerate() {
-            match self.dofs.kind(self.dofs.dof(eq)) {
+            match self.dofs.equation_kind(eq) {
                 DofKind::Translation => nx += v * v,
                 DofKind::Rotation => nth += v * v,
-                DofKind::Extra => {}
+                DofKind::Coordinate { .. } | DofKind::Multiplier(_) => {}
             }
         }
         self.translation_weight = if ok && nx > 0.0 && nth > 0.0 && (nth / nx).is_finite() {
@@ -1191,7 +1279,7 @@ impl NewtonSolver {
                 return Err(self.diagnose(model, state, *t, iteration));
             }
             state.time = *t;
-            self.update(model, state);
+            self.update(state);
             progress.last_correction = Some((dx, dth));
         }
         unreachable!("the loop returns at max_iterations")
@@ -1214,8 +1302,28 @@ impl NewtonSolver {
         }
         self.analyze()?;
         let lu = self.lu.as_mut().expect("analysed above");
+        self.newton_sign = None;
         lu.factor(&self.assembler.matrix)?;
+        if lu.kernel() == LuKernel::Simplicial {
+            // read off the factors: a pass over them, no more
+            self.newton_sign = self.determinant.of(lu, &self.assembler.matrix);
+        }
         lu.solve_in_place(&mut self.rhs)
+    }
+
+    /// Sign of the determinant of the tangent after a converged solve
+    /// (docs/theory.md §9): that of the last Newton system factored (at
+    /// the last iterate but one, within the tolerances of the converged
+    /// state) with the simplicial kernel; with the supernodal kernel, that
+    /// of the tangent assembled at the converged state, factored once more
+    /// by the simplicial kernel, below 5,000 unknowns only (`None` above:
+    /// [`DeterminantSign`]).
+    pub fn tangent_sign(&mut self) -> Option<f64> {
+        let lu = self.lu.as_ref()?;
+        match lu.kernel() {
+            LuKernel::Simplicial => self.newton_sign,
+            LuKernel::Supernodal => self.determinant.of(lu, &self.assembler.matrix),
+        }
     }
 
     /// `‖r‖₂` over the free translation equations of the last assembly.
@@ -1253,18 +1361,10 @@ impl NewtonSolver {
     /// and multipliers of constraints on angles (whose gradients lie in the
     /// rotations).
     fn held(&self, eq: usize) -> bool {
-        let d = self.dofs.dof(eq);
-        match self.dofs.kind(d) {
-            DofKind::Translation => false,
-            DofKind::Rotation => true,
-            DofKind::Extra => {
-                let first_extra = self.dofs.n_dofs() - self.extra_kinds.len();
-                matches!(
-                    self.extra_kinds[d - first_extra],
-                    ExtraKind::Multiplier { angular: true, .. }
-                )
-            }
-        }
+        matches!(
+            self.dofs.equation_kind(eq),
+            DofKind::Rotation | DofKind::Multiplier(ConstraintKind::Angle)
+        )
     }
 
     /// Translation iteration (docs/theory.md §7.2): solves the last
@@ -1339,41 +1439,14 @@ impl NewtonSolver {
         }
     }
 
-    /// Applies the correction in `self.rhs` to `state`
-    /// and adds it to the increment's sum `self.step`.
-    fn update(&mut self, model: &Model, state: &mut State) {
+    /// Applies the correction in `self.rhs` to `state` (the update rule
+    /// of [`State::update`]) and adds it to the increment's sum
+    /// `self.step`.
+    fn update(&mut self, state: &mut State) {
         for (s, d) in self.step.iter_mut().zip(&self.rhs) {
             *s += d;
         }
-        let n_nodes = model.n_nodes();
-        for node in 0..n_nodes {
-            let mut dx = Vec3::zeros();
-            let mut dth = Vec3::zeros();
-            let mut any_rotation = false;
-            for c in 0..6 {
-                let eq = self.dofs.equation(6 * node + c);
-                if eq == NO_EQUATION {
-                    continue;
-                }
-                if c < 3 {
-                    dx[c] = self.rhs[eq];
-                } else {
-                    dth[c - 3] = self.rhs[eq];
-                    any_rotation = true;
-                }
-            }
-            state.x[node] += dx;
-            if any_rotation {
-                state.q[node] *= so3::exp(&dth);
-                state.q[node].renormalize_fast();
-            }
-        }
-        for (k, v) in state.extra.iter_mut().enumerate() {
-            let eq = self.dofs.equation(6 * n_nodes + k);
-            if eq != NO_EQUATION {
-                *v += self.rhs[eq];
-            }
-        }
+        state.update(&self.dofs, &self.rhs);
     }
 }
 
@@ -1390,7 +1463,9 @@ struct Progress {
     first_work: Option<f64>,
 }
 
-/// `(max|Δx|, max|ΔΘ|)` of a correction.
+/// `(max|Δx|, max|ΔΘ|)` of a correction, coordinates counted as the
+/// displacements they make (times their length); multipliers (forces) are
+/// not motions.
 fn correction_size(dofs: &DofMap, delta: &[f64]) -> (f64, f64) {
     let (mut dx, mut dth) = (0.0f64, 0.0f64);
     for (eq, &d) in delta.iter().enumerate() {
@@ -1399,13 +1474,26 @@ fn correction_size(dofs: &DofMap, delta: &[f64]) -> (f64, f64) {
         } else {
             f64::INFINITY
         };
-        match dofs.kind(dofs.dof(eq)) {
+        match dofs.equation_kind(eq) {
             DofKind::Translation => dx = dx.max(a),
             DofKind::Rotation => dth = dth.max(a),
-            DofKind::Extra => {}
+            DofKind::Coordinate { length } => dx = dx.max(a * length),
+            DofKind::Multiplier(_) => {}
         }
     }
     (dx, dth)
+}
+
+/// `sⱼ`, the size of the value of unknown `dof` (docs/theory.md §7.1):
+/// `|x| + ℓ` for a translation, 1 rad for a rotation, the magnitude of a
+/// coordinate or multiplier.
+fn unknown_size(dofs: &DofMap, node_lengths: &[f64], state: &State, dof: usize) -> f64 {
+    match dofs.kind(dof) {
+        DofKind::Translation => state.x[dof / 6].norm() + node_lengths[dof / 6],
+        DofKind::Rotation => 1.0,
+        DofKind::Coordinate { .. } => state.coordinates[dof - dofs.first_coordinate()].abs(),
+        DofKind::Multiplier(_) => state.multipliers[dof - dofs.first_multiplier()].abs(),
+    }
 }
 
 /// `ℓₙ` of every node: the largest reference distance to another node of
@@ -1444,7 +1532,8 @@ fn free_size(model: &Model, dofs: &DofMap) -> f64 {
 }
 
 /// Where non-finite values come from at `state` and `time`: a curve, the
-/// gravity, a node's position or orientation, an extra unknown, or the
+/// gravity, a node's position or orientation, a coordinate or multiplier,
+/// or the
 /// first element whose residual or tangent is not finite, each element
 /// evaluated again on its own.
 pub(crate) fn non_finite_origin(model: &Model, state: &State, time: f64) -> String {
@@ -1462,7 +1551,7 @@ pub(crate) fn non_finite_origin(model: &Model, state: &State, time: f64) -> Stri
             return format!("in the position of node {}", model.node_ids[node]);
         }
     }
-    let ctx = model.context(time, true);
+    let ctx = model.context(time, Need::STIFFNESS);
     let (mut residual, mut tangent) = (Vec::new(), Vec::new());
     for e in &model.elements {
         let n = e.n_local();
@@ -1473,10 +1562,7 @@ pub(crate) fn non_finite_origin(model: &Model, state: &State, time: f64) -> Stri
         e.evaluate(
             &ctx,
             state,
-            &mut crate::elements::ElementOutput {
-                residual: &mut residual,
-                tangent: &mut tangent,
-            },
+            &mut ElementOutput::with_stiffness(&mut residual, &mut tangent),
         );
         let what = if !residual.iter().all(|v| v.is_finite()) {
             "residual"
@@ -1487,12 +1573,14 @@ pub(crate) fn non_finite_origin(model: &Model, state: &State, time: f64) -> Stri
         };
         return format!("in the {what} of {} {}", e.kind().name(), e.id());
     }
-    if let Some(mut k) = state.extra.iter().position(|v| !v.is_finite()) {
-        for e in &model.elements {
-            if k < e.n_extra() {
-                return format!("in unknown {} of {} {}", k + 1, e.kind().name(), e.id());
-            }
-            k -= e.n_extra();
+    for (i, e) in model.elements.iter().enumerate() {
+        let o = model.offsets(i);
+        let (nc, nm) = (e.n_coordinates(), e.n_multipliers());
+        let mut values = state.coordinates[o.coordinates..o.coordinates + nc]
+            .iter()
+            .chain(&state.multipliers[o.multipliers..o.multipliers + nm]);
+        if let Some(k) = values.position(|v| !v.is_finite()) {
+            return format!("in unknown {} of {} {}", k + 1, e.kind().name(), e.id());
         }
     }
     "in the assembled system".into()

@@ -5,7 +5,12 @@
 //! 1. The rank of the constraints at the reference configuration
 //!    (docs/joints.md §5): redundant constraint equations are counted, and
 //!    a kinematic analysis whose joints and drivers leave motions free is
-//!    rejected ([`StaticError::Indeterminate`]).
+//!    rejected ([`StaticError::Indeterminate`]). A redundant equation of a
+//!    driver is warned about: the driver either repeats what the joints
+//!    and the other drivers impose (two drivers turning one axle through
+//!    two hinges by the same angle) or contradicts it (an over-driven
+//!    mechanism), which only the first increment tells: the analysis then
+//!    stops ([`StaticError::Inconsistent`]).
 //! 2. The initial stiffness: the tangent at `t = 0` is factored and solved
 //!    for a probe load that acts on every unknown (the analysis's first
 //!    correction acts only along the loads of `t = 0`, so a run with no
@@ -18,10 +23,12 @@
 //! Equilibrium itself is not sought: that is the analysis.
 
 use super::newton::{NewtonFailure, NewtonSolver};
+use super::settings::StaticSettings;
 use super::statics::StaticError;
 use crate::dofs::DofKind;
+use crate::elements::ElementKind;
 use crate::linalg::{smallest_relative_pivot, SparseLu};
-use crate::model::Model;
+use crate::model::{Model, ModelWarning};
 
 // the Newton solver's thresholds: a check reports what a run would
 use super::newton::{non_finite_origin, RUNAWAY_CORRECTION, SINGULAR_PIVOT};
@@ -37,48 +44,68 @@ pub struct Preflight {
     /// Motions the constraints leave free (to springs and beams in
     /// statics; none in a kinematic analysis).
     pub free_motions: usize,
+    /// Input that is valid but probably not meant: a driver equation among
+    /// the redundant ones.
+    pub warnings: Vec<ModelWarning>,
 }
 
-/// Runs the checks of the module documentation on `model`.
-pub fn check(model: &Model) -> Result<Preflight, StaticError> {
+/// Runs the checks of the module documentation on `model`, for the first
+/// analysis of a run, with `settings`.
+pub fn check(model: &Model, settings: &StaticSettings) -> Result<Preflight, StaticError> {
     let mut solver = NewtonSolver::new(model);
     let unknowns = solver.dofs.n_equations();
     let mut state = model.initial_state();
     model.apply_prescribed(&mut state, 0.0);
 
-    // rank of the constraints, as StaticAnalysis::run
-    let rank = solver.constraint_rank(model, &state);
+    // rank of the constraints, as StaticAnalysis::start
+    let rank = solver.constraint_rank(model, &state, 0.0);
     let free = rank.degrees_of_freedom();
-    if model.settings.kinematic && free > 0 {
-        let dofs: Vec<String> = rank
-            .freedom
-            .iter()
-            .take(free.min(6))
-            .map(|&(d, _)| solver.dof_label(model, d))
-            .collect();
-        return Err(StaticError::Indeterminate {
-            free,
-            dofs: dofs.join(", "),
-        });
+    if settings.kinematic && free > 0 {
+        return Err(solver.indeterminate(model, &rank));
     }
 
     // residual and tangent at t = 0, then the tangent's response to a
     // probe load
     solver.assemble(model, &state, 0.0, true);
     if solver.residual().iter().any(|r| !r.is_finite()) {
-        return Err(StaticError::Initial(NewtonFailure::NonFinite {
-            iteration: 0,
-            origin: non_finite_origin(model, &state, 0.0),
-        }));
+        return Err(StaticError::Initial {
+            time: 0.0,
+            failure: NewtonFailure::NonFinite {
+                iteration: 0,
+                origin: non_finite_origin(model, &state, 0.0),
+            },
+        });
     }
     if let Some(failure) = singular_direction(model, &solver) {
-        return Err(StaticError::Initial(failure));
+        return Err(StaticError::Initial { time: 0.0, failure });
     }
     Ok(Preflight {
         unknowns,
         redundant_constraints: rank.redundant.len(),
         free_motions: free,
+        warnings: redundant_drivers(model, &rank.redundant),
     })
+}
+
+/// A warning for each redundant equation (`redundant`: indices among the
+/// multipliers) that belongs to a driver.
+fn redundant_drivers(model: &Model, redundant: &[usize]) -> Vec<ModelWarning> {
+    let mut warnings = Vec::new();
+    for (k, e) in model.elements.iter().enumerate() {
+        let (offset, n) = (model.offsets(k).multipliers, e.n_multipliers());
+        if e.kind() == ElementKind::Driver {
+            for &k in redundant.iter().filter(|&&k| k >= offset && k < offset + n) {
+                warnings.push(ModelWarning {
+                    entity: format!("driver {}", e.id()),
+                    message: format!(
+                        "equation {} is redundant with the joints and the other drivers at t = 0: the driver repeats or contradicts what they impose (an over-driven mechanism); if it contradicts them the run stops at its first increment (\"inconsistent constraints\"): remove the driver or free the motion it drives",
+                        k - offset + 1
+                    ),
+                });
+            }
+        }
+    }
+    warnings
 }
 
 /// Solves `K Δq = b` for a probe load `b` with every component of the size
@@ -95,15 +122,13 @@ fn singular_direction(model: &Model, solver: &NewtonSolver) -> Option<NewtonFail
         return None;
     }
     let length = model.length_scale;
-    let kinds: Vec<DofKind> = (0..n)
-        .map(|eq| solver.dofs.kind(solver.dofs.dof(eq)))
-        .collect();
+    let kinds: Vec<DofKind> = (0..n).map(|eq| solver.dofs.equation_kind(eq)).collect();
     let mut probe: Vec<f64> = (0..n)
         .map(|eq| {
             let size = match kinds[eq] {
                 DofKind::Translation => length,
                 DofKind::Rotation => 1.0,
-                DofKind::Extra => return 0.0,
+                DofKind::Coordinate { .. } | DofKind::Multiplier(_) => return 0.0,
             };
             let d = k.position(eq, eq).map_or(0.0, |p| k.values()[p].abs());
             let d = if d > 0.0 {
@@ -128,7 +153,7 @@ fn singular_direction(model: &Model, solver: &NewtonSolver) -> Option<NewtonFail
         || probe.iter().zip(&kinds).any(|(&dq, kind)| match kind {
             DofKind::Translation => !within(dq, RUNAWAY_CORRECTION * length),
             DofKind::Rotation => !within(dq, RUNAWAY_CORRECTION),
-            DofKind::Extra => false,
+            DofKind::Coordinate { .. } | DofKind::Multiplier(_) => false,
         });
     if !runaway {
         return None;

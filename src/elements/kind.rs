@@ -25,8 +25,12 @@ pub enum ElementKind {
     Joint,
     /// Spring or damper on a joint coordinate.
     JointSpring,
+    /// Hysteretic moment law on a joint coordinate (hinge law with memory).
+    HingeLaw,
     /// Prescribed history of a joint coordinate or node component.
     Driver,
+    /// Lock of a joint coordinate at the end of its travel.
+    Latch,
 }
 
 /// A cell data array of the VTK files filled from an element's results:
@@ -54,7 +58,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 9] = [
+    pub const ALL: [ElementKind; 11] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -63,7 +67,9 @@ impl ElementKind {
         Self::Constraint,
         Self::Joint,
         Self::JointSpring,
+        Self::HingeLaw,
         Self::Driver,
+        Self::Latch,
     ];
 
     /// Lower-case name used in messages and output file names.
@@ -77,7 +83,9 @@ impl ElementKind {
             Self::Constraint => "constraint",
             Self::Joint => "joint",
             Self::JointSpring => "joint spring",
+            Self::HingeLaw => "hinge law",
             Self::Driver => "driver",
+            Self::Latch => "latch",
         }
     }
 
@@ -93,6 +101,8 @@ impl ElementKind {
             Self::Joint => 7,
             Self::JointSpring => 8,
             Self::Driver => 9,
+            Self::HingeLaw => 10,
+            Self::Latch => 11,
         }
     }
 
@@ -106,6 +116,8 @@ impl ElementKind {
             Self::Joint => Some("joints.csv"),
             Self::Driver => Some("drivers.csv"),
             Self::JointSpring => Some("joint_springs.csv"),
+            Self::HingeLaw => Some("hinge_laws.csv"),
+            Self::Latch => Some("latches.csv"),
             Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
     }
@@ -115,6 +127,7 @@ impl ElementKind {
         match self {
             Self::Joint => "joint",
             Self::Driver => "driver",
+            Self::Latch => "latch",
             _ => "element",
         }
     }

@@ -85,16 +85,16 @@ impl Element for NodalLoad {
             // L2
             add_vec(out.residual, 0, &(-(r * f)));
             add_vec(out.residual, 3, &(-m));
-            if ctx.need_tangent {
-                add_block(out.tangent, 6, 0, 3, &(r * skew(&f)));
+            if let Some(tangent) = out.stiffness.as_deref_mut() {
+                add_block(tangent, 6, 0, 3, &(r * skew(&f)));
             }
         } else {
             // L1
             let m_mat = r.transpose() * m;
             add_vec(out.residual, 0, &(-f));
             add_vec(out.residual, 3, &(-m_mat));
-            if ctx.need_tangent {
-                add_block(out.tangent, 6, 3, 3, &(-skew(&m_mat)));
+            if let Some(tangent) = out.stiffness.as_deref_mut() {
+                add_block(tangent, 6, 3, 3, &(-skew(&m_mat)));
             }
         }
     }
@@ -123,18 +123,15 @@ mod tests {
                 time: 0.7,
                 curves: &curves,
                 gravity: Vec3::zeros(),
-                need_tangent: true,
-                dynamics: None,
+                need: crate::elements::Need::STIFFNESS,
+                dynamics: false,
                 scaling: Default::default(),
             };
-            let state = State {
-                time: 0.7,
-                x: vec![Vec3::new(0.3, 0.1, 0.2)],
-                q: vec![so3::exp(&Vec3::new(r.0, r.1, r.2))],
-                extra: vec![],
-                internal: vec![],
-                velocity: vec![],
-            };
+            let state = State::at_rest(
+                0.7,
+                vec![Vec3::new(0.3, 0.1, 0.2)],
+                vec![so3::exp(&Vec3::new(r.0, r.1, r.2))],
+            );
             for follower in [false, true] {
                 let l = NodalLoad::new(1, 0, Vec3::new(f.0, f.1, f.2), Vec3::new(m.0, m.1, m.2), follower, 0);
                 prop_assert!(tangent_error(&l, &ctx, &state, 1e-6) < 1e-6, "follower = {}", follower);

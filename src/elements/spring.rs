@@ -146,6 +146,27 @@ impl Element for Spring {
         ElementKind::Spring
     }
 
+    /// A rotational spring whose relative rotation passes half a turn:
+    /// `ψ = log(…)` jumps there from `π u` to `−π u`, and with it the
+    /// moment `K ψ`, which then turns the spring the wrong way (S2 holds
+    /// below π). Between two converged states the relative rotation
+    /// changes by less than half a turn, so a jump of `ψ` by more than π
+    /// is that crossing.
+    fn law_violated(&self, before: &State, after: &State) -> Option<String> {
+        if self.kind != SpringKind::Rotational {
+            return None;
+        }
+        let (_, a) = self.relative_rotation(before);
+        let (_, b) = self.relative_rotation(after);
+        ((b - a).norm() > std::f64::consts::PI).then(|| {
+            format!(
+                "its relative rotation passed half a turn (from {:.4} to {:.4} rad, measured the other way round): a rotational spring's law m = K ψ holds below half a turn only (docs/theory.md §5), beyond it the moment would turn the spring the wrong way; use a joint spring on a revolute joint, whose angle may go any number of turns",
+                a.norm(),
+                b.norm()
+            )
+        })
+    }
+
     fn id(&self) -> Id {
         self.id
     }
@@ -154,7 +175,7 @@ impl Element for Spring {
         &self.nodes
     }
 
-    fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
+    fn evaluate(&self, _ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         let n = self.n_local();
         let b = self.b();
         let grounded = self.grounded();
@@ -166,13 +187,13 @@ impl Element for Spring {
                 if !grounded {
                     add_vec(out.residual, 0, &(-f));
                 }
-                if ctx.need_tangent {
+                if let Some(tangent) = out.stiffness.as_deref_mut() {
                     let k = Mat3::from_diagonal(&self.k);
-                    add_block(out.tangent, n, b, b, &k);
+                    add_block(tangent, n, b, b, &k);
                     if !grounded {
-                        add_block(out.tangent, n, 0, 0, &k);
-                        add_block(out.tangent, n, 0, b, &(-k));
-                        add_block(out.tangent, n, b, 0, &(-k));
+                        add_block(tangent, n, 0, 0, &k);
+                        add_block(tangent, n, 0, b, &(-k));
+                        add_block(tangent, n, b, 0, &(-k));
                     }
                 }
             }
@@ -188,18 +209,18 @@ impl Element for Spring {
                 if !grounded {
                     add_vec(out.residual, ra, &(-ti.apply(&m)));
                 }
-                if ctx.need_tangent {
+                if let Some(tangent) = out.stiffness.as_deref_mut() {
                     // ∂(rows)/∂ψ, then ∂ψ/∂Θ_b = T⁻¹ C₀, ∂ψ/∂Θ_a = −T⁻ᵀ
                     let gb = c0.transpose()
                         * (ti.derivative_of_apply_transpose(&m) + ti_m.transpose() * kmat);
                     let dpsi_b = ti_m * c0;
-                    add_block(out.tangent, n, rb, rb, &(gb * dpsi_b));
+                    add_block(tangent, n, rb, rb, &(gb * dpsi_b));
                     if !grounded {
                         let ga = -(ti.derivative_of_apply(&m) + ti_m * kmat);
                         let dpsi_a = -ti_m.transpose();
-                        add_block(out.tangent, n, rb, ra, &(gb * dpsi_a));
-                        add_block(out.tangent, n, ra, rb, &(ga * dpsi_b));
-                        add_block(out.tangent, n, ra, ra, &(ga * dpsi_a));
+                        add_block(tangent, n, rb, ra, &(gb * dpsi_a));
+                        add_block(tangent, n, ra, rb, &(ga * dpsi_b));
+                        add_block(tangent, n, ra, ra, &(ga * dpsi_a));
                     }
                 }
             }
@@ -213,13 +234,13 @@ impl Element for Spring {
                 let f = e * (k * (l - self.l0));
                 add_vec(out.residual, 6, &f);
                 add_vec(out.residual, 0, &(-f));
-                if ctx.need_tangent {
+                if let Some(tangent) = out.stiffness.as_deref_mut() {
                     let ee = e * e.transpose();
                     let kt = ee * k + (Mat3::identity() - ee) * (k * (l - self.l0) / l);
-                    add_block(out.tangent, n, 6, 6, &kt);
-                    add_block(out.tangent, n, 0, 0, &kt);
-                    add_block(out.tangent, n, 0, 6, &(-kt));
-                    add_block(out.tangent, n, 6, 0, &(-kt));
+                    add_block(tangent, n, 6, 6, &kt);
+                    add_block(tangent, n, 0, 0, &kt);
+                    add_block(tangent, n, 0, 6, &(-kt));
+                    add_block(tangent, n, 6, 0, &(-kt));
                 }
             }
         }
@@ -262,21 +283,14 @@ mod tests {
             time: 1.0,
             curves: &[],
             gravity: Vec3::zeros(),
-            need_tangent: true,
-            dynamics: None,
+            need: crate::elements::Need::STIFFNESS,
+            dynamics: false,
             scaling: Default::default(),
         }
     }
 
     fn state(x: &[Vec3], q: &[Rotation]) -> State {
-        State {
-            time: 0.0,
-            x: x.to_vec(),
-            q: q.to_vec(),
-            extra: vec![],
-            internal: vec![],
-            velocity: vec![],
-        }
+        State::at_rest(0.0, x.to_vec(), q.to_vec())
     }
 
     fn vec3(max: f64) -> impl Strategy<Value = Vec3> {

@@ -1,5 +1,7 @@
 //! Input and output: model files in, results out.
 //!
+//! - [`modes`]: the result files of modal analyses (`modes.csv`,
+//!   `mode_shapes.csv`, a grid per mode and `modes.pvd`);
 //! - [`model_file`]: reads a TOML model file into a validated model, with
 //!   errors that name the file, the entity and the problem;
 //! - [`results`]: writes per-step CSV histories, `summary.json`, and VTK
@@ -7,12 +9,16 @@
 //! - [`run`]: the record of a whole run (results, `log.txt`, summary,
 //!   stopping on a signal), shared by the command-line tool and the
 //!   programs that use the library;
+//! - [`restart`]: restart files, the state of a run from which a later
+//!   run continues;
 //! - [`vtk`]: the VTK unstructured-grid (`.vtu`) and collection (`.pvd`)
 //!   writers;
 //! - [`plot`]: line charts of result histories, as SVG and PNG files.
 
 pub mod model_file;
+pub mod modes;
 pub mod plot;
+pub mod restart;
 pub mod results;
 pub mod run;
 pub mod vtk;

@@ -8,6 +8,11 @@
 //!   the element's [`crate::elements::Element::result_names`];
 //! - `steps.csv`: one line per output step (increment, load parameter,
 //!   iterations, final relative residual);
+//! - in a run with a dynamic analysis: `nodes_velocities.csv` (velocity,
+//!   angular velocity and their rates of every node at every output step),
+//!   `energies.csv` (the energy balance at the output steps of dynamic
+//!   analyses), the rates of the joint coordinates in `joints.csv`, and the
+//!   velocities in the grids;
 //! - `vtk/step_NNNNN.vtu` and `unfold.pvd`: the configurations for ParaView;
 //! - `summary.json`: size of the model, counts, wall time and status.
 //!
@@ -35,8 +40,11 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::vtk;
-use crate::analysis::{IncrementInfo, Observer, StaticAnalysis, StaticOutcome};
-use crate::elements::ElementKind;
+use crate::analysis::{
+    AnalysisSettings, DynamicOutcome, Energies, IncrementInfo, Observer, StaticAnalysis,
+    StaticOutcome,
+};
+use crate::elements::{ElementKind, Need};
 use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -44,10 +52,12 @@ use crate::state::State;
 /// Result files in the output directory that unfold writes besides the
 /// tables of the element kinds ([`ElementKind::results_file`]) and the
 /// grids `vtk/step_NNNNN.vtu`.
-const RUN_FILES: [&str; 6] = [
+const RUN_FILES: [&str; 8] = [
     "log.txt",
     "steps.csv",
     "nodes.csv",
+    "nodes_velocities.csv",
+    "energies.csv",
     "reactions.csv",
     "unfold.pvd",
     "summary.json",
@@ -86,6 +96,140 @@ pub struct IncrementRecord {
     pub iterations: usize,
     /// Relative residual at each iteration.
     pub residuals: Vec<f64>,
+}
+
+/// What one analysis of a run did, for `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct AnalysisRecord {
+    /// Analysis type (`static`, `kinematic`).
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// `t` it started from.
+    pub start_time: f64,
+    /// Its requested end.
+    pub end_time: f64,
+    /// `t` it reached.
+    pub final_time: f64,
+    /// Converged increments after its initial equilibrium.
+    pub increments: usize,
+    /// Newton iterations of its converged increments.
+    pub iterations: usize,
+    /// Its cut-backs.
+    pub cutbacks: usize,
+    /// Whether it stopped early (the analyses after it were not run).
+    pub failed: bool,
+    /// Its wall-clock time, seconds.
+    pub wall_time_s: f64,
+    /// What a dynamic analysis did besides (absent for the others).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dynamic: Option<DynamicRecord>,
+}
+
+/// The time steps and the energy balance of a dynamic analysis, for
+/// `summary.json`.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct DynamicRecord {
+    /// Accepted time steps.
+    pub steps: usize,
+    /// Steps rejected: cut back after Newton failed, or rejected by the
+    /// local error estimate.
+    pub rejected_steps: usize,
+    /// Of which rejected by the error estimate.
+    pub error_rejections: usize,
+    /// Newton iterations of the accepted steps.
+    pub newton_iterations: usize,
+    /// Newton iterations of the rejected steps.
+    pub wasted_iterations: usize,
+    /// Wall-clock time, seconds.
+    pub wall_time_s: f64,
+    /// Energy balance error `(T + V) − (T₀ + V₀) − W + D` at the last
+    /// converged step (docs/results.md, `energies.csv`).
+    pub energy_balance_error: f64,
+    /// Largest absolute balance error over the steps.
+    pub largest_energy_balance_error: f64,
+    /// Largest kinetic energy over the steps: the scale of the errors.
+    pub largest_kinetic_energy: f64,
+}
+
+impl DynamicRecord {
+    /// The record of `outcome`, with the largest balance error and kinetic
+    /// energy seen over its steps.
+    pub fn of(outcome: &DynamicOutcome, largest_error: f64, largest_kinetic: f64) -> Self {
+        Self {
+            steps: outcome.steps,
+            rejected_steps: outcome.rejected_steps,
+            error_rejections: outcome.error_rejections,
+            newton_iterations: outcome.iterations,
+            wasted_iterations: outcome.wasted_iterations,
+            wall_time_s: outcome.wall_time,
+            energy_balance_error: outcome.energies.balance_error,
+            largest_energy_balance_error: largest_error.max(outcome.energies.balance_error.abs()),
+            largest_kinetic_energy: largest_kinetic.max(outcome.energies.kinetic),
+        }
+    }
+}
+
+/// What one analysis of a run did, whatever its type: the counts that the
+/// summary adds up.
+#[derive(Clone, Debug, Default)]
+pub struct AnalysisEnd {
+    /// `t` reached.
+    pub time: f64,
+    /// Converged increments or time steps (after the start).
+    pub increments: usize,
+    /// Newton iterations of the converged ones.
+    pub iterations: usize,
+    /// Newton iterations of those cut back or rejected.
+    pub wasted_iterations: usize,
+    /// Cut-backs after Newton failed.
+    pub cutbacks: usize,
+    /// Constraint equations removed as redundant.
+    pub redundant_constraints: usize,
+    /// Wall-clock time, seconds.
+    pub wall_time: f64,
+    /// Why it stopped early, if it did.
+    pub error: Option<String>,
+    /// Whether it stopped on request (a signal).
+    pub interrupted: Option<super::run::Interrupted>,
+    /// The dynamic analysis's record.
+    pub dynamic: Option<DynamicRecord>,
+}
+
+impl From<&StaticOutcome> for AnalysisEnd {
+    fn from(o: &StaticOutcome) -> Self {
+        Self {
+            time: o.time,
+            increments: o.increments,
+            iterations: o.iterations,
+            wasted_iterations: o.wasted_iterations,
+            cutbacks: o.cutbacks,
+            redundant_constraints: o.redundant_constraints,
+            wall_time: o.wall_time,
+            error: o.error.as_ref().map(|e| e.to_string()),
+            interrupted: o.error.as_ref().and_then(super::run::Interrupted::of),
+            dynamic: None,
+        }
+    }
+}
+
+impl From<&DynamicOutcome> for AnalysisEnd {
+    fn from(o: &DynamicOutcome) -> Self {
+        Self {
+            time: o.time,
+            increments: o.steps,
+            iterations: o.iterations,
+            wasted_iterations: o.wasted_iterations,
+            cutbacks: o.cutbacks,
+            redundant_constraints: o.redundant_constraints,
+            wall_time: o.wall_time,
+            error: o.error.as_ref().map(|e| e.to_string()),
+            interrupted: o
+                .error
+                .as_ref()
+                .and_then(super::run::Interrupted::of_dynamic),
+            dynamic: Some(DynamicRecord::of(o, 0.0, 0.0)),
+        }
+    }
 }
 
 /// Where a run stands, as written in `summary.json`.
@@ -141,9 +285,11 @@ pub struct Summary {
     pub drivers: usize,
     /// Constraint equations removed as redundant.
     pub redundant_constraints: usize,
-    /// Free unknowns (equations).
+    /// Equations solved: free unknowns, after the redundant constraint
+    /// equations were removed (before the run starts: all of them).
     pub dofs: usize,
-    /// Non-zeros of the system matrix.
+    /// Non-zeros of the system matrix as first assembled (redundant
+    /// constraint equations included).
     pub nonzeros: usize,
     /// Converged increments after the initial equilibrium.
     pub increments: usize,
@@ -163,14 +309,58 @@ pub struct Summary {
     pub wall_time_s: f64,
     /// Output steps written.
     pub output_steps: usize,
+    /// Each analysis of the run, in order (one unless the model file asks
+    /// for a sequence).
+    pub analyses: Vec<AnalysisRecord>,
+    /// Warnings of the analyses about converged increments (a limit point
+    /// passed under load control), as logged.
+    pub warnings: Vec<String>,
     /// Every converged increment.
     pub increment_log: Vec<IncrementRecord>,
+    /// What each modal analysis of the run found (docs/results.md,
+    /// "Modes").
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<super::modes::ModalRecord>,
+    /// Iterations of the initial equilibria, left out of the average.
+    #[serde(skip)]
+    initial_iterations: usize,
+    /// Free unknowns before redundant constraint equations are removed.
+    #[serde(skip)]
+    unknowns: usize,
 }
 
 impl Summary {
-    /// The summary of a run of `model` (read from `model_file`) that has
-    /// not started: status `running`, counts of the model, no increment.
-    pub fn start(model_file: &str, model: &Model, analysis: &StaticAnalysis) -> Self {
+    /// The summary of a run of the analyses `plan` on `model` (read from
+    /// `model_file`), the first of which is `first`, that has not started:
+    /// status `running`, counts of the model, no increment.
+    pub fn start(
+        model_file: &str,
+        model: &Model,
+        first: &StaticAnalysis,
+        plan: &[AnalysisSettings],
+    ) -> Self {
+        let end_time = plan
+            .last()
+            .map_or(first.settings().end_time, |a| a.end_time());
+        Self::start_with(
+            model_file,
+            model,
+            first.n_equations(),
+            first.solver().nnz(),
+            end_time,
+        )
+    }
+
+    /// The summary of a run on `model` (read from `model_file`) whose first
+    /// analysis has `dofs` unknowns and `nonzeros` non-zeros in its matrix,
+    /// ending at `end_time`, that has not started.
+    pub fn start_with(
+        model_file: &str,
+        model: &Model,
+        dofs: usize,
+        nonzeros: usize,
+        end_time: f64,
+    ) -> Self {
         let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
         Self {
             model: model_file.to_string(),
@@ -183,97 +373,202 @@ impl Summary {
             joints: count(ElementKind::Joint),
             drivers: count(ElementKind::Driver),
             redundant_constraints: 0,
-            dofs: analysis.n_equations(),
-            nonzeros: analysis.solver().nnz(),
+            dofs,
+            nonzeros,
             increments: 0,
             iterations: 0,
             average_iterations: 0.0,
             wasted_iterations: 0,
             cutbacks: 0,
             final_time: 0.0,
-            end_time: model.settings.end_time,
+            end_time,
             wall_time_s: 0.0,
             output_steps: 0,
+            analyses: Vec::new(),
+            warnings: Vec::new(),
             increment_log: Vec::new(),
+            modes: Vec::new(),
+            initial_iterations: 0,
+            unknowns: dofs,
         }
     }
 
-    /// Fills in what the analysis did (`outcome`), the increments recorded
-    /// by `writer`, and the final status.
-    pub fn finish(
+    /// Adds what analysis `kind` (from `start_time` to `end_time`) did,
+    /// `outcome`, to the counts; `initial_iterations` are those of its
+    /// initial equilibrium (left out of the average).
+    pub fn add(
         &mut self,
+        kind: &str,
+        start_time: f64,
+        end_time: f64,
         outcome: &StaticOutcome,
-        writer: &ResultWriter,
-        status: RunStatus,
-        message: Option<String>,
+        initial_iterations: usize,
     ) {
-        self.status = status;
-        self.message = message;
-        self.redundant_constraints = outcome.redundant_constraints;
-        self.increments = outcome.increments;
-        self.iterations = outcome.iterations;
-        // the initial equilibrium is not an increment
-        self.average_iterations = if outcome.increments > 0 {
-            (outcome.iterations - writer.log.first().map_or(0, |r| r.iterations)) as f64
-                / outcome.increments as f64
+        self.add_end(
+            kind,
+            start_time,
+            end_time,
+            &outcome.into(),
+            initial_iterations,
+        );
+    }
+
+    /// As [`Summary::add`], for an analysis of any type that ended as
+    /// `outcome` says.
+    pub fn add_end(
+        &mut self,
+        kind: &str,
+        start_time: f64,
+        end_time: f64,
+        outcome: &AnalysisEnd,
+        initial_iterations: usize,
+    ) {
+        self.analyses.push(AnalysisRecord {
+            kind: kind.to_string(),
+            start_time,
+            end_time,
+            final_time: outcome.time,
+            increments: outcome.increments,
+            iterations: outcome.iterations,
+            cutbacks: outcome.cutbacks,
+            failed: outcome.error.is_some(),
+            wall_time_s: outcome.wall_time,
+            dynamic: outcome.dynamic.clone(),
+        });
+        self.redundant_constraints = self
+            .redundant_constraints
+            .max(outcome.redundant_constraints);
+        // the equations solved: without the redundant ones
+        self.dofs = self.unknowns.saturating_sub(self.redundant_constraints);
+        self.increments += outcome.increments;
+        self.iterations += outcome.iterations;
+        self.wasted_iterations += outcome.wasted_iterations;
+        self.cutbacks += outcome.cutbacks;
+        self.final_time = outcome.time;
+        self.wall_time_s += outcome.wall_time;
+        // the initial equilibria are not increments
+        self.initial_iterations += initial_iterations;
+        self.average_iterations = if self.increments > 0 {
+            self.iterations.saturating_sub(self.initial_iterations) as f64 / self.increments as f64
         } else {
             0.0
         };
-        self.wasted_iterations = outcome.wasted_iterations;
-        self.cutbacks = outcome.cutbacks;
-        self.final_time = outcome.time;
-        self.wall_time_s = outcome.wall_time;
+    }
+
+    /// Newton iterations of the initial equilibria of the analyses added
+    /// (counted in `iterations`, not in `average_iterations`).
+    pub fn initial_iterations(&self) -> usize {
+        self.initial_iterations
+    }
+
+    /// The final status, the increments recorded by `writer`.
+    pub fn finish(&mut self, writer: &ResultWriter, status: RunStatus, message: Option<String>) {
+        self.status = status;
+        self.message = message;
         self.output_steps = writer.output_steps();
         self.increment_log = writer.log.clone();
     }
 }
 
-/// A lock held on an output directory for the life of a run (an advisory
+/// A lock held on an output directory for the life of a run: an advisory
 /// lock on `.unfold.lock`, released by the system when the process ends,
-/// however it ends).
+/// however it ends, so that the file left by a killed process does not
+/// block the next run. The file itself is removed when the lock is
+/// dropped (while still locked: a run that opened it meanwhile finds, once
+/// it holds the lock, that the file is no longer the one at the path, and
+/// starts again).
 #[derive(Debug)]
 pub struct DirectoryLock {
-    _file: File,
+    file: File,
+    path: PathBuf,
 }
+
+/// Attempts at locking a directory whose lock file is being replaced.
+const LOCK_ATTEMPTS: usize = 10;
 
 impl DirectoryLock {
     /// Locks `dir`, or fails with [`io::ErrorKind::ResourceBusy`] if
     /// another run holds it.
     pub fn acquire(dir: &Path) -> io::Result<Self> {
         let path = dir.join(LOCK_FILE);
-        let mut file = std::fs::OpenOptions::new()
+        for _ in 0..LOCK_ATTEMPTS {
+            let file = Self::try_acquire(dir, &path)?;
+            // the file locked must still be the one at the path (not one
+            // removed by the run that held it)
+            if same_file(&file, &path) {
+                let mut lock = Self { file, path };
+                // the owner, for the message of a run refused (best effort)
+                let _ = lock
+                    .file
+                    .set_len(0)
+                    .and_then(|()| write!(lock.file, "{}", std::process::id()));
+                return Ok(lock);
+            }
+        }
+        Err(io::Error::new(
+            io::ErrorKind::ResourceBusy,
+            format!(
+                "{}: its lock file {LOCK_FILE} keeps being replaced by other runs; choose another output directory",
+                dir.display()
+            ),
+        ))
+    }
+
+    /// Opens and locks the lock file `path` of `dir`.
+    fn try_acquire(dir: &Path, path: &Path) -> io::Result<File> {
+        let file = std::fs::OpenOptions::new()
             .read(true)
             .write(true)
             .create(true)
             .truncate(false)
-            .open(&path)
-            .map_err(|e| file_error(&path, e))?;
+            .open(path)
+            .map_err(|e| file_error(path, e))?;
         match file.try_lock() {
-            Ok(()) => {}
+            Ok(()) => Ok(file),
             Err(std::fs::TryLockError::WouldBlock) => {
-                let owner = std::fs::read_to_string(&path).unwrap_or_default();
+                let owner = std::fs::read_to_string(path).unwrap_or_default();
                 let owner = owner.trim();
                 let by = if owner.is_empty() {
                     String::new()
                 } else {
                     format!(" (process {owner})")
                 };
-                return Err(io::Error::new(
+                Err(io::Error::new(
                     io::ErrorKind::ResourceBusy,
                     format!(
                         "{}: another run is writing its results there{by}; wait for it to end or choose another output directory",
                         dir.display()
                     ),
-                ));
+                ))
             }
-            Err(std::fs::TryLockError::Error(e)) => return Err(file_error(&path, e)),
+            Err(std::fs::TryLockError::Error(e)) => Err(file_error(path, e)),
         }
-        // the owner, for the message above (best effort)
-        let _ = file
-            .set_len(0)
-            .and_then(|()| write!(file, "{}", std::process::id()));
-        Ok(Self { _file: file })
     }
+}
+
+impl Drop for DirectoryLock {
+    fn drop(&mut self) {
+        // removed while locked (see the type's documentation); the lock
+        // goes with the file handle
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// Whether `path` names the open `file` (the same inode).
+#[cfg(unix)]
+fn same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Without inode numbers a lock file in use cannot be removed (Windows),
+/// so the file at the path is the one opened.
+#[cfg(not(unix))]
+fn same_file(_file: &File, _path: &Path) -> bool {
+    true
 }
 
 /// A CSV file written one step at a time: the rows of a step are gathered
@@ -328,7 +623,27 @@ struct ElementTable {
     file: CsvFile,
     /// Elements (indices in `model.elements`) in increasing id.
     elements: Vec<usize>,
+    /// Number of results whose rates follow them (the joint coordinates
+    /// in a run with dynamics), 0 otherwise.
+    rates: usize,
 }
+
+/// Names of the columns of the rates of the joint coordinates.
+const COORDINATE_RATES: [&str; 3] = ["c1_rate", "c2_rate", "c3_rate"];
+
+/// The files of a run with a dynamic analysis.
+struct MotionFiles {
+    /// `nodes_velocities.csv`.
+    velocities: CsvFile,
+    /// `energies.csv`.
+    energies: CsvFile,
+}
+
+/// Relative motion over the step of the differences that give the rates of
+/// the joint coordinates: 1e-4 of the model size or 1e-4 rad. With
+/// Richardson extrapolation of central differences the truncation error is
+/// of order (1e-4)⁴ and the round-off about 1e-12 of the rate.
+const RATE_MOTION: f64 = 1e-4;
 
 /// Writes result files as the analysis converges.
 pub struct ResultWriter {
@@ -349,6 +664,13 @@ pub struct ResultWriter {
     pvd: Vec<(f64, String)>,
     /// Every converged increment, for the summary.
     pub log: Vec<IncrementRecord>,
+    /// The files of a run with dynamics.
+    motion: Option<MotionFiles>,
+    /// The analysis running is dynamic: its steps have velocities and
+    /// energies.
+    moving: bool,
+    /// The energies of the step about to be written, if dynamic.
+    energies: Option<Energies>,
 }
 
 /// Removes `path` if it exists.
@@ -364,11 +686,75 @@ fn is_step_grid(name: &str) -> bool {
     name.starts_with("step_") && (name.ends_with(".vtu") || name.ends_with(".tmp"))
 }
 
+/// Removes from `dir` the files of an earlier run that this one will not
+/// rewrite (those `writes` does not name), every temporary file and every
+/// grid `vtk/step_NNNNN.vtu`.
+fn remove_leftovers(dir: &Path, writes: impl Fn(&str) -> bool) -> io::Result<()> {
+    for name in owned_files() {
+        if !writes(name) {
+            remove_if_present(&dir.join(name))?;
+        }
+        remove_if_present(&dir.join(format!("{name}.tmp")))?;
+    }
+    // the temporary collection of earlier versions
+    remove_if_present(&dir.join("unfold.tmp"))?;
+    let vtk_dir = dir.join("vtk");
+    let entries = match std::fs::read_dir(&vtk_dir) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        entries => entries.map_err(|e| file_error(&vtk_dir, e))?,
+    };
+    for entry in entries {
+        let path = entry.map_err(|e| file_error(&vtk_dir, e))?.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if is_step_grid(name) {
+            remove_if_present(&path)?;
+        }
+    }
+    Ok(())
+}
+
+/// Records in `dir` a run of `model` (read from `model_file`, analyses
+/// `plan`, the first of which is `first`) rejected before its first
+/// analysis started, by the checks of
+/// [`crate::analysis::preflight`]: `summary.json` alone, status `failed`
+/// with `message`. The directory is locked as for a run, and the files of
+/// an earlier run are removed (none would belong to this model), its
+/// restart files too but `keep` (the restart file given to this run, if
+/// any); no other file is written.
+pub fn write_rejected(
+    dir: &Path,
+    model_file: &str,
+    model: &Model,
+    first: &StaticAnalysis,
+    plan: &[AnalysisSettings],
+    message: &str,
+    keep: Option<&Path>,
+) -> io::Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| file_error(dir, e))?;
+    let _lock = DirectoryLock::acquire(dir)?;
+    remove_leftovers(dir, |_| false)?;
+    super::restart::remove_earlier(dir, keep)?;
+    // an empty grid folder of an earlier run goes too
+    let _ = std::fs::remove_dir(dir.join("vtk"));
+    let mut summary = Summary::start(model_file, model, first, plan);
+    summary.status = RunStatus::Failed;
+    summary.message = Some(message.to_string());
+    let text = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;
+    vtk::write_atomically(&dir.join("summary.json"), (text + "\n").as_bytes())
+}
+
 impl ResultWriter {
     /// Locks `dir` (creating it and `dir/vtk`), removes the result files
     /// of an earlier run that this one will not rewrite (see the module
     /// documentation), and creates the CSV files with their headers.
     pub fn create(dir: &Path, model: &Model) -> io::Result<Self> {
+        Self::create_for(dir, model, false)
+    }
+
+    /// As [`ResultWriter::create`], for a run with a dynamic analysis if
+    /// `dynamics`: it also writes `nodes_velocities.csv`, `energies.csv`,
+    /// the rates of the joint coordinates and the velocities in the grids.
+    pub fn create_for(dir: &Path, model: &Model, dynamics: bool) -> io::Result<Self> {
         let vtk_dir = dir.join("vtk");
         std::fs::create_dir_all(&vtk_dir).map_err(|e| file_error(&vtk_dir, e))?;
         let lock = DirectoryLock::acquire(dir)?;
@@ -384,6 +770,7 @@ impl ResultWriter {
         };
         let writes = |name: &str| match name {
             "reactions.csv" => !supported.is_empty(),
+            "nodes_velocities.csv" | "energies.csv" => dynamics,
             // written again by whoever writes the summary
             "summary.json" => false,
             _ => ElementKind::ALL
@@ -392,23 +779,8 @@ impl ResultWriter {
                 .is_none_or(has),
         };
 
-        // leftovers of an earlier run
-        for name in owned_files() {
-            if !writes(name) {
-                remove_if_present(&dir.join(name))?;
-            }
-            remove_if_present(&dir.join(format!("{name}.tmp")))?;
-        }
-        // the temporary collection of earlier versions
-        remove_if_present(&dir.join("unfold.tmp"))?;
-        let entries = std::fs::read_dir(&vtk_dir).map_err(|e| file_error(&vtk_dir, e))?;
-        for entry in entries {
-            let path = entry.map_err(|e| file_error(&vtk_dir, e))?.path();
-            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-            if is_step_grid(name) {
-                remove_if_present(&path)?;
-            }
-        }
+        remove_leftovers(dir, writes)?;
+        super::modes::remove_leftovers(dir)?;
 
         let mut node_order: Vec<usize> = (0..model.n_nodes()).collect();
         node_order.sort_by_key(|&i| model.node_ids[i]);
@@ -430,13 +802,20 @@ impl ResultWriter {
             debug_assert!(elements
                 .iter()
                 .all(|&k| model.elements[k].result_names() == names));
+            let rates = if dynamics && kind == ElementKind::Joint {
+                COORDINATE_RATES.len()
+            } else {
+                0
+            };
+            let mut header = format!("step,time,{},{}", kind.id_column(), names.join(","));
+            for r in &COORDINATE_RATES[..rates] {
+                header += &format!(",{r}");
+            }
             tables.push(ElementTable {
                 kind,
-                file: CsvFile::create(
-                    dir.join(name),
-                    &format!("step,time,{},{}", kind.id_column(), names.join(",")),
-                )?,
+                file: CsvFile::create(dir.join(name), &header)?,
                 elements,
+                rates,
             });
         }
         let longest = model
@@ -471,7 +850,30 @@ impl ResultWriter {
             values: vec![0.0; longest],
             pvd: Vec::new(),
             log: Vec::new(),
+            motion: dynamics
+                .then(|| -> io::Result<MotionFiles> {
+                    Ok(MotionFiles {
+                        velocities: CsvFile::create(
+                            dir.join("nodes_velocities.csv"),
+                            "step,time,node,vx,vy,vz,wx,wy,wz,ax,ay,az,dwx,dwy,dwz",
+                        )?,
+                        energies: CsvFile::create(
+                            dir.join("energies.csv"),
+                            "step,time,kinetic,strain,gravity,spring,external_work,dissipated,balance_error",
+                        )?,
+                    })
+                })
+                .transpose()?,
+            moving: false,
+            energies: None,
         })
+    }
+
+    /// Whether the analysis now running is dynamic (its steps have
+    /// velocities and energies; those of the others are at rest).
+    pub fn set_dynamic(&mut self, dynamic: bool) {
+        self.moving = dynamic;
+        self.energies = None;
     }
 
     /// Writes the grids in `encoding` (binary by default).
@@ -490,6 +892,11 @@ impl ResultWriter {
         self.pvd.len()
     }
 
+    /// The load parameter of the last output step written, if any.
+    pub fn last_output_time(&self) -> Option<f64> {
+        self.pvd.last().map(|p| p.0)
+    }
+
     /// Writes `summary.json` (through a temporary file, so that it is
     /// never seen half written).
     pub fn write_summary(&self, summary: &Summary) -> io::Result<()> {
@@ -499,10 +906,15 @@ impl ResultWriter {
 
     /// Every CSV file.
     fn csv_files(&mut self) -> impl Iterator<Item = &mut CsvFile> {
+        let motion = self
+            .motion
+            .as_mut()
+            .map(|m| [&mut m.velocities, &mut m.energies]);
         [&mut self.nodes, &mut self.steps]
             .into_iter()
             .chain(self.reactions.as_mut())
             .chain(self.tables.iter_mut().map(|t| &mut t.file))
+            .chain(motion.into_iter().flatten())
     }
 
     /// Formats the rows of output step `step` into the files' pending
@@ -527,12 +939,20 @@ impl ResultWriter {
                 model.node_ids[i], x.x, x.y, x.z, u.x, u.y, u.z, q.w, q.i, q.j, q.k
             );
         }
-        let ctx = model.context(t, false);
+        let ctx = model.context(t, Need::RESIDUAL);
+        // the state moved along its velocities, for the rates
+        let moved = if self.moving && self.tables.iter().any(|t| t.rates > 0) {
+            motion_probes(model, state)
+        } else {
+            None
+        };
+        let mut rates = [0.0; COORDINATE_RATES.len()];
         for table in &mut self.tables {
             for &k in &table.elements {
                 let e = &model.elements[k];
                 debug_assert_eq!(e.kind(), table.kind);
-                let values = &mut self.values[..e.result_names().len()];
+                let n = e.result_names().len();
+                let values = &mut self.values[..n];
                 values.fill(0.0);
                 e.results(&ctx, state, values);
                 let w = &mut table.file.pending;
@@ -545,7 +965,65 @@ impl ResultWriter {
                         let _ = write!(w, ",{v:.9e}");
                     }
                 }
+                if table.rates > 0 {
+                    let r = &mut rates[..table.rates.min(n)];
+                    match &moved {
+                        Some(probes) => result_rates(e.as_ref(), &ctx, probes, r),
+                        None => r.fill(0.0),
+                    }
+                    for (v, c) in r.iter().zip(values.iter()) {
+                        if c.is_nan() {
+                            w.push(',');
+                        } else {
+                            let _ = write!(w, ",{v:.9e}");
+                        }
+                    }
+                }
                 w.push('\n');
+            }
+        }
+        if let Some(m) = self.motion.as_mut() {
+            for &i in &self.node_order {
+                // at rest outside dynamic analyses; Ω and Ω̇ material, to
+                // global: ω = RΩ, ω̇ = RΩ̇
+                let (v, a) = if self.moving {
+                    (state.velocity[i], state.acceleration[i])
+                } else {
+                    ([0.0; 6], [0.0; 6])
+                };
+                let r = so3::matrix(&state.q[i]);
+                let w = r * Vec3::new(v[3], v[4], v[5]);
+                let dw = r * Vec3::new(a[3], a[4], a[5]);
+                let _ = writeln!(
+                    m.velocities.pending,
+                    "{step},{t:.12e},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
+                    model.node_ids[i], v[0], v[1], v[2], w.x, w.y, w.z, a[0], a[1], a[2], dw.x, dw.y, dw.z
+                );
+            }
+            match (self.moving, &self.energies) {
+                (true, Some(e)) => {
+                    let _ = writeln!(
+                        m.energies.pending,
+                        "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e}",
+                        e.kinetic,
+                        e.strain,
+                        e.gravity,
+                        e.spring,
+                        e.external_work,
+                        e.dissipated,
+                        e.balance_error
+                    );
+                }
+                _ => {
+                    // at rest (a static step): the stored energies; work,
+                    // dissipation and balance belong to motions
+                    let e = crate::analysis::energy::energies(model, state);
+                    let _ = writeln!(
+                        m.energies.pending,
+                        "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},,,",
+                        0.0, e.strain, e.gravity, e.spring
+                    );
+                }
             }
         }
         if let Some(file) = self.reactions.as_mut() {
@@ -588,8 +1066,9 @@ impl ResultWriter {
         self.format_step(step, info, model, state, residual);
         let name = format!("step_{step:05}.vtu");
         let grid = self.dir.join("vtk").join(&name);
-        let ctx = model.context(info.time, false);
-        if let Err(e) = vtk::write_vtu(&grid, model, &ctx, state, self.encoding) {
+        let ctx = model.context(info.time, Need::RESIDUAL);
+        let velocities = self.motion.is_some().then_some(self.moving);
+        if let Err(e) = vtk::write_step_vtu(&grid, model, &ctx, state, self.encoding, velocities) {
             self.csv_files().for_each(CsvFile::rollback);
             return Err(e);
         }
@@ -615,7 +1094,71 @@ impl ResultWriter {
     }
 }
 
+/// The state moved along its velocities by `±e` and `±e/2` (nodes on the
+/// group, `x + e ẋ`, `R exp(e Ω~)`; coordinates `c + e ċ`), and `e`; `None`
+/// at rest.
+fn motion_probes(model: &Model, state: &State) -> Option<(f64, [State; 4])> {
+    let (mut v, mut w) = (0.0f64, 0.0f64);
+    for r in &state.velocity {
+        v = v.max(Vec3::new(r[0], r[1], r[2]).norm());
+        w = w.max(Vec3::new(r[3], r[4], r[5]).norm());
+    }
+    let rate = state
+        .coordinate_rates
+        .iter()
+        .fold(0.0f64, |m, r| m.max(r.abs()));
+    // the inverse of the time over which a node moves by the model's size
+    // or turns by a radian (a coordinate, length or angle, likewise)
+    let l = model.length_scale;
+    let pace = (v / l).max(w).max(rate / l.min(1.0));
+    if pace == 0.0 || !pace.is_finite() {
+        return None;
+    }
+    let e = RATE_MOTION / pace;
+    let moved = |h: f64| {
+        let mut s = state.clone();
+        for node in 0..s.n_nodes() {
+            let r = state.velocity[node];
+            s.displace_node(
+                node,
+                &(Vec3::new(r[0], r[1], r[2]) * h),
+                &(Vec3::new(r[3], r[4], r[5]) * h),
+            );
+        }
+        for (c, r) in s.coordinates.iter_mut().zip(&state.coordinate_rates) {
+            *c += h * r;
+        }
+        s
+    };
+    Some((e, [moved(e), moved(-e), moved(0.5 * e), moved(-0.5 * e)]))
+}
+
+/// The rates of the first `out.len()` results of `element` along the
+/// motion: central differences over `±e` and `±e/2`, Richardson
+/// extrapolated, `ċ = (4 D(e/2) − D(e))/3`.
+fn result_rates(
+    element: &dyn crate::elements::Element,
+    ctx: &crate::elements::EvalContext,
+    (e, probes): &(f64, [State; 4]),
+    out: &mut [f64],
+) {
+    let n = element.result_names().len();
+    let mut values = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    for (v, s) in values.iter_mut().zip(probes) {
+        element.results(ctx, s, v);
+    }
+    for (k, r) in out.iter_mut().enumerate() {
+        let d1 = (values[0][k] - values[1][k]) / (2.0 * e);
+        let d2 = (values[2][k] - values[3][k]) / e;
+        *r = (4.0 * d2 - d1) / 3.0;
+    }
+}
+
 impl Observer for ResultWriter {
+    fn energies(&mut self, energies: &Energies) {
+        self.energies = Some(*energies);
+    }
+
     fn increment(
         &mut self,
         info: &IncrementInfo,

@@ -3,15 +3,27 @@
 //! and for programs that build their model with the library.
 //!
 //! ```no_run
-//! # use unfold::analysis::StaticAnalysis;
+//! # use std::sync::Arc;
+//! # use unfold::analysis::{StaticAnalysis, StaticSettings};
 //! # use unfold::io::run::{Recorder, Silent};
-//! # fn run(model: &unfold::model::Model) -> std::io::Result<()> {
-//! let mut analysis = StaticAnalysis::new(model);
-//! let mut recorder = Recorder::create("results/x".as_ref(), "x.toml", model, &analysis, Silent)?;
-//! let outcome = analysis.run(&mut recorder);
+//! # fn run(model: Arc<unfold::model::Model>, settings: StaticSettings) -> std::io::Result<()> {
+//! let mut analysis = StaticAnalysis::new(model.clone(), settings);
+//! let mut recorder = Recorder::create("results/x".as_ref(), "x.toml", &analysis, Silent)?;
+//! let outcome = analysis.run(model.initial_state(), &mut recorder);
 //! let report = recorder.finish(&outcome);
 //! # Ok(()) }
 //! ```
+//!
+//! A sequence of analyses ([`Recorder::create_sequence`]) is recorded in
+//! one set of files: each analysis starts from the final state of the one
+//! before ([`Recorder::next_analysis`]), the output steps and increments
+//! are numbered on across them, and `summary.json` lists each analysis.
+//!
+//! A dynamic analysis ([`Recorder::create_dynamic_first`],
+//! [`Recorder::open_dynamic`], [`Recorder::end_analysis`]) adds its time
+//! steps, the velocities of its output steps and their energies
+//! (`nodes_velocities.csv`, `energies.csv`) and its energy balance in
+//! `summary.json`.
 //!
 //! Stopping: a [`StopRequest`] shared with the recorder (set by
 //! [`stop_on_signals`] on SIGINT, SIGTERM or SIGHUP) makes it write the
@@ -20,6 +32,10 @@
 //! `interrupted`. A step is never split between files: the request is
 //! looked at between increments, and a second signal, which ends the
 //! process at once, waits for the step being written.
+//!
+//! Restart files ([`super::restart`]): with [`Recorder::with_restart`]
+//! the recorder writes them at the requested times and, when the run ends,
+//! `restart.json` with its last converged state.
 //!
 //! The library never prints: what a person should see goes to a
 //! [`Console`], which the caller provides.
@@ -30,15 +46,20 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicI32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
-use super::results::{file_error, ResultWriter, RunStatus, Summary};
+use super::modes::ModalFiles;
+use super::restart::RestartWriter;
+use super::results::{file_error, AnalysisEnd, ResultWriter, RunStatus, Summary};
 use super::vtk::Encoding;
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
-    CutbackInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome,
+    AnalysisSettings, Continuation, CutbackInfo, DynamicAnalysis, DynamicError, Energies,
+    EventInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
 use crate::model::Model;
 use crate::state::State;
+
+mod modal;
 
 /// What a person watching the run sees. Every method has an empty
 /// default.
@@ -49,6 +70,8 @@ pub trait Console {
     fn progress(&mut self, _info: &IncrementInfo) {}
     /// The last line of the run (status, counts, where the results are).
     fn finish(&mut self, _text: &str) {}
+    /// A warning of the analysis (shown even when lines are not).
+    fn warning(&mut self, _text: &str) {}
 }
 
 /// A console that shows nothing.
@@ -132,6 +155,14 @@ impl Interrupted {
             _ => None,
         }
     }
+
+    /// As [`Interrupted::of`], for a dynamic analysis.
+    pub fn of_dynamic(error: &DynamicError) -> Option<Self> {
+        match error {
+            DynamicError::Output(e) => e.get_ref()?.downcast_ref::<Self>().copied(),
+            _ => None,
+        }
+    }
 }
 
 impl std::fmt::Display for Interrupted {
@@ -206,9 +237,30 @@ pub fn stop_on_signals(
     Ok(())
 }
 
+/// A load parameter for messages: six decimals, trailing zeros dropped
+/// (`1`, `0.071849`), or six in exponent form outside `[1e-3, 1e6)`.
+pub fn format_time(t: f64) -> String {
+    if t == 0.0 || !t.is_finite() {
+        return format!("{t}");
+    }
+    if (1e-3..1e6).contains(&t.abs()) {
+        let fixed = format!("{t:.6}");
+        fixed
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        format!("{t:.6e}")
+    }
+}
+
 /// The size of a model in one line: nodes and elements of each kind.
 pub fn describe(model: &Model) -> String {
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
+    let hinge_laws = match count(ElementKind::HingeLaw) {
+        0 => String::new(),
+        n => format!(", {n} hinge laws"),
+    };
     format!(
         "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
         model.n_nodes(),
@@ -220,7 +272,7 @@ pub fn describe(model: &Model) -> String {
         count(ElementKind::JointSpring),
         count(ElementKind::Driver),
         count(ElementKind::NodalLoad),
-    )
+    ) + &hinge_laws
 }
 
 /// `log.txt`: a line per increment, iteration, cut-back and note. A write
@@ -284,6 +336,9 @@ pub struct RunReport {
     pub output_errors: Vec<io::Error>,
     /// The last line of the run, as written to `log.txt`.
     pub last_line: String,
+    /// The load parameter of the last output step written (the results
+    /// kept), if any.
+    pub last_output_time: Option<f64>,
 }
 
 /// Records a run: result files, `log.txt`, `summary.json`; stops it on
@@ -294,43 +349,224 @@ pub struct Recorder {
     console: Box<dyn Console>,
     stop: StopRequest,
     summary: Summary,
+    /// End of the last analysis of the run.
     end_time: f64,
+    /// Number of analyses of the run.
+    analyses: usize,
+    /// The analysis running: its index, type, start and end.
+    current: Running,
+    /// Increments of the analyses before the running one.
+    increment_offset: usize,
+    /// Whether `current` is a static analysis not yet closed.
+    open: bool,
+    /// Why a modal analysis of the run failed, if one did.
+    failure: Option<String>,
+    /// The result files of the modal analyses.
+    modal: ModalFiles,
+    /// Encoding of the grids.
+    encoding: Encoding,
+    /// Largest constraint violation (relative to its tolerance) at each
+    /// iteration of the increment being solved.
+    violations: Vec<f64>,
+    /// Restart files, and the index in the model's sequence of the first
+    /// analysis recorded.
+    restart: Option<(RestartWriter, usize)>,
+    /// Largest absolute energy balance error and kinetic energy over the
+    /// steps of the running dynamic analysis.
+    energy_extremes: (f64, f64),
+    /// The energies of its last converged step.
+    energies: Option<Energies>,
+    /// What it needs besides its last converged state to go on (for
+    /// restart files).
+    motion: Option<Continuation>,
+}
+
+/// The analysis being recorded.
+struct Running {
+    index: usize,
+    kind: &'static str,
+    start_time: f64,
+    end_time: f64,
+    initial_iterations: usize,
+}
+
+impl Running {
+    fn of_dynamic(index: usize, analysis: &DynamicAnalysis) -> Self {
+        Self {
+            index,
+            kind: "dynamic",
+            start_time: 0.0,
+            end_time: analysis.settings().end_time,
+            initial_iterations: 0,
+        }
+    }
+
+    fn of(index: usize, analysis: &StaticAnalysis) -> Self {
+        let s = analysis.settings();
+        Self {
+            index,
+            kind: if s.kinematic { "kinematic" } else { "static" },
+            start_time: 0.0,
+            end_time: s.end_time,
+            initial_iterations: 0,
+        }
+    }
 }
 
 impl Recorder {
-    /// Locks and prepares `dir` for a run of `model` (read from
-    /// `model_file`, as named in the summary): result files with their
+    /// Locks and prepares `dir` for a run of `analysis` (of a model read
+    /// from `model_file`, as named in the summary): result files with their
     /// headers, `log.txt` with a first line describing the model, and a
     /// `summary.json` saying `running`; the run is shown on `console`.
     /// Every error names its file.
     pub fn create(
         dir: &Path,
         model_file: &str,
-        model: &Model,
         analysis: &StaticAnalysis,
         console: impl Console + 'static,
     ) -> io::Result<Self> {
-        let writer = ResultWriter::create(dir, model)?;
+        let plan = [AnalysisSettings::Static(analysis.settings().clone())];
+        Self::create_sequence(dir, model_file, analysis, &plan, console)
+    }
+
+    /// As [`Recorder::create`], for a run of the analyses `plan` in order,
+    /// the first of which is `first`.
+    pub fn create_sequence(
+        dir: &Path,
+        model_file: &str,
+        first: &StaticAnalysis,
+        plan: &[AnalysisSettings],
+        console: impl Console + 'static,
+    ) -> io::Result<Self> {
+        let model = &**first.model();
+        let summary = Summary::start(model_file, model, first, plan);
+        let running = Running::of(0, first);
+        let unknowns = first.n_equations();
+        Self::create_with(
+            dir, model_file, model, summary, running, unknowns, plan, console,
+        )
+    }
+
+    /// As [`Recorder::create_sequence`], for a run whose first analysis
+    /// is the dynamic analysis `first`.
+    pub fn create_dynamic_first(
+        dir: &Path,
+        model_file: &str,
+        first: &DynamicAnalysis,
+        plan: &[AnalysisSettings],
+        console: impl Console + 'static,
+    ) -> io::Result<Self> {
+        let model = &**first.model();
+        let end_time = plan
+            .last()
+            .map_or(first.settings().end_time, |a| a.end_time());
+        let unknowns = first.n_equations();
+        let summary = Summary::start_with(model_file, model, unknowns, first.nnz(), end_time);
+        let running = Running::of_dynamic(0, first);
+        let mut recorder = Self::create_with(
+            dir, model_file, model, summary, running, unknowns, plan, console,
+        )?;
+        recorder.writer.set_dynamic(true);
+        Ok(recorder)
+    }
+
+    /// Opens the record of the dynamic analysis `next`, which starts from
+    /// the final state of the analysis before it, at `t = from` (that
+    /// analysis closed with [`Recorder::end_analysis`]).
+    pub fn open_dynamic(&mut self, next: &DynamicAnalysis, from: f64) {
+        self.current = Running::of_dynamic(self.current.index + 1, next);
+        self.open_next(from);
+    }
+
+    /// Opens the record of the static analysis `next` after another
+    /// analysis (closed with [`Recorder::end_analysis`]), from `t = from`.
+    pub fn open_static(&mut self, next: &StaticAnalysis, from: f64) {
+        self.current = Running::of(self.current.index + 1, next);
+        self.open_next(from);
+    }
+
+    fn open_next(&mut self, from: f64) {
+        self.open = true;
+        self.energy_extremes = (0.0, 0.0);
+        self.energies = None;
+        self.motion = None;
+        self.writer.set_dynamic(self.current.kind == "dynamic");
+        self.line(&format!(
+            "analysis {} of {}: {} from t = {} to t = {}",
+            self.current.index + 1,
+            self.analyses,
+            self.current.kind,
+            format_time(from),
+            format_time(self.current.end_time)
+        ));
+    }
+
+    /// Closes the record of the running analysis, which ended as `end`
+    /// says (nothing if it is closed already).
+    pub fn end_analysis(&mut self, end: &AnalysisEnd) {
+        self.close_end(end);
+    }
+
+    /// The recorder of a run of `plan` whose first analysis is `running`,
+    /// a static one if `running.kind` is not `modal`.
+    #[allow(clippy::too_many_arguments)]
+    fn create_with(
+        dir: &Path,
+        model_file: &str,
+        model: &Model,
+        summary: Summary,
+        running: Running,
+        unknowns: usize,
+        plan: &[AnalysisSettings],
+        console: impl Console + 'static,
+    ) -> io::Result<Self> {
+        let dynamics = plan.iter().any(|a| a.as_dynamic().is_some());
+        let writer = ResultWriter::create_for(dir, model, dynamics)?;
         let log = LogFile::create(dir.join("log.txt"))?;
-        let summary = Summary::start(model_file, model, analysis);
         let mut recorder = Self {
             writer,
             log,
             console: Box::new(console),
             stop: StopRequest::new(),
+            end_time: summary.end_time,
             summary,
-            end_time: model.settings.end_time,
+            analyses: plan.len().max(1),
+            open: running.kind != "modal",
+            current: running,
+            increment_offset: 0,
+            failure: None,
+            modal: ModalFiles::default(),
+            encoding: Encoding::default(),
+            violations: Vec::new(),
+            restart: None,
+            energy_extremes: (0.0, 0.0),
+            energies: None,
+            motion: None,
+        };
+        let analyses = if plan.len() > 1 {
+            let each: Vec<String> = plan
+                .iter()
+                .map(|a| match a.as_modal() {
+                    Some(m) => format!("modal at t = {}", format_time(m.time)),
+                    None => format!("{} to t = {}", a.name(), format_time(a.end_time())),
+                })
+                .collect();
+            format!("{} analyses: {}", plan.len(), each.join(", "))
+        } else {
+            match recorder.current.kind {
+                "modal" => format!(
+                    "modal analysis at t = {}",
+                    format_time(recorder.current.end_time)
+                ),
+                kind => format!(
+                    "{kind} analysis to t = {}",
+                    format_time(recorder.current.end_time)
+                ),
+            }
         };
         recorder.line(&format!(
-            "{model_file}: {}; {} unknowns; {} analysis to t = {}",
+            "{model_file}: {}; {unknowns} unknowns; {analyses}",
             describe(model),
-            analysis.n_equations(),
-            if model.settings.kinematic {
-                "kinematic"
-            } else {
-                "static"
-            },
-            model.settings.end_time
         ));
         // warnings are shown by the caller; the log keeps them with the run
         for w in &model.warnings {
@@ -344,15 +580,83 @@ impl Recorder {
         Ok(recorder)
     }
 
+    /// Closes the record of the analysis that returned `outcome` and opens
+    /// that of `next`, which starts from `outcome`'s final state.
+    pub fn next_analysis(&mut self, outcome: &StaticOutcome, next: &StaticAnalysis) {
+        self.close(outcome);
+        self.current = Running::of(self.current.index + 1, next);
+        self.open = true;
+        self.line(&format!(
+            "analysis {} of {}: {} from t = {} to t = {}",
+            self.current.index + 1,
+            self.analyses,
+            self.current.kind,
+            format_time(outcome.time),
+            format_time(self.current.end_time)
+        ));
+    }
+
+    /// Adds the running analysis's `outcome` to the summary.
+    fn close(&mut self, outcome: &StaticOutcome) {
+        self.close_end(&outcome.into());
+    }
+
+    /// Adds the running analysis, which ended as `end` says, to the
+    /// summary.
+    fn close_end(&mut self, end: &AnalysisEnd) {
+        if !std::mem::replace(&mut self.open, false) {
+            return;
+        }
+        let mut end = end.clone();
+        if let Some(d) = end.dynamic.as_mut() {
+            let (error, kinetic) = self.energy_extremes;
+            d.largest_energy_balance_error = d.largest_energy_balance_error.max(error);
+            d.largest_kinetic_energy = d.largest_kinetic_energy.max(kinetic);
+            self.line(&format!(
+                "dynamic analysis to t = {}: {} steps, {} rejected ({} by the error estimate), {} iterations, {:.3} s; energy balance error {:.3e} (largest {:.3e}; largest kinetic energy {:.3e})",
+                format_time(end.time),
+                d.steps,
+                d.rejected_steps,
+                d.error_rejections,
+                d.newton_iterations,
+                d.wall_time_s,
+                d.energy_balance_error,
+                d.largest_energy_balance_error,
+                d.largest_kinetic_energy
+            ));
+        }
+        let c = &self.current;
+        self.summary
+            .add_end(c.kind, c.start_time, c.end_time, &end, c.initial_iterations);
+        self.increment_offset += end.increments;
+    }
+
+    /// `info` numbered on across the analyses of the run.
+    fn renumbered(&self, info: &IncrementInfo) -> IncrementInfo {
+        IncrementInfo {
+            increment: info.increment + self.increment_offset,
+            ..info.clone()
+        }
+    }
+
     /// Stops the run when `stop` is requested.
     pub fn with_stop(mut self, stop: &StopRequest) -> Self {
         self.stop = stop.clone();
         self
     }
 
+    /// Writes restart files with `writer` (io::restart); the first analysis
+    /// recorded is analysis `first_analysis` (from 0) of the model's
+    /// sequence, as in a restarted run.
+    pub fn with_restart(mut self, writer: RestartWriter, first_analysis: usize) -> Self {
+        self.restart = Some((writer, first_analysis));
+        self
+    }
+
     /// Writes the grids in `encoding` (binary by default).
     pub fn with_vtk_encoding(mut self, encoding: Encoding) -> Self {
         self.writer = self.writer.with_vtk_encoding(encoding);
+        self.encoding = encoding;
         self
     }
 
@@ -372,36 +676,107 @@ impl Recorder {
         self.console.line(text);
     }
 
-    /// Ends the record of a run whose analysis returned `outcome`: the
-    /// status (completed, failed or interrupted), the last line of
+    /// Ends the record of a run whose (last) analysis returned `outcome`:
+    /// the status (completed, failed or interrupted), the last line of
     /// `log.txt`, and `summary.json`. Write errors are returned in the
     /// report, not lost.
-    pub fn finish(mut self, outcome: &StaticOutcome) -> RunReport {
-        let interrupted = outcome.error.as_ref().and_then(Interrupted::of);
-        let (status, message) = match (&outcome.error, interrupted) {
-            (None, _) => (RunStatus::Completed, None),
-            (Some(_), Some(i)) => (
+    pub fn finish(self, outcome: &StaticOutcome) -> RunReport {
+        self.finish_with(Some(outcome), &outcome.state)
+    }
+
+    /// As [`Recorder::finish`], for a run whose last static analysis (if
+    /// any) returned `outcome` and whose last converged state is `state`
+    /// (that of `outcome`, or the state a modal analysis after it was
+    /// given and left unchanged), written to `restart.json`; a failed
+    /// modal analysis fails the run.
+    pub fn finish_with(self, outcome: Option<&StaticOutcome>, state: &State) -> RunReport {
+        let end = outcome.map(AnalysisEnd::from);
+        self.finish_after(end.as_ref(), state)
+    }
+
+    /// As [`Recorder::finish_with`], for a run whose last static or
+    /// dynamic analysis ended as `last` says.
+    pub fn finish_after(mut self, last: Option<&AnalysisEnd>, state: &State) -> RunReport {
+        let error = last.and_then(|o| o.error.as_ref());
+        if let Some(o) = last {
+            self.close_end(o);
+        }
+        let interrupted = last.and_then(|o| o.interrupted);
+        let (status, message) = match (error, interrupted, self.failure.take()) {
+            (None, _, None) => (RunStatus::Completed, None),
+            (None, _, Some(failure)) => (RunStatus::Failed, Some(failure)),
+            (Some(_), Some(i), _) => (
                 RunStatus::Interrupted,
-                Some(format!("{i} at t = {}", outcome.time)),
+                Some(format!(
+                    "{i} at t = {}",
+                    format_time(self.summary.final_time)
+                )),
             ),
-            (Some(e), None) => (RunStatus::Failed, Some(e.to_string())),
+            (Some(e), None, _) => (RunStatus::Failed, Some(e.clone())),
         };
-        self.summary.finish(outcome, &self.writer, status, message);
+        let mut output_errors = Vec::new();
+        if let Some((restart, first)) = &self.restart {
+            let _writing = self.stop.output();
+            let index = first + self.current.index;
+            // the dynamic analysis that ended at `state`
+            let motion = self.motion.filter(|m| m.energies.time == state.time);
+            if let Err(e) = restart.finish(index, self.current.kind, state, motion) {
+                output_errors.push(e);
+            }
+        }
+        self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
-        let last_line = format!(
-            "{}: {} increments, {} iterations ({:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
-            s.status.name(),
-            s.increments,
-            s.iterations,
-            s.average_iterations,
-            s.cutbacks,
-            s.final_time,
-            s.wall_time_s,
-            self.writer.dir().display()
-        );
+        // the initial equilibria's iterations are counted in the total,
+        // not in the average
+        let initial = if self.analyses > 1 {
+            "the initial equilibria"
+        } else {
+            "the initial equilibrium"
+        };
+        let dynamic: Vec<_> = s
+            .analyses
+            .iter()
+            .filter_map(|a| a.dynamic.as_ref())
+            .collect();
+        let last_line = if !dynamic.is_empty()
+            && dynamic.len() == s.analyses.iter().filter(|a| a.kind != "modal").count()
+        {
+            // dynamic analyses only (and modal ones): time steps
+            let steps: usize = dynamic.iter().map(|d| d.steps).sum();
+            let rejected: usize = dynamic.iter().map(|d| d.rejected_steps).sum();
+            let balance = dynamic.last().map_or(0.0, |d| d.energy_balance_error);
+            format!(
+                "{}: {steps} steps, {rejected} rejected, {} iterations ({:.2} per step), t = {}, {:.3} s, energy balance error {balance:.3e}; results in {}",
+                s.status.name(),
+                s.iterations,
+                if steps > 0 { s.iterations as f64 / steps as f64 } else { 0.0 },
+                format_time(s.final_time),
+                s.wall_time_s,
+                self.writer.dir().display()
+            )
+        } else {
+            let steps = if dynamic.is_empty() {
+                String::new()
+            } else {
+                let steps: usize = dynamic.iter().map(|d| d.steps).sum();
+                let rejected: usize = dynamic.iter().map(|d| d.rejected_steps).sum();
+                format!(" (of which {steps} time steps, {rejected} rejected)")
+            };
+            format!(
+                "{}: {} increments{steps}, {} iterations ({} for {initial}; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
+                s.status.name(),
+                s.increments,
+                s.iterations,
+                s.initial_iterations(),
+                s.average_iterations,
+                s.cutbacks,
+                format_time(s.final_time),
+                s.wall_time_s,
+                self.writer.dir().display()
+            )
+        };
         self.log.line(&last_line);
         self.console.finish(&last_line);
-        let mut output_errors = Vec::new();
         if let Err(e) = self.log.flush() {
             output_errors.push(e);
         }
@@ -417,21 +792,40 @@ impl Recorder {
             interrupted,
             output_errors,
             last_line,
+            last_output_time: self.writer.last_output_time(),
         }
     }
 }
 
 impl Observer for Recorder {
+    fn energies(&mut self, energies: &Energies) {
+        let (error, kinetic) = &mut self.energy_extremes;
+        *error = error.max(energies.balance_error.abs());
+        *kinetic = kinetic.max(energies.kinetic);
+        self.energies = Some(*energies);
+        self.writer.energies(energies);
+    }
+
     fn iteration(&mut self, info: &IterationInfo) {
+        if info.iteration == 0 {
+            self.violations.clear();
+        }
+        self.violations.push(info.norms.residual_constraint);
         let n = &info.norms;
         self.log.line(&format!(
-            "    increment {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
-            info.increment,
+            "    {} {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+            if self.current.kind == "dynamic" {
+                "step"
+            } else {
+                "increment"
+            },
+            info.increment + self.increment_offset,
             info.iteration,
             n.residual_force,
             n.flux_force,
             n.residual_moment,
             n.flux_moment,
+            n.residual_coordinate,
             n.relative_residual,
             n.residual_constraint,
             n.displacement_correction,
@@ -446,16 +840,48 @@ impl Observer for Recorder {
         state: &State,
         residual: &[f64],
     ) -> io::Result<()> {
-        let residuals: Vec<String> = info.residuals.iter().map(|r| format!("{r:.1e}")).collect();
+        if info.increment == 0 {
+            self.current.start_time = info.time;
+            self.current.initial_iterations = info.iterations;
+        }
+        // a later analysis starts at the final state of the one before,
+        // written already: its equilibrium there is logged, not written
+        let restart =
+            info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
+        if self.current.kind == "dynamic" {
+            // the step that ended here (none at the start: a restart there
+            // predicts its first step as the analysis's first)
+            self.motion = self.energies.map(|energies| Continuation {
+                energies,
+                last_step: (info.step > 0.0).then_some(info.step),
+            });
+        }
+        let info = &self.renumbered(info);
+        // a kinematic analysis has no loads: its residual is all constraint
+        // violation, measured against the tolerance of each constraint
+        let (what, values) = if self.current.kind == "kinematic" {
+            ("constraint violations (× tolerance)", &self.violations)
+        } else {
+            ("relative residuals", &info.residuals)
+        };
+        let values: Vec<String> = values.iter().map(|r| format!("{r:.1e}")).collect();
+        let (word, size) = if self.current.kind == "dynamic" {
+            ("step", "h")
+        } else {
+            ("increment", "dt")
+        };
         self.line(&format!(
-            "increment {:4}  t = {:.6}  dt = {:.3e}  iterations {:2}  relative residuals: {}",
+            "{word} {:4}  t = {:.6}  {size} = {:.3e}  iterations {:2}  {what}: {}",
             info.increment,
             info.time,
             info.step,
             info.iterations,
-            residuals.join(" ")
+            values.join(" ")
         ));
         self.console.progress(info);
+        if restart {
+            return self.log.flush();
+        }
 
         // a stop request before the end: this increment is the last
         // output step
@@ -471,6 +897,14 @@ impl Observer for Recorder {
             } else {
                 self.writer.increment(info, model, state, residual)?;
             }
+            if let Some((restart, first)) = &mut self.restart {
+                restart.increment(
+                    *first + self.current.index,
+                    self.current.kind,
+                    state,
+                    self.motion,
+                )?;
+            }
         }
         self.log.flush()?;
         match stop {
@@ -483,10 +917,42 @@ impl Observer for Recorder {
         self.line(&format!("note: {text}"));
     }
 
+    fn warning(&mut self, info: &WarningInfo) {
+        let text = format!(
+            "increment {} (t = {} to {}): {}",
+            info.increment + self.increment_offset,
+            format_time(info.from),
+            format_time(info.time),
+            info.message
+        );
+        self.log.line(&format!("warning: {text}"));
+        self.console.warning(&text);
+        self.summary.warnings.push(text);
+    }
+
     fn cutback(&mut self, info: &CutbackInfo) {
+        let word = if self.current.kind == "dynamic" {
+            "step"
+        } else {
+            "increment"
+        };
         self.line(&format!(
-            "increment {:4}  from t = {:.6}: step {:.3e} failed ({}); retrying with {:.3e}",
-            info.increment, info.time, info.failed_step, info.reason, info.next_step
+            "{word} {:4}  from t = {:.6}: step {:.3e} failed ({}); retrying with {:.3e}",
+            info.increment + self.increment_offset,
+            info.time,
+            info.failed_step,
+            info.reason,
+            info.next_step
+        ));
+    }
+
+    fn event(&mut self, info: &EventInfo) {
+        self.line(&format!(
+            "increment {:4}  t = {:.6}: event \"{}\" (value {:.3e})",
+            info.increment + self.increment_offset,
+            info.time,
+            info.name,
+            info.value
         ));
     }
 }

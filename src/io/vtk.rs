@@ -231,6 +231,62 @@ pub fn write_vtu(
     state: &State,
     encoding: Encoding,
 ) -> io::Result<()> {
+    write_grid(path, model, ctx, state, encoding, None, None)
+}
+
+/// Writes the grid of an output step of a run: as [`write_vtu`], with
+/// the point vectors `velocity` and `angular_velocity` (global) if
+/// `velocities` is given: the state's if `Some(true)` (a step of a dynamic
+/// analysis), zeros if `Some(false)` (a step at rest in a run with
+/// dynamics, so that every grid of the run has the same fields). A joint
+/// point moves with its node, `v + ω × (p − x)`, and with the ground not
+/// at all.
+pub fn write_step_vtu(
+    path: &Path,
+    model: &Model,
+    ctx: &EvalContext,
+    state: &State,
+    encoding: Encoding,
+    velocities: Option<bool>,
+) -> io::Result<()> {
+    write_grid(path, model, ctx, state, encoding, None, velocities)
+}
+
+/// A mode shape on the nodes: translation and rotation (global frame) of
+/// each node.
+#[derive(Clone, Copy, Debug)]
+pub struct ModeField<'a> {
+    /// Translation of each node.
+    pub translation: &'a [Vec3],
+    /// Rotation (small rotation vector) of each node.
+    pub rotation: &'a [Vec3],
+}
+
+/// Writes the grid of `state` to `path` with a mode shape as the point
+/// vectors `mode_displacement` (the default vectors of the file, for
+/// ParaView's Warp By Vector) and `mode_rotation`; a joint point moves
+/// with its node, `u + θ × (p − x)`, and with the ground not at all.
+pub fn write_mode_vtu(
+    path: &Path,
+    model: &Model,
+    ctx: &EvalContext,
+    state: &State,
+    encoding: Encoding,
+    mode: ModeField,
+) -> io::Result<()> {
+    assert!(mode.translation.len() == model.n_nodes() && mode.rotation.len() == model.n_nodes());
+    write_grid(path, model, ctx, state, encoding, Some(mode), None)
+}
+
+fn write_grid(
+    path: &Path,
+    model: &Model,
+    ctx: &EvalContext,
+    state: &State,
+    encoding: Encoding,
+    mode: Option<ModeField>,
+    velocities: Option<bool>,
+) -> io::Result<()> {
     let n_nodes = model.n_nodes();
     let joints = attachments(model, state);
     let joints_at_reference = if joints.is_empty() {
@@ -255,6 +311,52 @@ pub fn write_vtu(
         let r = so3::matrix(&state.q[i]);
         for (c, a) in axes.iter_mut().enumerate() {
             push3(a, &r.column(c).into_owned());
+        }
+    }
+    // the mode shape at the nodes, then at the joint points
+    let mut mode_u = Vec::new();
+    let mut mode_theta = Vec::new();
+    if let Some(m) = &mode {
+        for i in 0..n_nodes {
+            push3(&mut mode_u, &m.translation[i]);
+            push3(&mut mode_theta, &m.rotation[i]);
+        }
+        for (_, a) in &joints {
+            let (u, theta) = a.node.map_or((Vec3::zeros(), Vec3::zeros()), |n| {
+                let theta = m.rotation[n];
+                (
+                    m.translation[n] + theta.cross(&(a.point - state.x[n])),
+                    theta,
+                )
+            });
+            push3(&mut mode_u, &u);
+            push3(&mut mode_theta, &theta);
+        }
+    }
+    // velocities (global) at the nodes, then at the joint points
+    let mut velocity = Vec::new();
+    let mut angular_velocity = Vec::new();
+    if let Some(moving) = velocities {
+        let omega = |i: usize| -> (Vec3, Vec3) {
+            if !moving {
+                return (Vec3::zeros(), Vec3::zeros());
+            }
+            let v = state.velocity[i];
+            let w = so3::matrix(&state.q[i]) * Vec3::new(v[3], v[4], v[5]);
+            (Vec3::new(v[0], v[1], v[2]), w)
+        };
+        for i in 0..n_nodes {
+            let (v, w) = omega(i);
+            push3(&mut velocity, &v);
+            push3(&mut angular_velocity, &w);
+        }
+        for (_, a) in &joints {
+            let (v, w) = a.node.map_or((Vec3::zeros(), Vec3::zeros()), |n| {
+                let (v, w) = omega(n);
+                (v + w.cross(&(a.point - state.x[n])), w)
+            });
+            push3(&mut velocity, &v);
+            push3(&mut angular_velocity, &w);
         }
     }
     for (j, (k, a)) in joints.iter().enumerate() {
@@ -357,14 +459,29 @@ pub fn write_vtu(
     );
 
     // point data
-    doc.xml
-        .push_str("      <PointData Scalars=\"node_id\" Vectors=\"displacement\">\n");
+    let vectors = if mode.is_some() {
+        "mode_displacement"
+    } else {
+        "displacement"
+    };
+    let _ = writeln!(
+        doc.xml,
+        "      <PointData Scalars=\"node_id\" Vectors=\"{vectors}\">"
+    );
     doc.array("node_id", 1, &node_id);
     doc.array("joint_id", 1, &joint_id);
     doc.array("displacement", 3, &displacement);
     doc.array("rotation", 3, &rotation);
     for (c, a) in axes.iter().enumerate() {
         doc.array(&format!("axis_{}", c + 1), 3, a);
+    }
+    if mode.is_some() {
+        doc.array("mode_displacement", 3, &mode_u);
+        doc.array("mode_rotation", 3, &mode_theta);
+    }
+    if velocities.is_some() {
+        doc.array("velocity", 3, &velocity);
+        doc.array("angular_velocity", 3, &angular_velocity);
     }
     doc.xml.push_str("      </PointData>\n");
 
@@ -482,7 +599,7 @@ mod tests {
         write_vtu(
             &path,
             &model,
-            &model.context(0.0, false),
+            &model.context(0.0, crate::elements::Need::RESIDUAL),
             &state,
             Encoding::Ascii,
         )

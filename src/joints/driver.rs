@@ -14,11 +14,13 @@
 //! at the last converged state before `start` (an internal variable).
 
 use super::coordinate::PairCoordinate;
-use super::joint::{add_constraints, scale_of};
+use super::joint::{add_constraints, constraint_kind, scale_of};
 use super::kinematics::{with_scratch, Conf};
 use super::types::Equation;
 use crate::curves::CurveIndex;
-use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext, ExtraKind};
+use crate::elements::{
+    CellShape, ConstraintKind, Element, ElementKind, ElementOutput, EvalContext, Need, Offsets,
+};
 use crate::model::Id;
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -33,8 +35,8 @@ pub struct Driver {
     active: Vec<usize>,
     /// Acting window `[start, end]` of `t`.
     window: (f64, f64),
-    extra: usize,
-    internal: usize,
+    /// Where its multiplier and internal variables are in the state.
+    offsets: Offsets,
 }
 
 /// Names of driver results: the coordinate, its target and the load along
@@ -64,8 +66,7 @@ impl Driver {
             curve,
             active,
             window: (f64::NEG_INFINITY, f64::INFINITY),
-            extra: 0,
-            internal: 0,
+            offsets: Offsets::default(),
         }
     }
 
@@ -87,7 +88,7 @@ impl Driver {
 
     /// Index of `c_start` in the internal variables.
     fn start_slot(&self) -> usize {
-        self.internal + usize::from(self.source.is_angle())
+        self.offsets.internal + usize::from(self.source.is_angle())
     }
 
     fn kind_of_equation(&self) -> Equation {
@@ -100,7 +101,7 @@ impl Driver {
 
     fn reference(&self, state: &State) -> f64 {
         if self.source.is_angle() {
-            state.internal[self.internal]
+            state.internal[self.offsets.internal]
         } else {
             0.0
         }
@@ -113,17 +114,10 @@ impl Driver {
     pub fn load_on_driven_body(&self, ctx: &EvalContext, state: &State) -> (Vec3, Vec3) {
         let mut r = vec![0.0; self.n_local()];
         let c = EvalContext {
-            need_tangent: false,
-            ..*ctx
+            dynamics: false,
+            ..ctx.with_need(Need::RESIDUAL)
         };
-        self.evaluate(
-            &c,
-            state,
-            &mut ElementOutput {
-                residual: &mut r,
-                tangent: &mut Vec::new(),
-            },
-        );
+        self.evaluate(&c, state, &mut ElementOutput::residual(&mut r));
         let nb = self.source.pair.node_b();
         let node = self.source.nodes[nb];
         let rb = so3::matrix(&state.q[node]);
@@ -156,31 +150,32 @@ impl Element for Driver {
     fn nodes(&self) -> &[usize] {
         &self.source.nodes
     }
-    fn n_extra(&self) -> usize {
+    fn n_multipliers(&self) -> usize {
         1
     }
     fn n_internal(&self) -> usize {
         usize::from(self.source.is_angle()) + 1
     }
-    fn set_offsets(&mut self, extra: usize, internal: usize) {
-        self.extra = extra;
-        self.internal = internal;
+    fn set_offsets(&mut self, offsets: Offsets) {
+        self.offsets = offsets;
     }
-    fn extra_kind(&self, ctx: &EvalContext, _k: usize) -> ExtraKind {
-        let e = self.kind_of_equation();
-        ExtraKind::Multiplier {
-            scale: scale_of(&ctx.scaling, e).0,
-            angular: e == Equation::Moment,
-        }
+    fn multiplier_kind(&self, _k: usize) -> ConstraintKind {
+        constraint_kind(self.kind_of_equation())
+    }
+    fn constraints_active(&self, time: f64, _state: &State) -> bool {
+        self.is_active(time)
+    }
+    fn imposed_angle(&self) -> Option<(f64, CurveIndex)> {
+        self.source.is_angle().then_some((self.value, self.curve))
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         if !self.is_active(ctx.time) {
             // released: k λ = 0
             let k = scale_of(&ctx.scaling, self.kind_of_equation()).0;
             let nq = 6 * self.source.nodes.len();
-            out.residual[nq] += k * state.extra[self.extra];
-            if ctx.need_tangent {
-                out.tangent[nq * (nq + 1) + nq] += k;
+            out.residual[nq] += k * state.multipliers[self.offsets.multipliers];
+            if let Some(t) = out.stiffness.as_deref_mut() {
+                t[nq * (nq + 1) + nq] += k;
             }
             return;
         }
@@ -190,7 +185,8 @@ impl Element for Driver {
             c(conf, o);
             o[0] = o[0] + (-target);
         };
-        let lambda = &state.extra[self.extra..self.extra + 1];
+        let m = self.offsets.multipliers;
+        let lambda = &state.multipliers[m..m + 1];
         with_scratch(|sc| {
             sc.local.gather(state, &self.source.nodes, 0..0);
             add_constraints(
@@ -230,7 +226,7 @@ impl Element for Driver {
             let (k, p) = scale_of(&ctx.scaling, self.kind_of_equation());
             all[1] = target;
             // generalised load applied along the coordinate: −(pΦ − kλ)
-            all[2] = k * state.extra[self.extra] - p * (all[0] - target);
+            all[2] = k * state.multipliers[self.offsets.multipliers] - p * (all[0] - target);
             let (f, m) = self.load_on_driven_body(ctx, state);
             all[3..6].copy_from_slice(f.as_slice());
             all[6..9].copy_from_slice(m.as_slice());

@@ -1,7 +1,7 @@
 //! Hyper-dual numbers `a + b ε₁ + c ε₂ + d ε₁ε₂` (ε₁² = ε₂² = 0) and the
 //! small generic 3-vector and 3×3 algebra the joint formulas are written in.
 //!
-//! Evaluating a function `f` with one input perturbed along `ε₁` and
+//! Evaluating a function `f` with one input seeded along `ε₁` and
 //! another along `ε₂` gives, exactly and without truncation error, `f`, its
 //! two first derivatives and the mixed second derivative (Fike & Alonso
 //! 2011). Joint constraints and coordinates are written once, generically

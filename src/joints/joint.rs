@@ -19,8 +19,8 @@ use super::types::{
     JointType,
 };
 use crate::elements::{
-    Attachment, CellShape, ConstraintScaling, Element, ElementKind, ElementOutput, EvalContext,
-    ExtraKind,
+    Attachment, CellShape, ConstraintKind, ConstraintScaling, Element, ElementKind, ElementOutput,
+    EvalContext, Need, Offsets,
 };
 use crate::model::Id;
 use crate::so3::{self, Vec3};
@@ -28,9 +28,14 @@ use crate::state::State;
 
 /// `(k, p)` of an equation kind.
 pub(crate) fn scale_of(s: &ConstraintScaling, e: Equation) -> (f64, f64) {
+    s.of(constraint_kind(e))
+}
+
+/// What an equation of the joint library measures.
+pub(crate) fn constraint_kind(e: Equation) -> ConstraintKind {
     match e {
-        Equation::Force => s.force,
-        Equation::Moment => s.moment,
+        Equation::Force => ConstraintKind::Distance,
+        Equation::Moment => ConstraintKind::Angle,
     }
 }
 
@@ -72,10 +77,9 @@ pub(crate) fn add_constraints<F>(
             out.residual[c] += grad[i * nq + c] * w[i];
         }
     }
-    if !ctx.need_tangent {
+    let Some(t) = out.stiffness.as_deref_mut() else {
         return;
-    }
-    let t = &mut *out.tangent;
+    };
     for i in 0..m {
         let g = &grad[i * nq..(i + 1) * nq];
         for &c in active {
@@ -106,10 +110,9 @@ pub struct Joint {
     kinds: &'static [Equation],
     /// Local unknowns the constraints depend on.
     active: Vec<usize>,
-    /// Offset of the slider parameter (if any) then the multipliers.
-    extra: usize,
-    /// Offset of the unwrap references of the angles.
-    internal: usize,
+    /// Where its slider parameter (if any), multipliers and unwrap
+    /// references of the angles are in the state.
+    offsets: Offsets,
     /// Reference value of the slider parameter.
     s0: f64,
 }
@@ -140,8 +143,7 @@ impl Joint {
             parameters,
             kinds,
             active,
-            extra: 0,
-            internal: 0,
+            offsets: Offsets::default(),
             s0: 0.0,
         }
     }
@@ -183,8 +185,7 @@ impl Joint {
             },
             kinds: JointType::Slider.equations(),
             active,
-            extra: 0,
-            internal: 0,
+            offsets: Offsets::default(),
             s0,
         }
     }
@@ -205,7 +206,8 @@ impl Joint {
     }
 
     fn angle_references<'s>(&self, state: &'s State) -> &'s [f64] {
-        &state.internal[self.internal..self.internal + self.n_internal()]
+        let i = self.offsets.internal;
+        &state.internal[i..i + self.n_internal()]
     }
 
     /// The constraint function of this joint.
@@ -229,7 +231,7 @@ impl Joint {
     pub fn coordinates(&self, state: &State, out: &mut [f64]) {
         let coords = self.joint_type.coordinates();
         if self.joint_type == JointType::Slider {
-            out[0] = state.extra[self.extra];
+            out[0] = state.coordinates[self.offsets.coordinates];
             return;
         }
         let mut local = Local::default();
@@ -255,21 +257,12 @@ impl Joint {
     /// the node of a joint to the ground, or a slider's sliding node):
     /// force, and moment about the joint point, global frame.
     pub fn reaction(&self, ctx: &EvalContext, state: &State) -> (Vec3, Vec3) {
-        let n = self.n_local();
-        let mut r = vec![0.0; n];
-        let mut t = Vec::new();
+        let mut r = vec![0.0; self.n_local()];
         let c = EvalContext {
-            need_tangent: false,
-            ..*ctx
+            dynamics: false,
+            ..ctx.with_need(Need::RESIDUAL)
         };
-        self.evaluate(
-            &c,
-            state,
-            &mut ElementOutput {
-                residual: &mut r,
-                tangent: &mut t,
-            },
-        );
+        self.evaluate(&c, state, &mut ElementOutput::residual(&mut r));
         let node = self.nodes[0];
         let f = -Vec3::new(r[0], r[1], r[2]);
         let rm = so3::matrix(&state.q[node]);
@@ -312,8 +305,11 @@ impl Element for Joint {
     fn nodes(&self) -> &[usize] {
         &self.nodes
     }
-    fn n_extra(&self) -> usize {
-        self.n_coords() + self.kinds.len()
+    fn n_coordinates(&self) -> usize {
+        self.n_coords()
+    }
+    fn n_multipliers(&self) -> usize {
+        self.kinds.len()
     }
     fn n_internal(&self) -> usize {
         self.joint_type
@@ -322,32 +318,23 @@ impl Element for Joint {
             .filter(|c| c.is_angle())
             .count()
     }
-    fn set_offsets(&mut self, extra: usize, internal: usize) {
-        self.extra = extra;
-        self.internal = internal;
+    fn set_offsets(&mut self, offsets: Offsets) {
+        self.offsets = offsets;
     }
-    fn extra_kind(&self, ctx: &EvalContext, k: usize) -> ExtraKind {
-        if k < self.n_coords() {
-            return ExtraKind::Coordinate;
-        }
-        let e = self.kinds[k - self.n_coords()];
-        ExtraKind::Multiplier {
-            scale: scale_of(&ctx.scaling, e).0,
-            angular: e == Equation::Moment,
-        }
+    fn multiplier_kind(&self, k: usize) -> ConstraintKind {
+        constraint_kind(self.kinds[k])
     }
-    fn initial_extra(&self, out: &mut [f64]) {
+    fn initial_coordinates(&self, out: &mut [f64]) {
         if self.joint_type == JointType::Slider {
             out[0] = self.s0;
         }
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
-        let nc = self.n_coords();
-        let lambda = &state.extra[self.extra + nc..self.extra + nc + self.kinds.len()];
+        let (c, m) = (self.offsets.coordinates, self.offsets.multipliers);
+        let lambda = &state.multipliers[m..m + self.kinds.len()];
         let refs = self.angle_references(state);
         with_scratch(|sc| {
-            sc.local
-                .gather(state, &self.nodes, self.extra..self.extra + nc);
+            sc.local.gather(state, &self.nodes, c..c + self.n_coords());
             add_constraints(
                 ctx,
                 &mut sc.local,

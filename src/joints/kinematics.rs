@@ -5,7 +5,7 @@
 //! curve parameter of a slider). Its derivatives are taken along the update
 //! of the unknowns (docs/theory.md §2): `x ← x + Δx`, `R ← R exp(ΔΘ~)`,
 //! coordinates additively. With hyper-dual numbers:
-//! - gradient `gᵣ = ∂f/∂qᵣ`: perturb unknown `r` by ε₁;
+//! - gradient `gᵣ = ∂f/∂qᵣ`: seed unknown `r` with ε₁;
 //! - second derivative `Hᵣ꜀ = ∂gᵣ/∂q꜀` (the tangent of a residual
 //!   `μ·g`): evaluate at `(q ⊕ ε₂e꜀) ⊕ ε₁eᵣ`, i.e. with
 //!   `R (I + ε₂ẽ꜀)(I + ε₁ẽᵣ)`, and read the ε₁ε₂ part. On the rotation
@@ -50,8 +50,8 @@ fn hd(v: f64, d1: f64, d2: f64, d12: f64) -> HyperDual {
 }
 
 impl Local {
-    /// Gathers the configuration of `nodes` and of the coordinate unknowns
-    /// `state.extra[coords]`.
+    /// Gathers the configuration of `nodes` and of the coordinates
+    /// `state.coordinates[coords]`.
     pub fn gather(&mut self, state: &State, nodes: &[usize], coords: std::ops::Range<usize>) {
         self.x.clear();
         self.r.clear();
@@ -60,7 +60,7 @@ impl Local {
             self.x.push(state.x[n]);
             self.r.push(so3::matrix(&state.q[n]));
         }
-        self.coords.extend_from_slice(&state.extra[coords]);
+        self.coords.extend_from_slice(&state.coordinates[coords]);
     }
 
     /// Number of local unknowns: 6 per node plus the coordinates.
@@ -68,7 +68,7 @@ impl Local {
         6 * self.x.len() + self.coords.len()
     }
 
-    /// Sets the hyper-dual configuration with unknown `i` perturbed by ε₁
+    /// Sets the hyper-dual configuration with unknown `i` seeded with ε₁
     /// and unknown `j` by ε₂ (composition `(q ⊕ ε₂eⱼ) ⊕ ε₁eᵢ`).
     fn set(&mut self, i: Option<usize>, j: Option<usize>) -> &Conf {
         let nn = self.x.len();
@@ -76,7 +76,7 @@ impl Local {
         c.x.resize(nn, V3([HyperDual::default(); 3]));
         c.r.resize(nn, M3([V3([HyperDual::default(); 3]); 3]));
         c.coords.resize(self.coords.len(), HyperDual::default());
-        // which component of which node each perturbation touches
+        // which component of which node each seed touches
         let split = |k: Option<usize>| match k {
             Some(k) if k < 6 * nn => (Some(k / 6), k % 6, None),
             Some(k) => (None, 0, Some(k - 6 * nn)),

@@ -11,16 +11,20 @@
 
 pub mod coordinate;
 pub mod driver;
+pub mod hinge;
 pub mod hyperdual;
 pub mod joint;
 pub mod kinematics;
+pub mod latch;
 pub mod spring;
 pub mod types;
 
 pub use coordinate::PairCoordinate;
 pub use driver::Driver;
+pub use hinge::{Branch, HingeLaw, Hysteresis, Response, TapeSpring};
 pub use joint::Joint;
 pub use kinematics::Pair;
+pub use latch::Latch;
 pub use spring::{JointSpring, Law};
 pub use types::{Coordinate, JointType};
 

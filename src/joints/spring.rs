@@ -1,13 +1,15 @@
 //! Springs and dampers on a joint coordinate `c` (hinge angle, stroke):
 //! a generalised force `f_s(c) + f_d(ċ)` along `c`, i.e. the residual
-//! `(f_s + f_d) ∂c/∂q` and its exact tangent
-//! `f_s' g gᵀ + (f_s + f_d) ∂g/∂q + f_d' g (∂ċ/∂q)ᵀ + γ f_d' g gᵀ`, with
-//! `g = ∂c/∂q`, `ċ = g·q̇` and `γ` the integrator's velocity factor
-//! (docs/joints.md §4). In quasi-static analyses `ċ = 0`.
+//! `(f_s + f_d) ∂c/∂q`, its exact stiffness
+//! `f_s' g gᵀ + (f_s + f_d) ∂g/∂q + f_d' g (∂ċ/∂q)ᵀ` and its damping matrix
+//! `∂r/∂v = f_d' g gᵀ` (in the inertia matrix, with the damping weight),
+//! with `g = ∂c/∂q` and `ċ = g·v` (docs/joints.md §4). The damper acts in
+//! dynamics only ([`EvalContext::dynamics`]): in quasi-static analyses
+//! `ċ = 0` and its law gives no force at zero rate.
 
 use super::coordinate::PairCoordinate;
 use super::kinematics::{with_scratch, Local};
-use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext};
+use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext, Offsets};
 use crate::model::Id;
 use crate::state::State;
 
@@ -109,14 +111,11 @@ impl JointSpring {
         }
     }
 
-    /// The local velocities `q̇` of the source's nodes (zero at rest).
+    /// The local velocities `v` of the source's nodes.
     fn velocities(&self, state: &State, v: &mut Vec<f64>) {
         v.clear();
         for &n in &self.source.nodes {
-            match state.velocity.get(n) {
-                Some(w) => v.extend_from_slice(w),
-                None => v.extend_from_slice(&[0.0; 6]),
-            }
+            v.extend_from_slice(&state.velocity[n]);
         }
     }
 
@@ -156,8 +155,8 @@ impl Element for JointSpring {
     fn n_internal(&self) -> usize {
         usize::from(self.source.is_angle())
     }
-    fn set_offsets(&mut self, _extra: usize, internal: usize) {
-        self.internal = internal;
+    fn set_offsets(&mut self, offsets: Offsets) {
+        self.internal = offsets.internal;
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         with_scratch(|sc| {
@@ -174,26 +173,44 @@ impl Element for JointSpring {
             self.velocities(state, v);
             let rate: f64 = g.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
             let (fs, ks) = self.spring.as_ref().map_or((0.0, 0.0), |l| l.eval(c[0]));
+            // the damper's force in dynamics; its slope for the damping
+            // matrix whenever asked
             let (fd, kd) = self.damper.as_ref().map_or((0.0, 0.0), |l| l.eval(rate));
+            let fd = if ctx.dynamics { fd } else { 0.0 };
             let total = fs + fd;
             for r in 0..n {
                 out.residual[r] += total * g[r];
             }
-            if !ctx.need_tangent {
-                return;
+            if let (Some(w), Some(d)) = (ctx.need.inertia, out.inertia.as_deref_mut()) {
+                // ∂r/∂v = f_d' g gᵀ
+                let c = w.damping * kd;
+                if c != 0.0 {
+                    for col in 0..n {
+                        for r in 0..n {
+                            d[col * n + r] += c * g[r] * g[col];
+                        }
+                    }
+                }
             }
+            let Some(stiffness) = out.stiffness.as_deref_mut() else {
+                return;
+            };
             // H = ∂g/∂q, column-major n×n
             let h = &mut sc.hess;
             h.clear();
             h.resize(n * n, 0.0);
             local.add_weighted_hessian(1, &self.active, &f, &[1.0], g, true, h, n);
-            let gamma = ctx.dynamics.map_or(0.0, |d| d.damping);
+            let kd = if ctx.dynamics { kd } else { 0.0 };
             for col in 0..n {
-                // ∂ċ/∂q_col at fixed q̇: Σ_r v_r H[r, col]
-                let dc = (0..n).map(|r| v[r] * h[col * n + r]).sum::<f64>();
+                // ∂ċ/∂q_col at fixed v: Σ_r v_r H[r, col]
+                let dc = if kd != 0.0 {
+                    (0..n).map(|r| v[r] * h[col * n + r]).sum::<f64>()
+                } else {
+                    0.0
+                };
                 for r in 0..n {
-                    out.tangent[col * n + r] +=
-                        (ks + gamma * kd) * g[r] * g[col] + total * h[col * n + r] + kd * g[r] * dc;
+                    stiffness[col * n + r] +=
+                        ks * g[r] * g[col] + total * h[col * n + r] + kd * g[r] * dc;
                 }
             }
         });
@@ -213,6 +230,11 @@ impl Element for JointSpring {
     fn strain_energy(&self, _ctx: &EvalContext, state: &State) -> f64 {
         let c = self.source.value(state, self.reference(state));
         self.spring.as_ref().map_or(0.0, |l| l.energy(c))
+    }
+    /// `f_d(ċ) ċ`: the power the damper takes out of the motion.
+    fn dissipated_power(&self, _ctx: &EvalContext, state: &State) -> f64 {
+        let (_, rate, _, fd) = self.forces(state);
+        fd * rate
     }
     fn cell_shape(&self) -> CellShape {
         CellShape::None

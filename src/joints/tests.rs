@@ -7,7 +7,7 @@
 
 use super::types::{Coordinate, JointParameters, SliderCurve};
 use super::*;
-use crate::elements::testing::{eval, tangent_error};
+use crate::elements::testing::{eval, rate_errors, tangent_error};
 use crate::elements::{ConstraintScaling, Element, EvalContext};
 use crate::so3::{self, Mat3, Rotation, Vec3};
 use crate::state::State;
@@ -32,8 +32,8 @@ fn ctx() -> EvalContext<'static> {
         time: 0.4,
         curves: &[],
         gravity: Vec3::zeros(),
-        need_tangent: true,
-        dynamics: None,
+        need: crate::elements::Need::STIFFNESS,
+        dynamics: false,
         scaling: ConstraintScaling {
             force: (3.0, 2.0),
             moment: (5.0, 1.5),
@@ -49,16 +49,19 @@ fn reference(rng: &mut Lcg) -> (Vec<Vec3>, Vec<Rotation>, Mat3, Vec3) {
     (x, q, e, rng.vec(1.0))
 }
 
-/// A state moved away from the reference, with random extras.
-fn moved(rng: &mut Lcg, x: &[Vec3], q: &[Rotation], n_extra: usize, n_internal: usize) -> State {
-    State {
-        time: 0.4,
-        x: x.iter().map(|x| x + rng.vec(0.3)).collect(),
-        q: q.iter().map(|q| q * so3::exp(&rng.vec(0.6))).collect(),
-        extra: (0..n_extra).map(|_| rng.next()).collect(),
-        internal: (0..n_internal).map(|_| 0.2 * rng.next()).collect(),
-        velocity: Vec::new(),
-    }
+/// A state of `e`'s nodes moved away from the reference, with random
+/// coordinates, multipliers and internal variables.
+fn moved(rng: &mut Lcg, x: &[Vec3], q: &[Rotation], e: &dyn Element) -> State {
+    let x = x.iter().map(|x| x + rng.vec(0.3)).collect();
+    let q = q.iter().map(|q| q * so3::exp(&rng.vec(0.6))).collect();
+    let mut s = State::at_rest(0.4, x, q).with_unknowns(
+        (0..e.n_coordinates()).map(|_| rng.next()).collect(),
+        e.n_multipliers(),
+        0,
+    );
+    s.multipliers.iter_mut().for_each(|v| *v = rng.next());
+    s.internal = (0..e.n_internal()).map(|_| 0.2 * rng.next()).collect();
+    s
 }
 
 fn check(e: &dyn Element, s: &State, what: &str) -> f64 {
@@ -101,7 +104,7 @@ fn joint_tangents_match_finite_differences() {
                 };
                 let j = Joint::new(1, t, 0, (!grounded).then_some(1), pair, params);
                 let nn = if grounded { 1 } else { 2 };
-                let s = moved(&mut rng, &x[..nn], &q[..nn], j.n_extra(), j.n_internal());
+                let s = moved(&mut rng, &x[..nn], &q[..nn], &j);
                 let err = tangent_error(&j, &ctx(), &s, 1e-6);
                 worst = worst.max(err);
                 assert!(
@@ -129,9 +132,9 @@ fn slider_tangents_match_finite_differences() {
             let q: Vec<Rotation> = (0..6).map(|_| so3::exp(&rng.vec(1.0))).collect();
             let a = rng.vec(0.1);
             let j = Joint::slider(2, 0, a, &[1, 2, 3, 4, 5], spline, 0.9);
-            let mut s = moved(&mut rng, &x, &q, j.n_extra(), 0);
+            let mut s = moved(&mut rng, &x, &q, &j);
             // s inside the curve, away from the nodes' parameters
-            s.extra[0] = 0.3 + 1.3 * (0.5 + 0.5 * rng.next());
+            s.coordinates[0] = 0.3 + 1.3 * (0.5 + 0.5 * rng.next());
             worst = worst.max(check(&j, &s, &format!("slider (spline {spline})")));
         }
     }
@@ -181,7 +184,7 @@ fn driver_and_spring_tangents_match_finite_differences() {
                 let (src, x, q) = revolute_coordinate(&mut rng, grounded, c);
                 let nn = src.nodes.len();
                 let d = Driver::new(3, src.clone(), 0.7, 0);
-                let s = moved(&mut rng, &x[..nn], &q[..nn], 1, d.n_internal());
+                let s = moved(&mut rng, &x[..nn], &q[..nn], &d);
                 let err = tangent_error(&d, &ctx, &s, 1e-6);
                 assert!(err < 1e-6, "driver on {}: {err:.3e}", c.name());
                 worst = worst.max(err);
@@ -194,19 +197,81 @@ fn driver_and_spring_tangents_match_finite_differences() {
                         Some(law),
                         Some(Law::Linear { k: 0.7, x0: 0.0 }),
                     );
-                    let mut s = moved(&mut rng, &x[..nn], &q[..nn], 0, sp.n_internal());
-                    // nodes moving: the damper contributes too
+                    let mut s = moved(&mut rng, &x[..nn], &q[..nn], &sp);
+                    // nodes moving and spinning: the damper contributes too
                     s.velocity = (0..nn)
-                        .map(|_| std::array::from_fn(|_| rng.next()))
+                        .map(|_| std::array::from_fn(|k| 30.0 * rng.next() + 10.0 * (k as f64)))
+                        .collect();
+                    s.acceleration = (0..nn)
+                        .map(|_| std::array::from_fn(|_| 100.0 * rng.next()))
                         .collect();
                     let err = tangent_error(&sp, &ctx, &s, 1e-6);
                     assert!(err < 1e-6, "spring on {}: {err:.3e}", c.name());
                     worst = worst.max(err);
+                    // in dynamics: the damper's force in the residual, its
+                    // rate terms in the stiffness, ∂r/∂v = f_d' g gᵀ in the
+                    // inertia matrix (steps 1e-3 in v and v̇: the residual
+                    // is linear in v with a linear damping law)
+                    let dynamic = EvalContext {
+                        dynamics: true,
+                        ..ctx
+                    };
+                    let err = tangent_error(&sp, &dynamic, &s, 1e-6);
+                    let (ev, ea) = rate_errors(&sp, &dynamic, &s, 1e-3, 1e-3);
+                    assert!(err < 1e-6, "spring-damper on {}: ∂r/∂q {err:.3e}", c.name());
+                    assert!(ev < 1e-6, "spring-damper on {}: ∂r/∂v {ev:.3e}", c.name());
+                    assert!(ea < 1e-6, "spring-damper on {}: ∂r/∂v̇ {ea:.3e}", c.name());
+                    worst = worst.max(err).max(ev);
                 }
             }
         }
     }
     println!("worst driver and joint-spring tangent error {worst:.2e}");
+}
+
+/// A latch, open (`kλ = 0`) and locked (`Φ = c − c_L`): its tangent, and
+/// the gradient `B` of its coordinate that the impact uses, against
+/// central differences (h = 1e-6; 1e-6 of the largest entry, as above).
+#[test]
+fn latch_tangents_and_gradient_match_finite_differences() {
+    let mut rng = Lcg(11);
+    let coords = [Coordinate::Angle, Coordinate::Slide1, Coordinate::Slide3];
+    let mut worst = 0.0f64;
+    for c in coords {
+        for grounded in [false, true] {
+            for _ in 0..8 {
+                let (src, x, q) = revolute_coordinate(&mut rng, grounded, c);
+                let nn = src.nodes.len();
+                let latch = Latch::new(5, 1, src, 0.3, -1.0);
+                let mut s = moved(&mut rng, &x[..nn], &q[..nn], &latch);
+                let flag = latch.n_internal() - 1;
+                for locked in [0.0, 1.0] {
+                    s.internal[flag] = locked;
+                    assert_eq!(latch.is_locked(&s), locked > 0.5);
+                    let err = tangent_error(&latch, &ctx(), &s, 1e-6);
+                    assert!(err < 1e-6, "latch on {} ({locked}): {err:.3e}", c.name());
+                    worst = worst.max(err);
+                }
+                // B: ∂c/∂q along each local unknown; ċ = B v
+                let (_, grad) = latch.rate(&s);
+                let h = 1e-6;
+                let largest = grad.iter().fold(1e-300f64, |a, g| a.max(g.abs()));
+                for (k, g) in grad.iter().enumerate() {
+                    let cp = latch.coordinate(&crate::elements::testing::moved(&s, &latch, k, h));
+                    let cm = latch.coordinate(&crate::elements::testing::moved(&s, &latch, k, -h));
+                    let fd = (cp - cm) / (2.0 * h);
+                    assert!(
+                        (fd - g).abs() < 1e-6 * largest,
+                        "{}: ∂c/∂q{k} {g} vs {fd}",
+                        c.name()
+                    );
+                    worst = worst.max((fd - g).abs() / largest);
+                }
+                assert!((latch.gap(&s) + (latch.coordinate(&s) - 0.3)).abs() < 1e-15);
+            }
+        }
+    }
+    println!("worst latch tangent and gradient error {worst:.2e}");
 }
 
 /// A node driver measures the node's own motion along a fixed direction.
@@ -221,22 +286,22 @@ fn node_driver_coordinate_is_the_displacement_along_its_direction() {
         pair: Pair::node_to_ground(&x, &r, &e),
         coordinate: Coordinate::Slide3,
     };
-    let s = State {
-        x: vec![x + Vec3::new(0.5, 1.0, -2.0)],
-        q: vec![so3::from_matrix(&r) * so3::exp(&Vec3::new(0.4, 0.1, 0.0))],
-        ..State::default()
-    };
+    let s = State::at_rest(
+        0.0,
+        vec![x + Vec3::new(0.5, 1.0, -2.0)],
+        vec![so3::from_matrix(&r) * so3::exp(&Vec3::new(0.4, 0.1, 0.0))],
+    );
     assert!((src.value(&s, 0.0) - (0.6 - 1.6)).abs() < 1e-14);
     // rotation about dir by 0.3 rad (applied in the global frame)
     let rot = PairCoordinate {
         coordinate: Coordinate::Angle,
         ..src
     };
-    let s = State {
-        x: vec![x],
-        q: vec![so3::exp(&(dir * 0.3)) * so3::from_matrix(&r)],
-        ..State::default()
-    };
+    let s = State::at_rest(
+        0.0,
+        vec![x],
+        vec![so3::exp(&(dir * 0.3)) * so3::from_matrix(&r)],
+    );
     assert!((rot.value(&s, 0.0) - 0.3).abs() < 1e-14);
     let _ = eval;
     let _ = SliderCurve { spline: true };

@@ -106,9 +106,19 @@ element_handle!(
     ElementKind::JointSpring
 );
 element_handle!(
+    /// A hysteretic moment law on a joint coordinate.
+    HingeLawHandle,
+    ElementKind::HingeLaw
+);
+element_handle!(
     /// A driver.
     DriverHandle,
     ElementKind::Driver
+);
+element_handle!(
+    /// A latch.
+    LatchHandle,
+    ElementKind::Latch
 );
 
 /// The nodes and elements of a beam line.
@@ -214,7 +224,11 @@ impl Model {
         let e = self.element(handle);
         let names = e.result_names();
         let mut values = vec![0.0; names.len()];
-        e.results(&self.context(state.time, false), state, &mut values);
+        e.results(
+            &self.context(state.time, crate::elements::Need::RESIDUAL),
+            state,
+            &mut values,
+        );
         ElementResults { names, values }
     }
 

@@ -43,6 +43,31 @@ impl AngleUnit {
     }
 }
 
+/// The keys of the top level of a model file ([`ModelInput`]'s fields).
+pub const TOP_LEVEL_KEYS: [&str; 21] = [
+    "title",
+    "analysis",
+    "nodes",
+    "sections",
+    "beams",
+    "beam_lines",
+    "rigid_bodies",
+    "point_masses",
+    "springs",
+    "supports",
+    "prescribed",
+    "loads",
+    "gravity",
+    "curves",
+    "joints",
+    "joint_springs",
+    "hinge_laws",
+    "drivers",
+    "latches",
+    "initial_motion",
+    "output",
+];
+
 /// A complete model definition.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -50,9 +75,10 @@ pub struct ModelInput {
     /// Free text describing the model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub title: Option<String>,
-    /// The analysis to run and its parameters.
+    /// The analysis to run and its parameters: one `[analysis]` table, or
+    /// a sequence of `[[analysis]]` tables run one after the other.
     #[serde(default)]
-    pub analysis: AnalysisInput,
+    pub analysis: Analyses,
     /// Nodes: positions and orientations of the reference configuration.
     #[serde(default)]
     pub nodes: Vec<NodeInput>,
@@ -95,9 +121,33 @@ pub struct ModelInput {
     /// Springs and dampers on joint coordinates.
     #[serde(default)]
     pub joint_springs: Vec<JointSpringInput>,
+    /// Hysteretic moment laws on joint coordinates (hinge laws with
+    /// memory).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hinge_laws: Vec<HingeLawInput>,
     /// Prescribed histories of joint coordinates or node components.
     #[serde(default)]
     pub drivers: Vec<DriverInput>,
+    /// Locks of joint coordinates at the end of their travel.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub latches: Vec<LatchInput>,
+    /// Rigid motions of sets of nodes at the start (dynamic analyses).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub initial_motion: Vec<InitialMotionInput>,
+    /// What a run writes besides the result files (`[output]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<OutputInput>,
+}
+
+/// `[output]`: files a run writes besides the results.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OutputInput {
+    /// Times at which a restart file `restart-<t>.json` is written
+    /// (besides `restart.json` at the end of every run), in increasing
+    /// order, within the analyses; the analyses land on them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub restart_times: Vec<f64>,
 }
 
 /// A kinematic pair between node A and node B (or the ground).
@@ -184,6 +234,76 @@ pub struct JointSpringInput {
     pub damping_table: Vec<[f64; 2]>,
 }
 
+/// A hysteretic moment law on a joint coordinate (docs/joints.md §4.1):
+/// two bounding branches, given as tables or as the tape-spring shape,
+/// and the elastic slope between them.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct HingeLawInput {
+    /// Element id.
+    pub id: Id,
+    /// The joint.
+    pub joint: Id,
+    /// Which coordinate (`angle`, `slide`, `angle1`...), default the joint's
+    /// first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Unit of the angles when the coordinate is an angle: table abscissae,
+    /// the angles of the tape-spring shape, and the angle in the slopes
+    /// (N·m per unit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+    /// `k_e > 0`: slope of the moment between the bounds (N·m/rad or N/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elastic_slope: Option<f64>,
+    /// The loading bound `f_load`: points `[coordinate, moment]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub load_table: Vec<[f64; 2]>,
+    /// The unloading bound `f_unload`: points `[coordinate, moment]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unload_table: Vec<[f64; 2]>,
+    /// Both bounds from the analytic tape-spring shape.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tape_spring: Option<TapeSpringInput>,
+    /// The bound the hinge starts on in the reference configuration:
+    /// `load` (default) or `unload`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<StartBranch>,
+}
+
+/// The bound a hinge law starts on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StartBranch {
+    /// The loading bound `f_load(0)`.
+    #[default]
+    Load,
+    /// The unloading bound `f_unload(0)`.
+    Unload,
+}
+
+/// Parameters of the tape-spring shape (docs/joints.md §4.1), angles in
+/// the unit of the entry.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TapeSpringInput {
+    /// `M_d ≥ 0`: moment deploying the hinge over its travel (N·m).
+    pub deployment_moment: f64,
+    /// `c_L`: angle at which the hinge locks.
+    pub locking_angle: f64,
+    /// `M_L > M_d`: moment that unlocks (folds) the locked hinge (N·m).
+    pub locking_peak: f64,
+    /// `K > 0`: slope of the locked branch (N·m per angle unit).
+    pub locked_stiffness: f64,
+    /// `w > 0`: width over which the moment falls from `M_L` to `M_d` when
+    /// the hinge unlocks.
+    pub snap_width: f64,
+    /// `h ≥ 0`: half-width of the rounding of the corners (default: a
+    /// quarter of the smaller of `w` and `M_d/K`; 0 for sharp corners).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rounding: Option<f64>,
+}
+
 /// A prescribed history `value · f(t)` of a joint coordinate, or of a
 /// node's translation along or rotation about a direction, relative to the
 /// reference configuration.
@@ -223,22 +343,163 @@ pub struct DriverInput {
     pub active: Option<[f64; 2]>,
 }
 
-/// Kind and parameters of the analysis.
+/// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
+/// when it reaches `value` moving in the direction of approach, and stays
+/// locked.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LatchInput {
+    /// Element id.
+    pub id: Id,
+    /// The joint.
+    pub joint: Id,
+    /// Which coordinate (`angle`, `slide`, `angle1`...), default the joint's
+    /// first.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinate: Option<String>,
+    /// Locking value `c_L` (m, or rad unless `unit` says otherwise).
+    pub value: f64,
+    /// Unit of `value` for an angle coordinate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+    /// `increasing` or `decreasing`: how the coordinate reaches `value`
+    /// (default: away from the reference configuration, where it is 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub approach: Option<Approach>,
+    /// `rigid` (default): once locked, `c = c_L` is a constraint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mode: Option<LatchMode>,
+}
+
+/// How a latch's coordinate reaches its locking value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Approach {
+    /// With the coordinate increasing.
+    Increasing,
+    /// With the coordinate decreasing.
+    Decreasing,
+}
+
+/// What a latch does once locked.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LatchMode {
+    /// `c − c_L = 0` is a constraint with a multiplier.
+    #[default]
+    Rigid,
+}
+
+/// The analyses of a model: one (`[analysis]`, the default static analysis
+/// when the table is absent) or a sequence run in order (`[[analysis]]`),
+/// each starting from the final state of the one before. Never empty.
+///
+/// It dereferences to the first analysis, so that a model with one
+/// analysis reads and sets it as `input.analysis.end_time`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Analyses(Vec<AnalysisInput>);
+
+impl Analyses {
+    /// A sequence of analyses; `None` if it is empty.
+    pub fn sequence(analyses: Vec<AnalysisInput>) -> Option<Self> {
+        (!analyses.is_empty()).then_some(Self(analyses))
+    }
+
+    /// The analyses, in order.
+    pub fn all(&self) -> &[AnalysisInput] {
+        &self.0
+    }
+
+    /// Appends an analysis to the sequence.
+    pub fn push(&mut self, analysis: AnalysisInput) {
+        self.0.push(analysis);
+    }
+}
+
+impl Default for Analyses {
+    fn default() -> Self {
+        Self(vec![AnalysisInput::default()])
+    }
+}
+
+impl From<AnalysisInput> for Analyses {
+    fn from(a: AnalysisInput) -> Self {
+        Self(vec![a])
+    }
+}
+
+impl std::ops::Deref for Analyses {
+    type Target = AnalysisInput;
+    fn deref(&self) -> &AnalysisInput {
+        &self.0[0]
+    }
+}
+
+impl std::ops::DerefMut for Analyses {
+    fn deref_mut(&mut self) -> &mut AnalysisInput {
+        &mut self.0[0]
+    }
+}
+
+impl Serialize for Analyses {
+    /// One analysis as a table (`[analysis]`), a sequence as an array of
+    /// tables (`[[analysis]]`).
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match &self.0[..] {
+            [one] => one.serialize(s),
+            all => all.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Analyses {
+    /// A table or a non-empty array of tables; the messages of a table's
+    /// fields are those of [`AnalysisInput`], with their place in the file.
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = Analyses;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an [analysis] table or a sequence of [[analysis]] tables")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Analyses, A::Error> {
+                let one =
+                    AnalysisInput::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                Ok(Analyses(vec![one]))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Analyses, A::Error> {
+                let all = Vec::<AnalysisInput>::deserialize(
+                    serde::de::value::SeqAccessDeserializer::new(seq),
+                )?;
+                Analyses::sequence(all).ok_or_else(|| {
+                    serde::de::Error::invalid_length(0, &"at least one [[analysis]] table")
+                })
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
+}
+
+/// Kind and parameters of an analysis.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct AnalysisInput {
     /// Analysis type: `"static"` (default) or its alias `"kinetostatic"`
-    /// (nonlinear statics, loads and drivers), or `"kinematic"` (the
-    /// joints and drivers must determine every unknown).
+    /// (nonlinear statics, loads and drivers), `"kinematic"` (the
+    /// joints and drivers must determine every unknown), or `"modal"`
+    /// (natural frequencies and modes about the state reached).
     #[serde(rename = "type", default = "default_analysis_type")]
     pub kind: String,
-    /// Final value of the load parameter `t` (pseudo-time), default 1.
+    /// Final value of the load parameter `t` (pseudo-time), default 1 (each
+    /// analysis of a sequence ends later than the one before).
     #[serde(default = "default_end_time")]
     pub end_time: f64,
-    /// First increment of `t`, default `end_time / 10`.
+    /// First increment of `t`, default a tenth of the analysis's span
+    /// (`end_time / 10` for the first).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_increment: Option<f64>,
-    /// Smallest increment before the analysis gives up, default `end_time · 1e-6`.
+    /// Smallest increment before the analysis gives up, default 1e-6 of the
+    /// span (`end_time · 1e-6` for the first).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_increment: Option<f64>,
     /// Largest increment, default the initial increment.
@@ -260,6 +521,10 @@ pub struct AnalysisInput {
     /// last increment is always written.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output_every: Option<usize>,
+    /// Values of `t` the analysis lands on exactly and writes results at
+    /// (increasing, within the analysis's span).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_times: Option<Vec<f64>>,
     /// Scaling factor `k` of constraint equations (eq. 17), default the
     /// largest diagonal stiffness of the model (docs/joints.md §1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -276,6 +541,41 @@ pub struct AnalysisInput {
     /// Arc-length control: largest number of increments, default 1000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_increments: Option<usize>,
+    /// Dynamics: first time step, default a hundredth of the span.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_step: Option<f64>,
+    /// Dynamics: smallest time step, default `time_step · 1e-6`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_step: Option<f64>,
+    /// Dynamics: largest time step, default a tenth of the span (adaptive)
+    /// or `time_step` (fixed steps).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_step: Option<f64>,
+    /// Dynamics: spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`,
+    /// default 0.9.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_infinity: Option<f64>,
+    /// Dynamics: relative tolerance of the local error estimate, default
+    /// 1e-4.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error_tolerance: Option<f64>,
+    /// Dynamics: whether the step follows the error estimate (default
+    /// true); `false` for fixed steps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<bool>,
+    /// Modal analysis: number of modes, default 10.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modes: Option<usize>,
+    /// Modal analysis: frequency (Hz) near which the modes are sought.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shift: Option<f64>,
+    /// Modal analysis: only the modes in `[low, high]` (Hz).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frequency_range: Option<[f64; 2]>,
+    /// Modal analysis: eigen-solver, `auto` (default), `dense` or
+    /// `lanczos`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solver: Option<String>,
 }
 
 fn default_analysis_type() -> String {
@@ -298,10 +598,21 @@ impl Default for AnalysisInput {
             displacement_tolerance: None,
             rotation_tolerance: None,
             output_every: None,
+            output_times: None,
             constraint_scale: None,
             constraint_penalty: None,
             control: None,
             max_increments: None,
+            time_step: None,
+            min_step: None,
+            max_step: None,
+            rho_infinity: None,
+            error_tolerance: None,
+            adaptive: None,
+            modes: None,
+            shift: None,
+            frequency_range: None,
+            solver: None,
         }
     }
 }
@@ -320,6 +631,30 @@ pub struct NodeInput {
     /// Unit of `rotation` (its length is the angle).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unit: Option<AngleUnit>,
+    /// Initial velocity (global frame), default zero; dynamic analyses.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<[f64; 3]>,
+    /// Initial angular velocity (global frame, rad/s), default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_velocity: Option<[f64; 3]>,
+}
+
+/// `[[initial_motion]]`: a rigid motion given to a set of nodes at the
+/// start, `v(x) = v + ω × (x − about)`, `ω` to every node (global frame).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct InitialMotionInput {
+    /// The nodes that move together.
+    pub nodes: Vec<Id>,
+    /// Velocity of the point `about`, default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<[f64; 3]>,
+    /// Angular velocity (rad/s), default zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_velocity: Option<[f64; 3]>,
+    /// The point whose velocity is `velocity`, default the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub about: Option<[f64; 3]>,
 }
 
 /// Cross-section properties of a beam.
@@ -360,6 +695,14 @@ pub struct SectionInput {
     /// (ρJ, ρI₂, ρI₃), default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inertia_per_length: Option<[f64; 3]>,
+    /// Rayleigh damping, mass-proportional coefficient `α` (1/s), default
+    /// 0 (docs/theory.md §11.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh_alpha: Option<f64>,
+    /// Rayleigh damping, stiffness-proportional coefficient `β` (s),
+    /// default 0 (docs/theory.md §11.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rayleigh_beta: Option<f64>,
 }
 
 impl SectionInput {
@@ -653,6 +996,8 @@ impl ModelInput {
             x,
             rotation: None,
             unit: None,
+            velocity: None,
+            angular_velocity: None,
         });
         self
     }

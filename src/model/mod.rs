@@ -1,11 +1,14 @@
 //! The validated, immutable model: nodes, elements, supports, prescribed
-//! motions, curves and analysis settings, with ids resolved to indices.
+//! motions and curves, with ids resolved to indices.
 //!
 //! A [`Model`] is built from a [`input::ModelInput`] (read from a model file
 //! or written in Rust) by [`Model::from_input`], which checks everything and
 //! reports every problem it finds, each naming the entity concerned, and
 //! keeps the warnings (input that is valid but probably not what was
-//! meant) in [`Model::warnings`] for the caller to show.
+//! meant) in [`Model::warnings`] for the caller to show. The analyses the
+//! input asks for are not part of the model: [`input::ModelInput::analyses`]
+//! gives their settings ([`crate::analysis::AnalysisSettings`]), and an
+//! analysis takes the model (shared, `Arc<Model>`) and a start state.
 
 mod build;
 pub mod builder;
@@ -15,7 +18,7 @@ pub mod input;
 use std::fmt;
 
 use crate::curves::{Curve, CurveIndex};
-use crate::elements::{ConstraintScaling, Element, ElementKind, EvalContext};
+use crate::elements::{ConstraintScaling, Element, ElementKind, EvalContext, Need, Offsets};
 use crate::so3::{Rotation, Vec3};
 use crate::state::State;
 
@@ -29,8 +32,9 @@ pub use build::{
 };
 pub use builder::ModelBuilder;
 pub use handles::{
-    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, JointHandle,
-    JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle, SpringHandle,
+    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
+    JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
+    RigidBodyHandle, SpringHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.
@@ -61,37 +65,12 @@ pub enum Prescribed {
     },
 }
 
-/// Parameters of the nonlinear static analysis (see docs/model-format.md,
-/// `[analysis]`, for the meaning and default of each).
-#[derive(Clone, Debug, PartialEq)]
-pub struct StaticSettings {
-    /// Final value of the load parameter.
-    pub end_time: f64,
-    /// First increment.
-    pub initial_increment: f64,
-    /// Smallest increment allowed after cut-backs.
-    pub min_increment: f64,
-    /// Largest increment allowed when increments grow again.
-    pub max_increment: f64,
-    /// Newton iterations per increment before a cut-back.
-    pub max_iterations: usize,
-    /// Residual tolerance, relative to the force flux.
-    pub residual_tolerance: f64,
-    /// Displacement increment tolerance, relative to the largest
-    /// translation of the increment.
-    pub displacement_tolerance: f64,
-    /// Rotation increment tolerance (radians).
-    pub rotation_tolerance: f64,
-    /// Results are written every this many increments.
-    pub output_every: usize,
-    /// Kinematic analysis: the joints and drivers must determine every
-    /// unknown (docs/joints.md §6).
-    pub kinematic: bool,
-    /// Arc-length path control instead of load increments.
-    pub arc_length: bool,
-    /// Arc-length control: largest number of increments.
-    pub max_increments: usize,
-}
+/// The most a prescribed rotation or a driven angle may turn in one load
+/// increment: a quarter turn, half of the half turn beyond which the
+/// increment would be ambiguous, leaving the other half to the Newton
+/// iterations of the free rotations that follow it
+/// ([`Model::rotation_step_limit`]).
+pub const MAX_TURN_PER_INCREMENT: f64 = std::f64::consts::FRAC_PI_2;
 
 /// A validated model.
 pub struct Model {
@@ -122,13 +101,20 @@ pub struct Model {
     pub warnings: Vec<ModelWarning>,
     /// Gravity acceleration and its curve.
     pub gravity: Option<(Vec3, CurveIndex)>,
-    /// Analysis settings.
-    pub settings: StaticSettings,
     /// Diagonal of the bounding box of the nodes (1 if zero): the length
     /// against which displacement tolerances are measured.
     pub length_scale: f64,
     /// Scaling and penalty of the constraint equations.
     pub scaling: ConstraintScaling,
+    /// Initial velocity of each node: `(ẋ, ω)`, both global (zero unless
+    /// the model gives them, for dynamic analyses).
+    pub initial_velocity: Vec<[f64; 6]>,
+    /// Where each element's coordinates, multipliers and internal
+    /// variables start in the state.
+    offsets: Vec<Offsets>,
+    /// Sizes of the state's coordinates, multipliers and internal
+    /// variables.
+    sizes: Offsets,
 }
 
 /// A quantity that follows a curve.
@@ -168,43 +154,79 @@ impl Model {
         self.node_ids.len()
     }
 
-    /// The reference (initial) state.
+    /// The reference (initial) state, at rest at `t = 0`: what a first
+    /// analysis starts from.
     pub fn initial_state(&self) -> State {
-        let mut extra = vec![0.0; self.elements.iter().map(|e| e.n_extra()).sum()];
-        let mut offset = 0;
-        for e in &self.elements {
-            e.initial_extra(&mut extra[offset..offset + e.n_extra()]);
-            offset += e.n_extra();
+        let mut coordinates = vec![0.0; self.sizes.coordinates];
+        for (e, o) in self.elements.iter().zip(&self.offsets) {
+            e.initial_coordinates(
+                &mut coordinates[o.coordinates..o.coordinates + e.n_coordinates()],
+            );
         }
-        State {
-            time: 0.0,
-            x: self.reference_x.clone(),
-            q: self.reference_q.clone(),
-            extra,
-            internal: vec![0.0; self.elements.iter().map(|e| e.n_internal()).sum()],
-            velocity: Vec::new(),
+        let mut state = State::at_rest(0.0, self.reference_x.clone(), self.reference_q.clone())
+            .with_unknowns(coordinates, self.sizes.multipliers, self.sizes.internal);
+        // velocities: ẋ global, Ω = Rᵀω material
+        for (i, v) in self.initial_velocity.iter().enumerate() {
+            let w = self.reference_q[i].inverse() * Vec3::new(v[3], v[4], v[5]);
+            state.velocity[i] = [v[0], v[1], v[2], w.x, w.y, w.z];
         }
+        state
     }
 
-    /// Adds an element, telling it where its extra unknowns and internal
-    /// variables are stored in the state.
-    pub fn push_element(&mut self, mut e: Box<dyn Element>) {
-        let extra = self.elements.iter().map(|e| e.n_extra()).sum();
-        let internal = self.elements.iter().map(|e| e.n_internal()).sum();
-        e.set_offsets(extra, internal);
+    /// Sets the initial velocity of node `node` (index): `v` and the
+    /// angular velocity `w`, both global.
+    pub fn set_initial_velocity(&mut self, node: usize, v: Vec3, w: Vec3) {
+        if self.initial_velocity.len() != self.n_nodes() {
+            self.initial_velocity = vec![[0.0; 6]; self.n_nodes()];
+        }
+        self.initial_velocity[node] = [v.x, v.y, v.z, w.x, w.y, w.z];
+    }
+
+    /// Where the coordinates, multipliers and internal variables of
+    /// element `e` start in the state.
+    pub fn offsets(&self, e: usize) -> Offsets {
+        self.offsets[e]
+    }
+
+    /// Numbers of coordinates, multipliers and internal variables of the
+    /// state.
+    pub fn state_sizes(&self) -> Offsets {
+        self.sizes
+    }
+
+    /// Tells every element where its unknowns and internal variables are
+    /// in the state (after the element list changed).
+    fn place_elements(&mut self) {
+        self.offsets.clear();
+        let mut o = Offsets::default();
+        for e in &mut self.elements {
+            e.set_offsets(o);
+            self.offsets.push(o);
+            o.coordinates += e.n_coordinates();
+            o.multipliers += e.n_multipliers();
+            o.internal += e.n_internal();
+        }
+        self.sizes = o;
+    }
+
+    /// Adds an element, telling it where its coordinates, multipliers and
+    /// internal variables are stored in the state.
+    pub fn push_element(&mut self, e: Box<dyn Element>) {
         self.element_lookup
             .insert((e.kind(), e.id()), self.elements.len());
         self.elements.push(e);
+        self.place_elements();
     }
 
-    /// The evaluation context at load parameter `time`.
-    pub fn context(&self, time: f64, need_tangent: bool) -> EvalContext<'_> {
+    /// The evaluation context at load parameter `time` (statics: no
+    /// inertia forces) asking for `need`.
+    pub fn context(&self, time: f64, need: Need) -> EvalContext<'_> {
         EvalContext {
             time,
             curves: &self.curves,
             gravity: self.gravity_at(time),
-            need_tangent,
-            dynamics: None,
+            need,
+            dynamics: false,
             scaling: self.scaling,
         }
     }
@@ -212,18 +234,16 @@ impl Model {
     /// Updates the internal variables of every element after `state` has
     /// converged (unwrapped joint angles).
     pub fn update_internal(&self, state: &mut State) {
-        let ctx = self.context(state.time, false);
-        let mut offset = 0;
+        let ctx = self.context(state.time, Need::RESIDUAL);
         let mut buf = Vec::new();
-        for e in &self.elements {
-            let n = e.n_internal();
+        for (e, o) in self.elements.iter().zip(&self.offsets) {
+            let (n, offset) = (e.n_internal(), o.internal);
             if n > 0 {
                 buf.clear();
                 buf.extend_from_slice(&state.internal[offset..offset + n]);
                 e.update_internal(&ctx, state, &mut buf);
                 state.internal[offset..offset + n].copy_from_slice(&buf);
             }
-            offset += n;
         }
     }
 
@@ -246,11 +266,11 @@ impl Model {
                 force: (0.0, 0.0),
                 moment: (0.0, 0.0),
             },
-            ..self.context(0.0, true)
+            ..self.context(0.0, Need::STIFFNESS)
         };
         let (mut kf, mut km) = (0.0f64, 0.0f64);
         for e in &self.elements {
-            if e.n_extra() > 0 {
+            if e.n_coordinates() + e.n_multipliers() > 0 {
                 continue;
             }
             let n = e.n_local();
@@ -259,10 +279,7 @@ impl Model {
             e.evaluate(
                 &ctx,
                 &state,
-                &mut crate::elements::ElementOutput {
-                    residual: &mut r,
-                    tangent: &mut t,
-                },
+                &mut crate::elements::ElementOutput::with_stiffness(&mut r, &mut t),
             );
             for i in 0..6 * e.nodes().len() {
                 let d = t[i * n + i].abs();
@@ -332,6 +349,30 @@ impl Model {
             Some((g, c)) => g * self.curves[c].value(t),
             None => Vec3::zeros(),
         }
+    }
+
+    /// The largest load increment over which no prescribed rotation and no
+    /// driven angle changes by more than [`MAX_TURN_PER_INCREMENT`]
+    /// anywhere in `[0, end_time]`, if any of them moves: beyond half a
+    /// turn an increment cannot tell a rotation from the same rotation less
+    /// a full turn (docs/joints.md §3.3), so a larger increment would miss
+    /// whole turns or converge to the wrong branch. Load control keeps its
+    /// increments below it.
+    pub fn rotation_step_limit(&self, end_time: f64) -> Option<f64> {
+        let prescribed = self.prescribed.iter().filter_map(|p| match p {
+            Prescribed::Rotation { psi, curve, .. } => Some((psi.norm(), *curve)),
+            Prescribed::Translation { .. } => None,
+        });
+        let driven = self.elements.iter().filter_map(|e| e.imposed_angle());
+        prescribed
+            .chain(driven)
+            .filter(|&(amplitude, curve)| {
+                amplitude != 0.0 && !self.curves[curve].is_constant_on(end_time)
+            })
+            .map(|(amplitude, curve)| {
+                self.curves[curve].largest_step(amplitude, MAX_TURN_PER_INCREMENT, end_time)
+            })
+            .reduce(f64::min)
     }
 
     /// Sets the prescribed components of `state` to their values at `t`.

@@ -4,7 +4,7 @@
 use std::collections::HashSet;
 
 use super::curves::CONSTANT;
-use super::{Builder, Checker, NodeData, MAX_LINE_ELEMENTS};
+use super::{num, Builder, Checker, NodeData, MAX_LINE_ELEMENTS};
 use crate::elements::beam::{Beam, InitialStrain};
 use crate::model::input::{Id, MAX_ID};
 use crate::model::ModelErrorKind;
@@ -78,6 +78,31 @@ impl Builder<'_> {
                 c
             }
         };
+        // the natural length L(1 + ε f(t)) must stay positive
+        if ok && strain[0] != 0.0 {
+            let (lo, hi) = match curve {
+                Some(c) => self.curves.curves[c].range(self.curves.end_time),
+                None => (1.0, 1.0),
+            };
+            let shortest = (strain[0] * lo).min(strain[0] * hi);
+            if shortest <= -1.0 {
+                let scaled = match (initial_strain_curve, curve) {
+                    (Some(name), Some(_)) if shortest != strain[0] => {
+                        format!(" (times curve \"{name}\": down to {})", num(shortest))
+                    }
+                    _ => String::new(),
+                };
+                self.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!(
+                        "initial axial strain {}{scaled} must stay above -1: the natural length L(1 + strain) would be zero or negative",
+                        num(strain[0])
+                    ),
+                );
+                ok = false;
+            }
+        }
         ok.then(|| (orientation.map(Vec3::from), InitialStrain { strain, curve }))
     }
 
@@ -324,6 +349,30 @@ impl Builder<'_> {
                     format!(
                         "zero length: nodes {} and {} coincide",
                         self.node_ids[a], self.node_ids[b]
+                    ),
+                );
+                continue;
+            }
+            // the stress-free relative rotation of the end sections, L κ₀,
+            // must be one the element can take: φ = log(Λ₁ᵀΛ₂) is at most
+            // half a turn (docs/theory.md §3.1)
+            let kappa = Vec3::new(
+                spec.initial.strain[3],
+                spec.initial.strain[4],
+                spec.initial.strain[5],
+            );
+            let scale = spec.initial.curve.map_or(1.0, |c| {
+                self.curves.curves[c].magnitude(self.curves.end_time)
+            });
+            let turn = kappa.norm() * scale * axis.norm();
+            if turn >= std::f64::consts::PI {
+                report(
+                    &mut self.ck,
+                    ModelErrorKind::Invalid,
+                    format!(
+                        "its initial twist and curvature {:?} turn its end sections by {turn:.4} rad over its length {}: at least half a turn, which one element cannot take (the relative rotation of its ends is at most π); divide it into more elements",
+                        kappa.as_slice(),
+                        num(axis.norm())
                     ),
                 );
                 continue;

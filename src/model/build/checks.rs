@@ -15,15 +15,14 @@ use crate::model::{Id, Model, ModelError, ModelErrorKind};
 /// a load times its curve), on which the analysis could only stop. One
 /// error per kind of element and time, naming the first element and
 /// counting the others.
-pub(super) fn non_finite_elements(model: &Model) -> Vec<ModelError> {
+pub(super) fn non_finite_elements(model: &Model, end: f64) -> Vec<ModelError> {
     let mut errors = Vec::new();
     let mut bad = vec![false; model.elements.len()];
-    let end = model.settings.end_time;
     for t in [0.0, 0.5 * end, end] {
         let mut state = model.initial_state();
         state.time = t;
         model.apply_prescribed(&mut state, t);
-        let ctx = model.context(t, true);
+        let ctx = model.context(t, crate::elements::Need::STIFFNESS);
         // (kind, first entity, count) of the elements found at this time
         let mut found: Vec<(ElementKind, String, usize)> = Vec::new();
         for (k, e) in model.elements.iter().enumerate() {
@@ -35,10 +34,7 @@ pub(super) fn non_finite_elements(model: &Model) -> Vec<ModelError> {
             e.evaluate(
                 &ctx,
                 &state,
-                &mut crate::elements::ElementOutput {
-                    residual: &mut r,
-                    tangent: &mut tangent,
-                },
+                &mut crate::elements::ElementOutput::with_stiffness(&mut r, &mut tangent),
             );
             if r.iter()
                 .chain(&tangent)

@@ -3,16 +3,18 @@
 
 use super::curves::RAMP;
 use super::joints::{angle_unit, joint_coordinate, triad, Context, Joints};
+use super::AngleLimit;
 use crate::joints::types::Coordinate;
 use crate::joints::{Driver, Pair, PairCoordinate};
 use crate::model::input::DriverInput;
 use crate::model::ModelErrorKind;
 use crate::so3;
+use std::f64::consts::FRAC_PI_2;
 
-/// Largest change of a driven angle in one increment: the branch of an
-/// angle is followed only while an increment turns it by less than half a
-/// turn (docs/joints.md §3.3).
-const MAX_TURN_PER_INCREMENT: f64 = std::f64::consts::PI;
+/// Change of a driven angle in one increment beyond which the increment is
+/// ambiguous: the branch of an angle is followed only while an increment
+/// turns it by less than half a turn (docs/joints.md §3.3).
+const AMBIGUOUS_TURN: f64 = std::f64::consts::PI;
 
 pub(super) fn driver(
     cx: &mut Context,
@@ -107,8 +109,16 @@ pub(super) fn driver(
             return None;
         }
     };
-    if source.is_angle() {
-        warn_fast_angle(cx, entity, d, value, curve);
+    // a value meant in degrees: the per-increment warning, when it
+    // applies, already says so
+    if source.is_angle() && !warn_fast_angle(cx, entity, d, value, curve) && d.unit.is_none() {
+        let total = value.abs() * cx.curves.curves[curve].magnitude(cx.curves.end_time);
+        cx.ck.unitless_angle(
+            entity,
+            "drives its angle up to",
+            total,
+            AngleLimit::FullTurn,
+        );
     }
     let driver = Driver::new(d.id, source, value, curve);
     Some(match window {
@@ -118,17 +128,25 @@ pub(super) fn driver(
 }
 
 /// Warns when a driven angle would turn by more than half a turn in one
-/// of the largest increments: the increments are then cut back until they
-/// ask less; a value meant in degrees and read in radians does this.
-fn warn_fast_angle(cx: &mut Context, entity: &str, d: &DriverInput, value: f64, curve: usize) {
-    let s = &cx.settings;
-    if s.arc_length || !(s.max_increment.is_finite() && s.max_increment > 0.0) {
-        return;
+/// of the largest increments: load control then limits its increments
+/// (`Model::rotation_step_limit`); a value meant in degrees and read in
+/// radians does this. Whether it warned.
+fn warn_fast_angle(
+    cx: &mut Context,
+    entity: &str,
+    d: &DriverInput,
+    value: f64,
+    curve: usize,
+) -> bool {
+    let Some(h) = cx.plan.max_increment else {
+        return false;
+    };
+    if !(h.is_finite() && h > 0.0) {
+        return false;
     }
     let end = cx.curves.end_time;
-    let h = s.max_increment;
     let change = value.abs() * cx.curves.curves[curve].largest_change(h, end);
-    if change > MAX_TURN_PER_INCREMENT {
+    if change > AMBIGUOUS_TURN {
         let hint = if d.unit.is_none() {
             " If the value is in degrees, write unit = \"deg\"."
         } else {
@@ -137,10 +155,12 @@ fn warn_fast_angle(cx: &mut Context, entity: &str, d: &DriverInput, value: f64, 
         cx.ck.warn(
             entity,
             format!(
-                "asks for {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot follow (docs/joints.md §3.3); increments will be cut back. Lower max_increment to at most {:.3e}.{hint}",
+                "asks for {change:.4} rad ({:.1}°) in one increment of t = {h} (max_increment): more than half a turn, which an increment cannot follow (docs/joints.md §3.3); load increments are limited to {:.3e} (a quarter turn each).{hint}",
                 change.to_degrees(),
-                h * MAX_TURN_PER_INCREMENT / change
+                cx.curves.curves[curve].largest_step(value, FRAC_PI_2, end)
             ),
         );
+        return true;
     }
+    false
 }

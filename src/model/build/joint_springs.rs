@@ -2,6 +2,7 @@
 //! or tabulated.
 
 use super::joints::{angle_unit, joint_coordinate, Context, Joints};
+use super::AngleLimit;
 use crate::joints::{JointSpring, Law};
 use crate::model::input::JointSpringInput;
 use crate::model::ModelErrorKind;
@@ -82,6 +83,23 @@ pub(super) fn joint_spring(
         cx.ck
             .push(ModelErrorKind::Invalid, entity, "free_value must be finite");
         return None;
+    }
+    // angles that look like degrees
+    if s.unit.is_none() && source.as_ref().is_some_and(|src| src.is_angle()) {
+        cx.ck
+            .unitless_angle(entity, "free_value is", x0, AngleLimit::FullTurn);
+        let widest = s
+            .table
+            .iter()
+            .map(|p| p[0].abs())
+            .filter(|a| a.is_finite())
+            .fold(0.0, f64::max);
+        cx.ck.unitless_angle(
+            entity,
+            "the angles of its table reach",
+            widest,
+            AngleLimit::FullTurn,
+        );
     }
     let spring = law(cx, entity, "stiffness", s.stiffness, x0, &s.table, unit);
     let damper = law(

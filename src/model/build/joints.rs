@@ -4,7 +4,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::Builder;
-use super::{drivers, joint_springs};
+use super::{drivers, hinge_laws, joint_springs, latches};
 use crate::elements::Element;
 use crate::joints::types::{Coordinate, JointParameters};
 use crate::joints::{Joint, JointType, Pair, PairCoordinate};
@@ -87,10 +87,24 @@ pub(super) fn build(cx: &mut Builder) {
             cx.elements.push(Box::new(e));
         }
     }
+    for h in &input.hinge_laws {
+        let entity = format!("hinge law {}", h.id);
+        let id_ok = cx.claim_id(&entity, h.id);
+        if let (Some(e), true) = (hinge_laws::hinge_law(cx, &entity, h, &joints), id_ok) {
+            cx.elements.push(Box::new(e));
+        }
+    }
     for d in &input.drivers {
         let entity = format!("driver {}", d.id);
         let id_ok = cx.claim_id(&entity, d.id);
         if let (Some(e), true) = (drivers::driver(cx, &entity, d, &joints), id_ok) {
+            cx.elements.push(Box::new(e));
+        }
+    }
+    for l in &input.latches {
+        let entity = format!("latch {}", l.id);
+        let id_ok = cx.claim_id(&entity, l.id);
+        if let (Some(e), true) = (latches::latch(cx, &entity, l, &joints), id_ok) {
             cx.elements.push(Box::new(e));
         }
     }

@@ -72,10 +72,16 @@ impl Builder<'_> {
         {
             return None;
         }
+        if a.norm() > 0.0 && self.elements.iter().all(|e| e.mass() == 0.0) {
+            self.ck.warn(
+                "gravity",
+                "acts on no mass: no beam's section has mass_per_length and the model has no rigid body or point mass, so gravity loads nothing; give the masses, or remove [gravity]",
+            );
+        }
         let end = self.curves.end_time;
         let c = &self.curves.curves[curve];
         let has_drivers = !self.input.drivers.is_empty();
-        if a.norm() > 0.0 && self.settings.kinematic && !c.is_constant_on(end) {
+        if a.norm() > 0.0 && self.plan.kinematic && !c.is_constant_on(end) {
             self.ck.warn(
                 "gravity",
                 format!(
@@ -83,7 +89,12 @@ impl Builder<'_> {
                     c.name()
                 ),
             );
-        } else if a.norm() > 0.0 && !self.settings.kinematic && has_drivers && g.curve.is_none() {
+        } else if a.norm() > 0.0
+            && !self.plan.kinematic
+            && !self.plan.first_dynamic
+            && has_drivers
+            && g.curve.is_none()
+        {
             self.ck.warn(
                 "gravity",
                 "follows the default ramp f = t while drivers move the model: their loads before the end include only f(t) of the gravity; write curve = \"ramp\" to confirm, or curve = \"constant\" for the full gravity throughout",

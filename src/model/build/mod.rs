@@ -13,20 +13,22 @@ mod beams;
 mod checks;
 mod curves;
 mod drivers;
+mod hinge_laws;
+mod initial;
 mod joint_springs;
 mod joints;
+mod latches;
 mod loads;
 mod masses;
 mod nodes;
+mod output;
 mod sections;
 mod settings;
 mod springs;
 mod supports;
 
 use super::input::*;
-use super::{
-    Model, ModelError, ModelErrorKind, ModelErrors, ModelWarning, Prescribed, StaticSettings,
-};
+use super::{Model, ModelError, ModelErrorKind, ModelErrors, ModelWarning, Prescribed};
 use crate::curves::CurveIndex;
 use crate::elements::beam::BeamSection;
 use crate::elements::{Element, ElementKind};
@@ -58,6 +60,21 @@ pub const MIN_RELATIVE_INCREMENT: f64 = 1e-12;
 /// configuration: the analysis measures residuals by sums of squares,
 /// which overflow beyond 1.3e154.
 pub const LARGEST_ELEMENT_VALUE: f64 = 1e150;
+
+/// Relative margin above half or a whole turn before an angle without a
+/// unit is warned about, so that π and 2π written to a few digits
+/// (3.1416, 6.2832) pass.
+const ANGLE_SLACK: f64 = 1e-3;
+
+/// How large an angle written without a unit may be before it looks like
+/// degrees: a rotation vector is at most half a turn long; a driven
+/// angle, a spring's free angle or a table's angle rarely pass a full
+/// turn.
+#[derive(Clone, Copy)]
+enum AngleLimit {
+    HalfTurn,
+    FullTurn,
+}
 
 /// Collects problems and warnings while the model is built.
 #[derive(Default)]
@@ -101,6 +118,26 @@ impl Checker {
         }
     }
 
+    /// Warns that an angle written without a `unit` (read in radians) is
+    /// beyond `limit` (half or a whole turn), as an angle in degrees
+    /// would be: `what` says which angle (`"rotation has the length"`).
+    fn unitless_angle(&mut self, entity: &str, what: &str, angle: f64, limit: AngleLimit) {
+        let (bound, beyond) = match limit {
+            AngleLimit::HalfTurn => (std::f64::consts::PI, "half a turn"),
+            AngleLimit::FullTurn => (std::f64::consts::TAU, "a full turn"),
+        };
+        if angle.abs() > bound * (1.0 + ANGLE_SLACK) {
+            self.warn(
+                entity,
+                format!(
+                    "{what} {:.4} rad ({:.1}°), more than {beyond}, and gives no unit: angles are read in radians. If it is in degrees, write unit = \"deg\" (unit = \"rad\" confirms radians)",
+                    angle.abs(),
+                    angle.abs().to_degrees()
+                ),
+            );
+        }
+    }
+
     /// Checks that a value is finite and strictly positive.
     fn positive(&mut self, entity: &str, what: &str, value: f64) -> bool {
         if value.is_finite() && value > 0.0 {
@@ -138,7 +175,8 @@ struct NodeData {
 struct Builder<'i> {
     input: &'i ModelInput,
     ck: Checker,
-    settings: StaticSettings,
+    /// What the checks and defaults take from the analyses.
+    plan: settings::Plan,
     curves: CurveTable,
     node_ids: Vec<Id>,
     nodes: Vec<NodeData>,
@@ -202,9 +240,11 @@ impl Builder<'_> {
     /// Default curve of loads and gravity: the ramp in statics (the load
     /// factor), the constant in a kinematic analysis, whose motion the
     /// drivers set and whose loads are those of the real, fully loaded
-    /// mechanism at every instant.
+    /// mechanism at every instant, and in a first dynamic analysis, whose
+    /// loads act from the start (a ramp in time is a loading history of
+    /// its own, to be given as such).
     fn load_default(&self) -> CurveIndex {
-        if self.settings.kinematic {
+        if self.plan.kinematic || self.plan.first_dynamic {
             CONSTANT
         } else {
             RAMP
@@ -231,7 +271,9 @@ fn model_size(input: &ModelInput) -> usize {
         input.loads.len(),
         input.joints.len(),
         input.joint_springs.len(),
+        input.hinge_laws.len(),
         input.drivers.len(),
+        input.latches.len(),
         generated,
     ]
     .into_iter()
@@ -243,12 +285,13 @@ impl Model {
     /// problem found.
     pub fn from_input(input: &ModelInput) -> Result<Model, ModelErrors> {
         let mut ck = Checker::default();
-        let settings = settings::settings(&mut ck, &input.analysis);
-        let curves = CurveTable::build(&mut ck, &input.curves, settings.end_time);
+        let plan = settings::Plan::of(&settings::analyses(&mut ck, &input.analysis));
+        let curves = CurveTable::build(&mut ck, &input.curves, plan.end_time);
+        output::check(&mut ck, input.output.as_ref(), plan.end_time);
         let mut b = Builder {
             input,
             ck,
-            settings,
+            plan,
             curves,
             node_ids: Vec::new(),
             nodes: Vec::new(),
@@ -285,16 +328,17 @@ impl Model {
         let gravity = b.gravity();
         b.supports();
         b.prescribed();
+        let initial_velocity = b.initial_velocities();
 
         // ---------- global checks ----------
         let Builder {
             mut ck,
-            settings,
+            plan,
             curves,
             node_ids,
             nodes,
             node_index,
-            mut elements,
+            elements,
             fixed,
             prescribed,
             ..
@@ -302,7 +346,10 @@ impl Model {
         if ck.errors.is_empty() {
             if elements.iter().all(|e| e.kind() == ElementKind::NodalLoad) {
                 ck.push(ModelErrorKind::Missing, "model", "has no elements");
-            } else {
+            } else if !plan.no_statics {
+                // a free part has no static equilibrium; in dynamics its
+                // inertia holds it, a modal analysis gives its rigid-body
+                // modes
                 checks::check_restraint(&mut ck, &node_ids, &elements, &fixed);
             }
         }
@@ -324,13 +371,7 @@ impl Model {
                 1.0
             }
         };
-        let (mut extra, mut internal) = (0, 0);
-        for e in &mut elements {
-            e.set_offsets(extra, internal);
-            extra += e.n_extra();
-            internal += e.n_internal();
-        }
-        let model = Model {
+        let mut model = Model {
             title: input.title.clone().unwrap_or_default(),
             node_ids,
             node_lookup: node_index,
@@ -348,15 +389,18 @@ impl Model {
             curve_uses: curves.uses,
             warnings: ck.warnings,
             gravity,
-            settings,
             length_scale,
             scaling: Default::default(),
-        }
-        .with_default_scaling(
+            initial_velocity,
+            offsets: Vec::new(),
+            sizes: Default::default(),
+        };
+        model.place_elements();
+        let model = model.with_default_scaling(
             input.analysis.constraint_scale,
             input.analysis.constraint_penalty,
         );
-        let errors = checks::non_finite_elements(&model);
+        let errors = checks::non_finite_elements(&model, plan.end_time);
         if !errors.is_empty() {
             return Err(ModelErrors(errors));
         }

@@ -1,6 +1,6 @@
 //! `[[nodes]]`: the reference positions and orientations.
 
-use super::{Builder, NodeData};
+use super::{AngleLimit, Builder, NodeData};
 use crate::model::input::MAX_ID;
 use crate::model::ModelErrorKind;
 use crate::so3::{self, Vec3};
@@ -43,6 +43,14 @@ impl Builder<'_> {
             if !ok {
                 self.invalid_nodes.insert(n.id);
                 continue;
+            }
+            if n.unit.is_none() {
+                self.ck.unitless_angle(
+                    &entity,
+                    "rotation has the length",
+                    psi.norm(),
+                    AngleLimit::HalfTurn,
+                );
             }
             self.node_index.insert(n.id, self.nodes.len());
             self.node_ids.push(n.id);

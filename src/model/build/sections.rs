@@ -1,8 +1,8 @@
 //! `[[sections]]`: the cross-section properties of beams, referred to by
 //! name.
 
-use super::{Builder, Checker};
-use crate::elements::beam::{BeamSection, SectionStiffness};
+use super::{num, Builder, Checker};
+use crate::elements::beam::{BeamSection, RayleighDamping, SectionStiffness};
 use crate::model::input::SectionInput;
 use crate::model::ModelErrorKind;
 use crate::so3::Vec3;
@@ -137,9 +137,30 @@ fn section(ck: &mut Checker, entity: &str, s: &SectionInput) -> Option<BeamSecti
         );
         ok = false;
     }
+    let mut damping = RayleighDamping::default();
+    for (key, given, value) in [
+        ("rayleigh_alpha", s.rayleigh_alpha, &mut damping.alpha),
+        ("rayleigh_beta", s.rayleigh_beta, &mut damping.beta),
+    ] {
+        let v = given.unwrap_or(0.0);
+        if v.is_finite() && v >= 0.0 {
+            *value = v;
+        } else {
+            ck.push(
+                ModelErrorKind::NonPositive,
+                entity,
+                format!(
+                    "{key} must be a finite number ≥ 0 (Rayleigh damping, docs/theory.md §11.5), got {}",
+                    num(v)
+                ),
+            );
+            ok = false;
+        }
+    }
     ok.then(|| BeamSection {
         stiffness,
         mass_per_length: mass,
         inertia_per_length: Vec3::from(inertia),
+        damping,
     })
 }

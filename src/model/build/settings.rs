@@ -1,30 +1,287 @@
-//! `[analysis]`: the analysis settings, with their defaults and limits.
+//! `[analysis]` or `[[analysis]]`: the settings of the analysis, or of
+//! each analysis of a sequence, with their defaults and limits.
 
 use super::{
     num, Checker, LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MIN_RELATIVE_INCREMENT,
 };
-use crate::model::input::AnalysisInput;
-use crate::model::{ModelErrorKind, StaticSettings};
+use crate::analysis::settings::{DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
+use crate::analysis::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
+use crate::eigen::Method;
+use crate::model::input::{Analyses, AnalysisInput, ModelInput};
+use crate::model::{ModelErrorKind, ModelErrors};
 
-/// Analysis settings with defaults (docs/model-format.md).
-pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
+impl ModelInput {
+    /// The settings of the analyses the model asks for, in order, validated
+    /// (the same checks and messages as [`crate::model::Model::from_input`],
+    /// which reports them with the rest of the model).
+    pub fn analyses(&self) -> Result<Vec<AnalysisSettings>, ModelErrors> {
+        let mut ck = Checker::default();
+        let mut all = analyses(&mut ck, &self.analysis);
+        // the analyses land on the restart times: they join the output
+        // times of the analysis they fall in
+        if let Some(o) = &self.output {
+            let mut start = 0.0;
+            // (a modal analysis has no increments: it neither moves `t`
+            // nor writes restart files)
+            for (end, times) in all.iter_mut().filter_map(|a| match a {
+                AnalysisSettings::Static(s) => Some((s.end_time, &mut s.output_times)),
+                AnalysisSettings::Dynamic(s) => Some((s.end_time, &mut s.output_times)),
+                _ => None,
+            }) {
+                let within = o.restart_times.iter().filter(|&&t| t > start && t <= end);
+                times.extend(within);
+                times.sort_by(f64::total_cmp);
+                times.dedup();
+                start = end;
+            }
+        }
+        if ck.errors.is_empty() {
+            Ok(all)
+        } else {
+            Err(ModelErrors(ck.errors))
+        }
+    }
+}
+
+/// What the model's own checks and defaults take from its analyses: the
+/// type of the first (the default curve of loads), whether any uses arc
+/// length, the end of the last and the largest load increment.
+#[derive(Clone, Debug)]
+pub(super) struct Plan {
+    /// The first analysis is kinematic.
+    pub kinematic: bool,
+    /// Some analysis uses arc-length control.
+    pub arc_length: bool,
+    /// End of the last analysis.
+    pub end_time: f64,
+    /// Largest `max_increment` of the load-controlled analyses.
+    pub max_increment: Option<f64>,
+    /// No analysis seeks a static equilibrium (dynamic and modal analyses
+    /// only): parts free to move as rigid bodies are allowed (their inertia
+    /// holds them; a modal analysis reports their rigid-body modes).
+    pub no_statics: bool,
+    /// The first analysis is dynamic (loads and gravity act in full from
+    /// the start by default).
+    pub first_dynamic: bool,
+}
+
+impl Plan {
+    pub(super) fn of(settings: &[AnalysisSettings]) -> Self {
+        let statics = || settings.iter().filter_map(AnalysisSettings::as_static);
+        let load = statics().filter(|s| !s.arc_length);
+        Self {
+            kinematic: settings
+                .first()
+                .and_then(AnalysisSettings::as_static)
+                .is_some_and(|s| s.kinematic),
+            arc_length: statics().any(|s| s.arc_length),
+            end_time: settings.last().map_or(1.0, |s| s.end_time()),
+            max_increment: load.map(|s| s.max_increment).reduce(f64::max),
+            no_statics: statics().next().is_none(),
+            first_dynamic: settings.first().is_some_and(|s| s.as_dynamic().is_some()),
+        }
+    }
+}
+
+/// Settings of every analysis of `analyses`, with defaults
+/// (docs/model-format.md). Each analysis of a sequence starts where the one
+/// before ends; the entities of messages are `analysis`, or
+/// `analysis[k]` (from 1) in a sequence.
+pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSettings> {
+    let all = analyses.all();
+    let mut start = 0.0;
+    let mut out = Vec::with_capacity(all.len());
+    for (k, a) in all.iter().enumerate() {
+        let entity = if all.len() == 1 {
+            "analysis".to_string()
+        } else {
+            format!("analysis[{}]", k + 1)
+        };
+        if k > 0 {
+            if a.kind != "modal" && a.end_time.is_finite() && a.end_time <= start {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    &entity,
+                    format!(
+                        "end_time must be after the end of the analysis before it (t = {}), got {}",
+                        num(start),
+                        num(a.end_time)
+                    ),
+                );
+            }
+            for (name, v) in [
+                ("constraint_scale", a.constraint_scale),
+                ("constraint_penalty", a.constraint_penalty),
+            ] {
+                if v.is_some() {
+                    ck.push(
+                        ModelErrorKind::Invalid,
+                        &entity,
+                        format!("{name} belongs to the model and applies to every analysis: give it in the first one"),
+                    );
+                }
+            }
+        }
+        if a.kind == "modal" {
+            // a modal analysis does not move t
+            out.push(AnalysisSettings::Modal(modal_settings(
+                ck, &entity, a, start,
+            )));
+            continue;
+        }
+        for (name, given) in [
+            ("modes", a.modes.is_some()),
+            ("shift", a.shift.is_some()),
+            ("frequency_range", a.frequency_range.is_some()),
+            ("solver", a.solver.is_some()),
+        ] {
+            if given {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    &entity,
+                    format!("{name} applies to a modal analysis (type = \"modal\")"),
+                );
+            }
+        }
+        let s = if a.kind == "dynamic" {
+            AnalysisSettings::Dynamic(dynamic_settings(ck, &entity, a, start))
+        } else {
+            for (key, given) in dynamic_keys(a) {
+                if given {
+                    ck.push(
+                        ModelErrorKind::Invalid,
+                        &entity,
+                        format!("{key} belongs to dynamic analyses (type = \"dynamic\"); a {} analysis takes initial_increment, min_increment and max_increment", a.kind),
+                    );
+                }
+            }
+            AnalysisSettings::Static(settings(ck, &entity, a, start))
+        };
+        start = s.end_time();
+        out.push(s);
+    }
+    out
+}
+
+/// The keys that only dynamic analyses take, and whether each is given.
+fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 6] {
+    [
+        ("time_step", a.time_step.is_some()),
+        ("min_step", a.min_step.is_some()),
+        ("max_step", a.max_step.is_some()),
+        ("rho_infinity", a.rho_infinity.is_some()),
+        ("error_tolerance", a.error_tolerance.is_some()),
+        ("adaptive", a.adaptive.is_some()),
+    ]
+}
+
+/// Largest number of modes a modal analysis may ask for: beyond it the
+/// dense solver's O(n³) and Lanczos's basis of 2·modes vectors of the
+/// model's size make the request a mistake rather than an analysis.
+const MAX_MODES: usize = 10_000;
+
+/// Settings of a modal analysis at `t = start`, with defaults.
+fn modal_settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> ModalSettings {
+    // the keys of incremental analyses do not apply
+    for (name, given) in [
+        ("initial_increment", a.initial_increment.is_some()),
+        ("min_increment", a.min_increment.is_some()),
+        ("max_increment", a.max_increment.is_some()),
+        ("max_iterations", a.max_iterations.is_some()),
+        ("residual_tolerance", a.residual_tolerance.is_some()),
+        ("displacement_tolerance", a.displacement_tolerance.is_some()),
+        ("rotation_tolerance", a.rotation_tolerance.is_some()),
+        ("output_every", a.output_every.is_some()),
+        ("output_times", a.output_times.is_some()),
+        ("control", a.control.is_some()),
+        ("max_increments", a.max_increments.is_some()),
+    ]
+    .into_iter()
+    .chain(dynamic_keys(a))
+    {
+        if given {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("{name} does not apply to a modal analysis (it linearises about the state reached and does not move t)"),
+            );
+        }
+    }
+    let modes = a.modes.unwrap_or(10);
+    if modes == 0 || modes > MAX_MODES {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!("modes must be from 1 to {MAX_MODES}, got {modes}"),
+        );
+    }
+    if let Some(f) = a.shift {
+        if !(f.is_finite() && f >= 0.0) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "shift must be a frequency in Hz, zero or positive, got {}",
+                    num(f)
+                ),
+            );
+        }
+    }
+    if let Some([lo, hi]) = a.frequency_range {
+        if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "frequency_range must be [low, high] in Hz with 0 ≤ low < high, got [{}, {}]",
+                    num(lo),
+                    num(hi)
+                ),
+            );
+        }
+    }
+    let solver = match a.solver.as_deref() {
+        None | Some("auto") => Method::Auto,
+        Some("dense") => Method::Dense,
+        Some("lanczos") => Method::Lanczos,
+        Some(other) => {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("unknown solver \"{other}\" (available: auto, dense, lanczos)"),
+            );
+            Method::Auto
+        }
+    };
+    ModalSettings {
+        modes,
+        shift: a.shift,
+        frequency_range: a.frequency_range.map(|[lo, hi]| (lo, hi)),
+        solver,
+        time: start,
+    }
+}
+
+/// Settings of one analysis from `start` to its end, with defaults.
+fn settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> StaticSettings {
     if !matches!(a.kind.as_str(), "static" | "kinetostatic" | "kinematic") {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
-                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic)",
+                "unknown analysis type \"{}\" (available: static, kinetostatic, kinematic, dynamic, modal)",
                 a.kind
             ),
         );
     }
     let end = a.end_time;
-    ck.positive("analysis", "end_time", end);
-    let initial = a.initial_increment.unwrap_or(end / 10.0);
+    ck.positive(entity, "end_time", end);
+    let span = end - start;
+    let initial = a.initial_increment.unwrap_or(span / 10.0);
     let s = StaticSettings {
         end_time: end,
         initial_increment: initial,
-        min_increment: a.min_increment.unwrap_or(end * 1e-6),
+        min_increment: a.min_increment.unwrap_or(span * 1e-6),
         max_increment: a.max_increment.unwrap_or(initial),
         max_iterations: a.max_iterations.unwrap_or(25),
         // quadratic convergence makes 1e-8 cheap: one iteration more than 1e-4
@@ -32,6 +289,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
         rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
         output_every: a.output_every.unwrap_or(1),
+        output_times: a.output_times.clone().unwrap_or_default(),
         kinematic: a.kind == "kinematic",
         arc_length: a.control.as_deref() == Some("arc_length"),
         max_increments: a.max_increments.unwrap_or(1000),
@@ -42,7 +300,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     ) {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "unknown control \"{}\" (available: load, arc_length)",
                 a.control.as_deref().unwrap_or("")
@@ -52,7 +310,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.arc_length && s.kinematic {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             "a kinematic analysis follows its drivers: arc-length control does not apply",
         );
     }
@@ -64,19 +322,19 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         if v.is_some_and(|v| v > LARGEST_ELEMENT_VALUE) {
             ck.push(
                 ModelErrorKind::Invalid,
-                "analysis",
+                entity,
                 format!("{name} must be at most {LARGEST_ELEMENT_VALUE:e}"),
             );
         }
     }
     if let Some(k) = a.constraint_scale {
-        ck.positive("analysis", "constraint_scale", k);
+        ck.positive(entity, "constraint_scale", k);
     }
     if let Some(p) = a.constraint_penalty {
         if !(p.is_finite() && p >= 0.0) {
             ck.push(
                 ModelErrorKind::NonPositive,
-                "analysis",
+                entity,
                 format!(
                     "constraint_penalty must be zero or positive, got {}",
                     num(p)
@@ -87,20 +345,16 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.max_increments == 0 {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             "max_increments must be at least 1",
         );
     }
-    ck.positive("analysis", "initial_increment", s.initial_increment);
-    ck.positive("analysis", "min_increment", s.min_increment);
-    ck.positive("analysis", "max_increment", s.max_increment);
-    ck.positive("analysis", "residual_tolerance", s.residual_tolerance);
-    ck.positive(
-        "analysis",
-        "displacement_tolerance",
-        s.displacement_tolerance,
-    );
-    ck.positive("analysis", "rotation_tolerance", s.rotation_tolerance);
+    ck.positive(entity, "initial_increment", s.initial_increment);
+    ck.positive(entity, "min_increment", s.min_increment);
+    ck.positive(entity, "max_increment", s.max_increment);
+    ck.positive(entity, "residual_tolerance", s.residual_tolerance);
+    ck.positive(entity, "displacement_tolerance", s.displacement_tolerance);
+    ck.positive(entity, "rotation_tolerance", s.rotation_tolerance);
     // relative tolerances of 1 or more accept any iterate
     for (name, v) in [
         ("residual_tolerance", s.residual_tolerance),
@@ -110,7 +364,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         if v >= 1.0 {
             ck.push(
                 ModelErrorKind::Invalid,
-                "analysis",
+                entity,
                 format!(
                     "{name} must be below 1 (a relative tolerance, or radians), got {}",
                     num(v)
@@ -121,7 +375,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.max_iterations == 0 || s.max_iterations > MAX_ITERATIONS {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "max_iterations must be from 1 to {MAX_ITERATIONS}, got {}",
                 s.max_iterations
@@ -131,7 +385,7 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.max_increments as f64 > MAX_INCREMENTS {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "max_increments must be at most {MAX_INCREMENTS:e}, got {}",
                 s.max_increments
@@ -139,20 +393,21 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
         );
     }
     // a run of more than MAX_INCREMENTS increments is a hang, not an analysis
-    let increments = s.end_time / s.max_increment;
+    let increments = span / s.max_increment;
     if increments > MAX_INCREMENTS {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
-                "end_time / max_increment = {increments:.3e}: the analysis would need more than {MAX_INCREMENTS:e} increments"
+                "{} / max_increment = {increments:.3e}: the analysis would need more than {MAX_INCREMENTS:e} increments",
+                if start == 0.0 { "end_time" } else { "(end_time − start)" }
             ),
         );
     }
     if s.min_increment < MIN_RELATIVE_INCREMENT * s.end_time {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "min_increment must be at least end_time·{MIN_RELATIVE_INCREMENT:e} = {:e} (smaller steps are lost in the round-off of t), got {}",
                 MIN_RELATIVE_INCREMENT * s.end_time,
@@ -163,20 +418,206 @@ pub(super) fn settings(ck: &mut Checker, a: &AnalysisInput) -> StaticSettings {
     if s.output_every == 0 {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             "output_every must be at least 1",
         );
     }
     if s.min_increment > s.initial_increment || s.initial_increment > s.max_increment {
         ck.push(
             ModelErrorKind::Invalid,
-            "analysis",
+            entity,
             format!(
                 "increments must satisfy min_increment ≤ initial_increment ≤ max_increment, got {} ≤ {} ≤ {}",
                 num(s.min_increment),
                 num(s.initial_increment),
                 num(s.max_increment)
             ),
+        );
+    }
+    for &t in &s.output_times {
+        if !(t.is_finite() && t > start && t <= end) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "output_times must lie after the start of the analysis (t = {}) and not after its end_time ({}), got {}",
+                    num(start),
+                    num(end),
+                    num(t)
+                ),
+            );
+        }
+    }
+    if s.output_times.windows(2).any(|w| w[1] <= w[0]) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            "output_times must be in increasing order",
+        );
+    }
+    s
+}
+
+/// Settings of one dynamic analysis from `start` to its end, with
+/// defaults (docs/model-format.md, dynamic analyses).
+fn dynamic_settings(
+    ck: &mut Checker,
+    entity: &str,
+    a: &AnalysisInput,
+    start: f64,
+) -> DynamicSettings {
+    for (key, given) in [
+        ("initial_increment", a.initial_increment.is_some()),
+        ("min_increment", a.min_increment.is_some()),
+        ("max_increment", a.max_increment.is_some()),
+        ("control", a.control.is_some()),
+        ("max_increments", a.max_increments.is_some()),
+    ] {
+        if given {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("{key} belongs to static analyses; a dynamic analysis takes time_step, min_step and max_step"),
+            );
+        }
+    }
+    let end = a.end_time;
+    ck.positive(entity, "end_time", end);
+    let span = end - start;
+    let time_step = a.time_step.unwrap_or(span / 100.0);
+    let adaptive = a.adaptive.unwrap_or(true);
+    let s = DynamicSettings {
+        end_time: end,
+        time_step,
+        min_step: a.min_step.unwrap_or(time_step * 1e-6),
+        max_step: a
+            .max_step
+            .unwrap_or(if adaptive { span / 10.0 } else { time_step }),
+        rho_infinity: a.rho_infinity.unwrap_or(DEFAULT_RHO_INFINITY),
+        adaptive,
+        error_tolerance: a.error_tolerance.unwrap_or(DEFAULT_ERROR_TOLERANCE),
+        max_iterations: a.max_iterations.unwrap_or(25),
+        residual_tolerance: a.residual_tolerance.unwrap_or(1e-8),
+        displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
+        rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
+        output_every: a.output_every.unwrap_or(1),
+        output_times: a.output_times.clone().unwrap_or_default(),
+    };
+    if !(s.rho_infinity.is_finite() && (0.0..=1.0).contains(&s.rho_infinity)) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "rho_infinity must lie in [0, 1] (1: no numerical dissipation), got {}",
+                num(s.rho_infinity)
+            ),
+        );
+    }
+    let steps_ok = ck.positive(entity, "time_step", s.time_step)
+        & ck.positive(entity, "min_step", s.min_step)
+        & ck.positive(entity, "max_step", s.max_step);
+    if steps_ok && s.min_step > s.max_step {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "min_step ({}) must not exceed max_step ({})",
+                num(s.min_step),
+                num(s.max_step)
+            ),
+        );
+    } else if steps_ok && !(s.min_step <= s.time_step && s.time_step <= s.max_step) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "time steps must satisfy min_step ≤ time_step ≤ max_step, got {} ≤ {} ≤ {}",
+                num(s.min_step),
+                num(s.time_step),
+                num(s.max_step)
+            ),
+        );
+    }
+    if steps_ok && s.min_step < MIN_RELATIVE_INCREMENT * s.end_time.abs() {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "min_step must be at least end_time·{MIN_RELATIVE_INCREMENT:e} = {:e} (smaller steps are lost in the round-off of t), got {}",
+                MIN_RELATIVE_INCREMENT * s.end_time,
+                num(s.min_step)
+            ),
+        );
+    }
+    if steps_ok && span / s.max_step > MAX_INCREMENTS {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "(end_time − start) / max_step = {:.3e}: the analysis would need more than {MAX_INCREMENTS:e} steps",
+                span / s.max_step
+            ),
+        );
+    }
+    if !(s.error_tolerance.is_finite() && s.error_tolerance > 0.0 && s.error_tolerance < 1.0) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "error_tolerance must lie between 0 and 1 (a relative tolerance), got {}",
+                num(s.error_tolerance)
+            ),
+        );
+    }
+    for (name, v) in [
+        ("residual_tolerance", s.residual_tolerance),
+        ("displacement_tolerance", s.displacement_tolerance),
+        ("rotation_tolerance", s.rotation_tolerance),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v < 1.0) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!("{name} must lie between 0 and 1, got {}", num(v)),
+            );
+        }
+    }
+    if s.max_iterations == 0 || s.max_iterations > MAX_ITERATIONS {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "max_iterations must be from 1 to {MAX_ITERATIONS}, got {}",
+                s.max_iterations
+            ),
+        );
+    }
+    if s.output_every == 0 {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            "output_every must be at least 1",
+        );
+    }
+    for &t in &s.output_times {
+        if !(t.is_finite() && t > start && t <= end) {
+            ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                format!(
+                    "output_times must lie after the start of the analysis (t = {}) and not after its end_time ({}), got {}",
+                    num(start),
+                    num(end),
+                    num(t)
+                ),
+            );
+        }
+    }
+    if s.output_times.windows(2).any(|w| w[1] <= w[0]) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            "output_times must be in increasing order",
         );
     }
     s

@@ -417,6 +417,60 @@ impl Analysis {
         Self::of_type("kinematic")
     }
 
+    /// Implicit dynamics (Lie-group generalised-α, docs/theory.md §15)
+    /// from the state reached to `end_time`; a model whose analyses are
+    /// all dynamic or modal may have parts free to move as rigid bodies.
+    pub fn dynamic() -> Self {
+        Self::of_type("dynamic")
+    }
+
+    /// Dynamics: the first time step (default a hundredth of the span).
+    pub fn time_step(mut self, h: f64) -> Self {
+        self.0.time_step = Some(h);
+        self
+    }
+
+    /// Dynamics: the spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`
+    /// (default 0.9).
+    pub fn rho_infinity(mut self, rho: f64) -> Self {
+        self.0.rho_infinity = Some(rho);
+        self
+    }
+
+    /// Dynamics: fixed steps of `time_step` instead of steps sized by the
+    /// error estimate.
+    pub fn fixed_step(mut self) -> Self {
+        self.0.adaptive = Some(false);
+        self
+    }
+
+    /// Modal analysis: the `modes` lowest natural modes about the state
+    /// reached (docs/theory.md §14.7).
+    pub fn modal(modes: usize) -> Self {
+        let mut a = Self::of_type("modal");
+        a.0.modes = Some(modes);
+        a
+    }
+
+    /// Modal analysis: the modes nearest to this frequency (Hz).
+    pub fn shift(mut self, frequency: f64) -> Self {
+        self.0.shift = Some(frequency);
+        self
+    }
+
+    /// Modal analysis: only the modes with frequencies in `[low, high]`
+    /// (Hz).
+    pub fn frequency_range(mut self, low: f64, high: f64) -> Self {
+        self.0.frequency_range = Some([low, high]);
+        self
+    }
+
+    /// Modal analysis: the eigen-solver, `auto`, `dense` or `lanczos`.
+    pub fn solver(mut self, solver: &str) -> Self {
+        self.0.solver = Some(solver.into());
+        self
+    }
+
     /// Final value of the load parameter (default 1).
     pub fn end_time(mut self, t: f64) -> Self {
         self.0.end_time = t;
@@ -473,6 +527,12 @@ impl Analysis {
         self
     }
 
+    /// Values of `t` the analysis lands on exactly and writes results at.
+    pub fn output_times(mut self, times: impl Into<Vec<f64>>) -> Self {
+        self.0.output_times = Some(times.into());
+        self
+    }
+
     /// Scaling factor `k` of the constraint equations (default from the
     /// model's stiffness).
     pub fn constraint_scale(mut self, k: f64) -> Self {
@@ -497,5 +557,34 @@ impl Analysis {
     /// The `[analysis]` table of the model file.
     pub fn into_input(self) -> AnalysisInput {
         self.0
+    }
+
+    /// The settings of this analysis alone (from `t = 0`), validated as in
+    /// a model file.
+    pub fn settings(self) -> Result<crate::analysis::StaticSettings, crate::model::ModelErrors> {
+        match self.analysis_settings()? {
+            crate::analysis::AnalysisSettings::Static(s) => Ok(s),
+            other => Err(crate::model::ModelErrors(vec![crate::model::ModelError {
+                kind: crate::model::ModelErrorKind::Invalid,
+                entity: "analysis".into(),
+                message: format!(
+                    "a {} analysis has no static settings: use analysis_settings",
+                    other.name()
+                ),
+            }])),
+        }
+    }
+
+    /// The settings of this analysis alone (from `t = 0`), of whatever
+    /// type, validated as in a model file.
+    pub fn analysis_settings(
+        self,
+    ) -> Result<crate::analysis::AnalysisSettings, crate::model::ModelErrors> {
+        let input = crate::model::input::ModelInput {
+            analysis: self.0.into(),
+            ..crate::model::input::ModelInput::default()
+        };
+        let mut all = input.analyses()?;
+        Ok(all.remove(0))
     }
 }

@@ -1,9 +1,14 @@
-//! Joints, joint springs and dampers, drivers (docs/joints.md).
+//! Joints, joint springs and dampers, drivers, latches (docs/joints.md).
 
 use super::{Body, CurveHandle, Entity, ModelBuilder};
 use crate::joints::{Coordinate, JointType};
-use crate::model::handles::{DriverHandle, JointHandle, JointSpringHandle, NodeHandle};
-use crate::model::input::{AngleUnit, DriverInput, JointInput, JointSpringInput};
+use crate::model::handles::{
+    DriverHandle, HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, NodeHandle,
+};
+use crate::model::input::{
+    AngleUnit, Approach, DriverInput, HingeLawInput, JointInput, JointSpringInput, LatchInput,
+    StartBranch, TapeSpringInput,
+};
 use crate::model::Id;
 
 /// A kinematic pair between node A and node B, or between node A and the
@@ -232,6 +237,84 @@ impl Entity for JointSpring {
     }
 }
 
+/// A hysteretic moment law on a joint coordinate (a hinge law with
+/// memory, docs/joints.md §4.1): bounds from tables or the tape-spring
+/// shape, and the elastic slope between them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HingeLaw {
+    input: HingeLawInput,
+    id: Option<Id>,
+}
+
+impl HingeLaw {
+    /// On the first coordinate of `joint`, with elastic slope `k_e`
+    /// (N·m or N per coordinate unit) between the bounds.
+    pub fn on(joint: JointHandle, elastic_slope: f64) -> Self {
+        Self {
+            input: HingeLawInput {
+                joint: joint.0,
+                elastic_slope: Some(elastic_slope),
+                ..HingeLawInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// The joint coordinate it acts on.
+    pub fn coordinate(mut self, coordinate: Coordinate) -> Self {
+        self.input.coordinate = Some(coordinate.name().into());
+        self
+    }
+
+    /// The unit of the angles (table abscissae, tape-spring angles, slopes
+    /// per unit) when the coordinate is an angle.
+    pub fn unit(mut self, unit: AngleUnit) -> Self {
+        self.input.unit = Some(unit);
+        self
+    }
+
+    /// Bounds from tables of points `[coordinate, moment]`: the loading
+    /// bound `f_load` and the unloading bound `f_unload ≤ f_load`.
+    pub fn tables(
+        mut self,
+        load: impl Into<Vec<[f64; 2]>>,
+        unload: impl Into<Vec<[f64; 2]>>,
+    ) -> Self {
+        self.input.load_table = load.into();
+        self.input.unload_table = unload.into();
+        self
+    }
+
+    /// Bounds from the tape-spring shape.
+    pub fn tape_spring(mut self, shape: TapeSpringInput) -> Self {
+        self.input.tape_spring = Some(shape);
+        self
+    }
+
+    /// The bound it starts on in the reference configuration (default
+    /// the loading bound).
+    pub fn start(mut self, start: StartBranch) -> Self {
+        self.input.start = Some(start);
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for HingeLaw {
+    type Handle = HingeLawHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> HingeLawHandle {
+        self.input.id = m.element_id(self.id, 1);
+        let handle = HingeLawHandle(self.input.id);
+        m.input.hinge_laws.push(self.input);
+        handle
+    }
+}
+
 /// A prescribed history `value · f(t)` of a joint coordinate, or of a
 /// node's translation along or rotation about a direction, relative to
 /// the reference configuration.
@@ -324,6 +407,66 @@ impl Entity for Driver {
         self.input.curve = self.curve.map(|c| m.curve_name(c));
         let handle = DriverHandle(self.input.id);
         m.input.drivers.push(self.input);
+        handle
+    }
+}
+
+/// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
+/// when it reaches its locking value moving in the direction of approach,
+/// and stays locked (in dynamic analyses, with the impact of the lock).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Latch {
+    input: LatchInput,
+    id: Option<Id>,
+}
+
+impl Latch {
+    /// Locks the first coordinate of `joint` at `value` (m, or rad; see
+    /// [`Latch::angle`]).
+    pub fn on(joint: JointHandle, value: f64) -> Self {
+        Self {
+            input: LatchInput {
+                joint: joint.0,
+                value,
+                ..LatchInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// The joint coordinate it locks.
+    pub fn coordinate(mut self, coordinate: Coordinate) -> Self {
+        self.input.coordinate = Some(coordinate.name().into());
+        self
+    }
+
+    /// The locking angle, in `unit`.
+    pub fn angle(mut self, value: f64, unit: AngleUnit) -> Self {
+        self.input.value = value;
+        self.input.unit = Some(unit);
+        self
+    }
+
+    /// How the coordinate reaches the locking value (default: away from
+    /// the reference configuration, where it is 0).
+    pub fn approach(mut self, approach: Approach) -> Self {
+        self.input.approach = Some(approach);
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for Latch {
+    type Handle = LatchHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> LatchHandle {
+        self.input.id = m.element_id(self.id, 1);
+        let handle = LatchHandle(self.input.id);
+        m.input.latches.push(self.input);
         handle
     }
 }

@@ -43,14 +43,15 @@ mod structure;
 pub use loading::{
     Analysis, Component, CurveHandle, Dofs, Gravity, Load, LoadCurve, PrescribedMotion,
 };
-pub use mechanism::{Driver, Joint, JointSpring};
+pub use mechanism::{Driver, HingeLaw, Joint, JointSpring, Latch};
 pub use structure::{Beam, BeamLine, Node, PointMass, RigidBody, Section, SectionHandle, Spring};
 
 pub use super::handles::{
-    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, JointHandle,
-    JointSpringHandle, LoadHandle, NodeHandle, PointMassHandle, RigidBodyHandle, SpringHandle,
+    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
+    JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
+    RigidBodyHandle, SpringHandle,
 };
-pub use super::input::AngleUnit;
+pub use super::input::{AngleUnit, Approach, StartBranch, TapeSpringInput as TapeSpring};
 pub use super::{Id, Model, ModelErrors};
 pub use crate::joints::{Coordinate, JointType};
 
@@ -136,6 +137,40 @@ impl ModelBuilder {
         self.add(Node::at(x).id(id))
     }
 
+    /// Gives node `node` the initial velocity `v` and angular velocity
+    /// `w` (global frame), for dynamic analyses.
+    pub fn initial_velocity(
+        &mut self,
+        node: NodeHandle,
+        v: impl Into<[f64; 3]>,
+        w: impl Into<[f64; 3]>,
+    ) {
+        if let Some(n) = self.input.nodes.iter_mut().find(|n| n.id == node.0) {
+            n.velocity = Some(v.into());
+            n.angular_velocity = Some(w.into());
+        }
+    }
+
+    /// Gives `nodes` the rigid motion in which the point `about` moves
+    /// with `velocity` and everything turns with `angular_velocity`
+    /// (global frame): `v(x) = velocity + angular_velocity × (x − about)`.
+    pub fn initial_motion(
+        &mut self,
+        nodes: impl IntoIterator<Item = NodeHandle>,
+        velocity: impl Into<[f64; 3]>,
+        angular_velocity: impl Into<[f64; 3]>,
+        about: impl Into<[f64; 3]>,
+    ) {
+        self.input
+            .initial_motion
+            .push(crate::model::input::InitialMotionInput {
+                nodes: nodes.into_iter().map(|n| n.0).collect(),
+                velocity: Some(velocity.into()),
+                angular_velocity: Some(angular_velocity.into()),
+                about: Some(about.into()),
+            });
+    }
+
     /// Adds a beam cross-section.
     pub fn section(&mut self, section: Section) -> SectionHandle {
         self.add(section)
@@ -181,15 +216,27 @@ impl ModelBuilder {
         self.add(Gravity::of(g));
     }
 
-    /// Sets the analysis and its parameters.
+    /// Sets the analysis and its parameters (the only one, replacing any
+    /// sequence).
     pub fn analysis(&mut self, analysis: Analysis) {
-        self.input.analysis = analysis.into_input();
+        self.input.analysis = analysis.into_input().into();
+    }
+
+    /// Adds an analysis after the last one: a sequence of analyses, each
+    /// starting from the final state of the one before (`[[analysis]]`).
+    pub fn then(&mut self, analysis: Analysis) {
+        self.input.analysis.push(analysis.into_input());
     }
 
     /// Validates the model and builds it: every problem found, as for a
     /// model file.
     pub fn build(&self) -> Result<Model, ModelErrors> {
         Model::from_input(&self.input)
+    }
+
+    /// The settings of the analyses, validated, in order.
+    pub fn analyses(&self) -> Result<Vec<crate::analysis::AnalysisSettings>, ModelErrors> {
+        self.input.analyses()
     }
 
     /// The model definition as the file schema holds it.

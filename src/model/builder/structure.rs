@@ -27,6 +27,8 @@ impl Node {
                 x: x.into(),
                 rotation: None,
                 unit: None,
+                velocity: None,
+                angular_velocity: None,
             },
             id: None,
         }
@@ -41,6 +43,19 @@ impl Node {
     /// The unit of the rotation vector.
     pub fn unit(mut self, unit: AngleUnit) -> Self {
         self.input.unit = Some(unit);
+        self
+    }
+
+    /// Its initial velocity (global frame), for dynamic analyses.
+    pub fn velocity(mut self, v: impl Into<[f64; 3]>) -> Self {
+        self.input.velocity = Some(v.into());
+        self
+    }
+
+    /// Its initial angular velocity (global frame, rad/s), for dynamic
+    /// analyses.
+    pub fn angular_velocity(mut self, w: impl Into<[f64; 3]>) -> Self {
+        self.input.angular_velocity = Some(w.into());
         self
     }
 
@@ -102,6 +117,14 @@ impl Section {
     /// (ρJ, ρI₂, ρI₃).
     pub fn inertia_per_length(mut self, inertia: [f64; 3]) -> Self {
         self.input.inertia_per_length = Some(inertia);
+        self
+    }
+
+    /// Its Rayleigh damping `C_R = α M + β K_mat` (docs/theory.md §11.5):
+    /// `alpha` in 1/s, `beta` in s.
+    pub fn rayleigh_damping(mut self, alpha: f64, beta: f64) -> Self {
+        self.input.rayleigh_alpha = Some(alpha);
+        self.input.rayleigh_beta = Some(beta);
         self
     }
 

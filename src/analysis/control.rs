@@ -1,0 +1,804 @@
+//! The step controller shared by every incremental analysis: load control
+//! and arc length in statics, time steps in dynamics (docs/theory.md §13).
+//!
+//! An analysis plugs in as a [`Stepper`]: from its last accepted state it
+//! attempts one step of a given size and says whether Newton converged
+//! (with the iterations, the residual history and optionally an estimate of
+//! the local error) or why not. The controller owns everything around it:
+//! - the step size: its bounds, its growth after easy steps
+//!   ([`EASY_ITERATIONS`], [`GROWTH`]), its cut-back after a failure
+//!   ([`CUTBACK`]), or the size an error estimate asks for;
+//! - landing exactly on `end_time` and on requested output times (a step
+//!   sized in time is shortened to reach them; a stepper whose steps are
+//!   not (arc length) lands on them itself when a step passes them);
+//! - events: a step across which an [`EventFunction`] changes sign is
+//!   rejected and retried shortened to land on the crossing, within the
+//!   event's tolerance;
+//! - the set of active constraints: before each attempt the stepper is asked
+//!   whether it changed (a driver's window opening, a latch locking), so
+//!   that the rank analysis of the constraints is run again;
+//! - the accept / reject / retry logic (the stepper keeps the backup of its
+//!   state), the increment numbering, the counts, and the observer's
+//!   cut-back and event reports.
+
+use super::newton::NewtonFailure;
+use super::{CutbackInfo, EventInfo, IncrementInfo, Observer};
+use crate::model::Model;
+use crate::state::State;
+
+/// Steps converged in this many iterations or fewer let the step grow.
+pub const EASY_ITERATIONS: usize = 5;
+/// Growth factor of the step after an easy step.
+pub const GROWTH: f64 = 1.5;
+/// Reduction factor of the step after a failed step.
+pub const CUTBACK: f64 = 0.5;
+/// A step that ends within this fraction of `end_time` (or more exactly,
+/// of the scale of `t`) from a landing time lands on it: `t` accumulated
+/// over many steps is not exact.
+pub const LANDING_SNAP: f64 = 1e-9;
+/// Safety factor on the step size an error estimate asks for.
+pub const ERROR_SAFETY: f64 = 0.9;
+/// The error estimate changes the step by at most these factors at once.
+pub const ERROR_FACTORS: (f64, f64) = (0.2, 2.0);
+/// Retries of one step to land on an event before the event is taken as
+/// happening within the step where it was found.
+pub const MAX_EVENT_RETRIES: usize = 30;
+
+/// What an attempted step gave.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Attempt {
+    /// Newton converged.
+    Converged {
+        /// Corrections applied.
+        iterations: usize,
+        /// Relative residual at each evaluation.
+        residuals: Vec<f64>,
+        /// Estimate of the local error relative to its tolerance (at most 1
+        /// to be accepted), when the stepper makes one.
+        error: Option<f64>,
+    },
+    /// Newton failed; the step is cut back.
+    Failed(NewtonFailure),
+}
+
+/// An analysis as the controller drives it.
+pub trait Stepper {
+    /// Why the stepper stops an analysis (an inconsistency found after a
+    /// converged step, an observer's error).
+    type Error;
+
+    /// The model and the current state: the last accepted one, or the
+    /// attempted one between an attempt and its acceptance or rejection.
+    fn current(&self) -> (&Model, &State);
+
+    /// `t` of the last accepted state.
+    fn time(&self) -> f64;
+
+    /// Whether step sizes are steps of `t` (load control, time steps).
+    fn sized_in_time(&self) -> bool;
+
+    /// Order `p` of the local error estimate, `err ∝ hᵖ⁺¹` (2 for
+    /// Newmark-type schemes, whose error is `O(h³)`).
+    fn error_order(&self) -> f64 {
+        2.0
+    }
+
+    /// Called before each attempt with the time the step will reach
+    /// (steps sized in time) or the last accepted time: checks whether the
+    /// set of active constraints changed there and, if it did, analyses the
+    /// rank of the constraints again. Returns whether it changed.
+    fn update_active_set(
+        &mut self,
+        time: f64,
+        observer: &mut dyn Observer,
+    ) -> Result<bool, Self::Error>;
+
+    /// Attempts one step of size `size` from the last accepted state, as
+    /// increment `increment`. A stepper whose steps are not sized in time
+    /// lands on `target` when the step passes it.
+    fn attempt(
+        &mut self,
+        size: f64,
+        target: f64,
+        increment: usize,
+        observer: &mut dyn Observer,
+    ) -> Attempt;
+
+    /// `t` reached by the last attempt.
+    fn attempted_time(&self) -> f64;
+
+    /// Goes back to the last accepted state after a rejected attempt.
+    fn reject(&mut self);
+
+    /// Accepts the attempted state as the converged increment `info`
+    /// (internal variables updated, checks, the observer told).
+    fn accept(
+        &mut self,
+        info: &IncrementInfo,
+        observer: &mut dyn Observer,
+    ) -> Result<(), Self::Error>;
+}
+
+/// A scalar function of the state whose change of sign is an event: a
+/// latch reached, a contact closed, or any predicate of a test ("the tip
+/// deflection reaches 1 cm").
+pub trait EventFunction: Send {
+    /// Name of the event, for reports.
+    fn name(&self) -> String;
+    /// `g(state)`; the event happens where it changes sign.
+    fn value(&self, model: &Model, state: &State) -> f64;
+    /// `|g|` at or below which a step has landed on the event.
+    fn tolerance(&self) -> f64;
+}
+
+/// Why the controller stopped an analysis.
+#[derive(Debug)]
+pub enum ControlStop<E> {
+    /// A step failed with the smallest allowed size.
+    Diverged {
+        /// Increment that failed.
+        increment: usize,
+        /// Last accepted `t`.
+        time: f64,
+        /// Last size tried.
+        step: f64,
+        /// Last failure.
+        reason: NewtonFailure,
+    },
+    /// The largest number of increments was used before `end_time`.
+    Limit {
+        /// Increments allowed.
+        increments: usize,
+        /// `t` reached.
+        time: f64,
+    },
+    /// The stepper stopped the analysis.
+    Stepper(E),
+}
+
+/// What one call of [`StepController::advance`] did.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Advance {
+    /// An increment was accepted.
+    Accepted(IncrementInfo),
+    /// `end_time` had already been reached: nothing to do.
+    Finished,
+}
+
+/// Counts of the controller's work.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepCounts {
+    /// Accepted increments.
+    pub increments: usize,
+    /// Newton iterations of accepted increments.
+    pub iterations: usize,
+    /// Newton iterations of rejected attempts.
+    pub wasted_iterations: usize,
+    /// Steps cut back after a failure.
+    pub cutbacks: usize,
+    /// Steps rejected to land on an event.
+    pub event_retries: usize,
+    /// Steps rejected by the error estimate.
+    pub error_rejections: usize,
+    /// Rank analyses of the constraints run again after a change of the
+    /// active set.
+    pub rank_analyses: usize,
+}
+
+/// Bounds of the step size, in the stepper's units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepBounds {
+    /// First size.
+    pub initial: f64,
+    /// Smallest size before the analysis gives up.
+    pub min: f64,
+    /// Largest size.
+    pub max: f64,
+}
+
+/// A crossing being located (regula falsi with the Illinois modification):
+/// the crossing lies within `span` (step units) of the accepted state, where
+/// the event function is `g_b` (halved each time this end is kept).
+#[derive(Clone, Copy, Debug)]
+struct Crossing {
+    event: usize,
+    span: f64,
+    g_b: f64,
+    retries: usize,
+}
+
+impl Crossing {
+    /// The fraction of `span` at the zero of the line from `g0` (accepted
+    /// state) to `g_b`.
+    fn fraction(&self, g0: f64) -> f64 {
+        let d = g0 - self.g_b;
+        if d != 0.0 && d.is_finite() {
+            (g0 / d).clamp(0.02, 0.98)
+        } else {
+            0.5
+        }
+    }
+}
+
+/// The step controller (see the module documentation).
+pub struct StepController {
+    bounds: StepBounds,
+    size: f64,
+    end_time: f64,
+    /// Requested output times, increasing; `next_landing` indexes the first
+    /// one after the accepted time.
+    output_times: Vec<f64>,
+    next_landing: usize,
+    output_every: usize,
+    max_increments: Option<usize>,
+    increment: usize,
+    counts: StepCounts,
+    events: Vec<Box<dyn EventFunction>>,
+    /// Value of each event function at the accepted state, and the side of
+    /// its zero the accepted state is on (`±1`; the side after the
+    /// crossing once a step has landed on it).
+    event_values: Vec<f64>,
+    event_sides: Vec<f64>,
+    crossing: Option<Crossing>,
+    /// The size of the next step is set by the error estimate.
+    error_controlled: bool,
+}
+
+impl StepController {
+    /// A controller for steps within `bounds`, from increment 1 to
+    /// `end_time`.
+    pub fn new(bounds: StepBounds, end_time: f64) -> Self {
+        Self {
+            bounds,
+            size: bounds.initial,
+            end_time,
+            output_times: Vec::new(),
+            next_landing: 0,
+            output_every: 1,
+            max_increments: None,
+            increment: 1,
+            counts: StepCounts::default(),
+            events: Vec::new(),
+            event_values: Vec::new(),
+            event_sides: Vec::new(),
+            crossing: None,
+            error_controlled: false,
+        }
+    }
+
+    /// Lands on `times` (increasing) and writes results there.
+    pub fn with_output_times(mut self, times: &[f64]) -> Self {
+        self.output_times = times.to_vec();
+        self
+    }
+
+    /// Results are written every `n` increments (and at every landing).
+    pub fn with_output_every(mut self, n: usize) -> Self {
+        self.output_every = n.max(1);
+        self
+    }
+
+    /// Stops after `n` increments.
+    pub fn with_max_increments(mut self, n: usize) -> Self {
+        self.max_increments = Some(n);
+        self
+    }
+
+    /// Watches `events` from now on.
+    pub fn with_events(mut self, events: Vec<Box<dyn EventFunction>>) -> Self {
+        self.events = events;
+        self
+    }
+
+    /// The size the next step will try.
+    pub fn size(&self) -> f64 {
+        self.size
+    }
+
+    /// The counts so far.
+    pub fn counts(&self) -> StepCounts {
+        self.counts
+    }
+
+    /// The end of the analysis.
+    pub fn end_time(&self) -> f64 {
+        self.end_time
+    }
+
+    /// Evaluates the event functions at the stepper's state (the start of
+    /// the analysis); called by [`StepController::advance`] when needed.
+    fn watch_events<S: Stepper + ?Sized>(&mut self, stepper: &S) {
+        let (model, state) = stepper.current();
+        self.event_values = self.events.iter().map(|e| e.value(model, state)).collect();
+        self.event_sides = self
+            .event_values
+            .iter()
+            .map(|&g| if g < 0.0 { -1.0 } else { 1.0 })
+            .collect();
+    }
+
+    /// The next time to land on after `t`: an output time or `end_time`.
+    fn target(&mut self, t: f64) -> (f64, bool) {
+        let snap = LANDING_SNAP * self.end_time.abs().max(t.abs());
+        while self
+            .output_times
+            .get(self.next_landing)
+            .is_some_and(|&o| o <= t + snap)
+        {
+            self.next_landing += 1;
+        }
+        match self.output_times.get(self.next_landing) {
+            Some(&o) if o < self.end_time => (o, true),
+            _ => (self.end_time, false),
+        }
+    }
+
+    /// Attempts steps until one is accepted (cutting back, retrying for
+    /// events and error estimates as needed), or stops the analysis.
+    pub fn advance<S: Stepper + ?Sized>(
+        &mut self,
+        stepper: &mut S,
+        observer: &mut dyn Observer,
+    ) -> Result<Advance, ControlStop<S::Error>> {
+        if self.event_values.len() != self.events.len() {
+            self.watch_events(stepper);
+        }
+        loop {
+            let t = stepper.time();
+            if t >= self.end_time {
+                return Ok(Advance::Finished);
+            }
+            if self.max_increments.is_some_and(|n| self.increment > n) {
+                return Err(ControlStop::Limit {
+                    increments: self.max_increments.unwrap_or(0),
+                    time: t,
+                });
+            }
+            let (target, output_time) = self.target(t);
+            let snap = LANDING_SNAP * self.end_time.abs().max(t.abs());
+            let mut size = self.size;
+            if let Some(c) = self.crossing {
+                size = size.min(c.span * c.fraction(self.event_values[c.event]));
+            }
+            let in_time = stepper.sized_in_time();
+            let mut lands = false;
+            if in_time {
+                size = size.min(target - t);
+                if target - (t + size) <= snap {
+                    size = target - t;
+                    lands = true;
+                }
+            }
+            let reach = if in_time { t + size } else { t };
+            if stepper
+                .update_active_set(reach, observer)
+                .map_err(ControlStop::Stepper)?
+            {
+                self.counts.rank_analyses += 1;
+            }
+
+            let increment = self.increment;
+            let (iterations, residuals, error) =
+                match stepper.attempt(size, target, increment, observer) {
+                    Attempt::Converged {
+                        iterations,
+                        residuals,
+                        error,
+                    } => (iterations, residuals, error),
+                    Attempt::Failed(reason) => {
+                        self.counts.wasted_iterations += reason.iterations_spent();
+                        stepper.reject();
+                        let next = size * CUTBACK;
+                        if next < self.bounds.min {
+                            return Err(ControlStop::Diverged {
+                                increment,
+                                time: t,
+                                step: size,
+                                reason,
+                            });
+                        }
+                        self.counts.cutbacks += 1;
+                        observer.cutback(&CutbackInfo {
+                            increment,
+                            time: t,
+                            failed_step: size,
+                            next_step: next,
+                            reason,
+                        });
+                        self.size = next;
+                        continue;
+                    }
+                };
+
+            // the local error: reject and shrink, or set the next size
+            if let Some(e) = error {
+                let factor = (ERROR_SAFETY
+                    * e.max(1e-300).powf(-1.0 / (stepper.error_order() + 1.0)))
+                .clamp(ERROR_FACTORS.0, ERROR_FACTORS.1);
+                if e > 1.0 {
+                    self.counts.wasted_iterations += iterations;
+                    self.counts.error_rejections += 1;
+                    stepper.reject();
+                    let next = size * factor;
+                    if next < self.bounds.min {
+                        return Err(ControlStop::Diverged {
+                            increment,
+                            time: t,
+                            step: size,
+                            reason: NewtonFailure::ErrorEstimate { error: e },
+                        });
+                    }
+                    self.size = next;
+                    continue;
+                }
+                self.error_controlled = true;
+                let grown = (size * factor).clamp(self.bounds.min, self.bounds.max);
+                self.size = if iterations <= EASY_ITERATIONS {
+                    grown
+                } else {
+                    grown.min(size)
+                };
+            }
+
+            // events: land on the first crossing
+            let mut landed = Vec::new();
+            if !self.events.is_empty() {
+                let (model, state) = stepper.current();
+                let values: Vec<f64> = self.events.iter().map(|e| e.value(model, state)).collect();
+                // the crossing beyond its tolerance nearest the start
+                let mut first: Option<(usize, f64)> = None;
+                for (i, (&g1, ev)) in values.iter().zip(&self.events).enumerate() {
+                    let (g0, side, tol) =
+                        (self.event_values[i], self.event_sides[i], ev.tolerance());
+                    if g1.abs() <= tol && g0.abs() > tol {
+                        landed.push(i);
+                    } else if g1 * side < 0.0 && g1.abs() > tol {
+                        let c = Crossing {
+                            event: i,
+                            span: size,
+                            g_b: g1,
+                            retries: 0,
+                        };
+                        let theta = c.fraction(g0);
+                        if first.is_none_or(|(_, th)| theta < th) {
+                            first = Some((i, theta));
+                        }
+                    }
+                }
+                if let Some((i, _)) = first {
+                    let retries = self.crossing.map_or(0, |c| c.retries) + 1;
+                    if retries <= MAX_EVENT_RETRIES {
+                        // retried shortened, from the same start
+                        self.counts.event_retries += 1;
+                        self.counts.wasted_iterations += iterations;
+                        stepper.reject();
+                        self.crossing = Some(Crossing {
+                            event: i,
+                            span: size,
+                            g_b: values[i],
+                            retries,
+                        });
+                        continue;
+                    }
+                    // not located: taken as happening within this step
+                    landed.push(i);
+                }
+                for &i in &landed {
+                    // the accepted state counts as past the crossing
+                    self.event_sides[i] = -self.event_sides[i];
+                }
+                for (i, &g) in values.iter().enumerate() {
+                    self.event_values[i] = g;
+                    if !landed.contains(&i) && g != 0.0 {
+                        self.event_sides[i] = g.signum();
+                    }
+                }
+                // a step short of the crossing: the crossing is now nearer,
+                // and the end kept is weighted down (Illinois)
+                self.crossing = match self.crossing {
+                    Some(c) if landed.is_empty() && c.span > size => Some(Crossing {
+                        span: c.span - size,
+                        g_b: 0.5 * c.g_b,
+                        ..c
+                    }),
+                    _ => None,
+                };
+            }
+
+            // accept
+            let mut reached = stepper.attempted_time();
+            if lands || reached >= self.end_time {
+                reached = if reached >= self.end_time {
+                    self.end_time
+                } else {
+                    target
+                };
+            }
+            let on_output_time = output_time
+                && (reached - target).abs() <= LANDING_SNAP * self.end_time.abs().max(1.0);
+            let info = IncrementInfo {
+                increment,
+                time: reached,
+                step: reached - t,
+                iterations,
+                residuals,
+                output: increment.is_multiple_of(self.output_every)
+                    || reached >= self.end_time
+                    || on_output_time
+                    || !landed.is_empty(),
+            };
+            stepper
+                .accept(&info, observer)
+                .map_err(ControlStop::Stepper)?;
+            for &i in &landed {
+                observer.event(&EventInfo {
+                    increment,
+                    time: reached,
+                    name: self.events[i].name(),
+                    value: self.event_values[i],
+                });
+            }
+            self.counts.increments += 1;
+            self.counts.iterations += iterations;
+            self.increment += 1;
+            if error.is_none() && iterations <= EASY_ITERATIONS && !self.error_controlled {
+                self.size = (self.size * GROWTH).min(self.bounds.max);
+            }
+            return Ok(Advance::Accepted(info));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The controller against steppers written for the tests: a scalar
+    //! "analysis" `x(t)` whose Newton fails on steps above a threshold,
+    //! whose local error grows as `h³`, or whose state crosses a value.
+    use super::*;
+    use crate::model::input::ModelInput;
+    use crate::so3::Vec3;
+
+    /// The smallest model (its state carries `x` in a node's position).
+    fn model() -> Model {
+        let mut m = ModelInput::new("point");
+        m.add_node(1, [0.0; 3]);
+        m.add_node(2, [1.0, 0.0, 0.0]);
+        m.add_section("s", [1.0, 1.0, 1.0, 1.0, 1.0, 1.0]);
+        m.add_beam(1, [1, 2], "s", Some([0.0, 0.0, 1.0]));
+        m.fix(1, &["all"]);
+        Model::from_input(&m).unwrap()
+    }
+
+    /// `x(t) = t²` reached in one "iteration" per step, failing on steps
+    /// above `fail_above`; an error estimate `(h/h_err)³` if `h_err` is set.
+    struct Scalar {
+        model: Model,
+        accepted: State,
+        attempted: State,
+        fail_above: f64,
+        h_err: Option<f64>,
+        sizes: Vec<f64>,
+        rank_changes_at: Option<f64>,
+        active: bool,
+    }
+
+    impl Scalar {
+        fn new(fail_above: f64, h_err: Option<f64>) -> Self {
+            let model = model();
+            // x(0) = 0
+            let mut s = model.initial_state();
+            s.x[1] = Vec3::zeros();
+            Self {
+                model,
+                accepted: s.clone(),
+                attempted: s,
+                fail_above,
+                h_err,
+                sizes: Vec::new(),
+                rank_changes_at: None,
+                active: false,
+            }
+        }
+    }
+
+    impl Stepper for Scalar {
+        type Error = ();
+        fn current(&self) -> (&Model, &State) {
+            (&self.model, &self.attempted)
+        }
+        fn time(&self) -> f64 {
+            self.accepted.time
+        }
+        fn sized_in_time(&self) -> bool {
+            true
+        }
+        fn update_active_set(&mut self, time: f64, _: &mut dyn Observer) -> Result<bool, ()> {
+            let active = self.rank_changes_at.is_some_and(|t| time >= t);
+            let changed = active != self.active;
+            self.active = active;
+            Ok(changed)
+        }
+        fn attempt(&mut self, size: f64, _: f64, _: usize, _: &mut dyn Observer) -> Attempt {
+            self.sizes.push(size);
+            if size > self.fail_above {
+                return Attempt::Failed(NewtonFailure::MaxIterations {
+                    iterations: 3,
+                    relative_residual: 1.0,
+                });
+            }
+            let t = self.accepted.time + size;
+            self.attempted.time = t;
+            self.attempted.x[1] = Vec3::new(t * t, 0.0, 0.0);
+            Attempt::Converged {
+                iterations: 1,
+                residuals: vec![1.0, 0.0],
+                error: self.h_err.map(|h| (size / h).powi(3)),
+            }
+        }
+        fn attempted_time(&self) -> f64 {
+            self.attempted.time
+        }
+        fn reject(&mut self) {
+            self.attempted.clone_from(&self.accepted);
+        }
+        fn accept(&mut self, info: &IncrementInfo, _: &mut dyn Observer) -> Result<(), ()> {
+            self.attempted.time = info.time;
+            self.accepted.clone_from(&self.attempted);
+            Ok(())
+        }
+    }
+
+    /// Every accepted increment.
+    fn run(c: &mut StepController, s: &mut Scalar) -> Vec<IncrementInfo> {
+        let mut out = Vec::new();
+        loop {
+            match c.advance(s, &mut crate::analysis::NoObserver) {
+                Ok(Advance::Accepted(i)) => out.push(i),
+                Ok(Advance::Finished) => return out,
+                Err(ControlStop::Diverged { .. }) => panic!("diverged"),
+                Err(_) => panic!("stopped"),
+            }
+        }
+    }
+
+    /// Steps grow by 1.5 after easy steps up to the largest, are halved
+    /// after a failure, and the last one lands exactly on end_time.
+    #[test]
+    fn steps_grow_are_cut_back_and_land_on_the_end() {
+        let bounds = StepBounds {
+            initial: 0.1,
+            min: 1e-6,
+            max: 0.4,
+        };
+        let mut c = StepController::new(bounds, 1.0);
+        let mut s = Scalar::new(0.3, None);
+        let steps = run(&mut c, &mut s);
+        // 0.1, 0.15, 0.225, then 0.3375 fails (> 0.3) and 0.16875 is tried
+        let tried: Vec<f64> = s.sizes.iter().map(|h| (h * 1e6).round() / 1e6).collect();
+        assert_eq!(&tried[..5], &[0.1, 0.15, 0.225, 0.3375, 0.16875]);
+        assert_eq!(c.counts().cutbacks, 1);
+        // exactly on the end, every step's t the sum of the steps
+        let last = steps.last().unwrap();
+        assert_eq!(last.time, 1.0);
+        assert!(steps.iter().all(|i| i.step <= 0.3));
+        let total: f64 = steps.iter().map(|i| i.step).sum();
+        assert!((total - 1.0).abs() < 1e-12);
+        // growth never above the largest step
+        assert!(s.sizes.iter().all(|&h| h <= 0.4 + 1e-15));
+    }
+
+    /// Requested output times are landed on exactly and written.
+    #[test]
+    fn steps_land_on_output_times() {
+        let bounds = StepBounds {
+            initial: 0.3,
+            min: 1e-6,
+            max: 0.3,
+        };
+        let times = [0.25, 0.5, 0.55];
+        let mut c = StepController::new(bounds, 1.0)
+            .with_output_times(&times)
+            .with_output_every(1000);
+        let mut s = Scalar::new(1.0, None);
+        let steps = run(&mut c, &mut s);
+        let reached: Vec<f64> = steps.iter().map(|i| i.time).collect();
+        for t in times {
+            let i = reached.iter().position(|&r| r == t).expect("landed on it");
+            assert!(steps[i].output, "written at {t}");
+        }
+        // only the landings and the end are written
+        assert_eq!(steps.iter().filter(|i| i.output).count(), 4);
+        assert_eq!(*reached.last().unwrap(), 1.0);
+    }
+
+    /// With an error estimate `(h/h₀)³`, rejected steps have an error above
+    /// 1 and the accepted ones settle at `0.9 h₀` (the safety factor): the
+    /// estimate, not the iterations, sets the step.
+    #[test]
+    fn the_error_estimate_sets_the_step() {
+        let bounds = StepBounds {
+            initial: 0.2,
+            min: 1e-6,
+            max: 1.0,
+        };
+        let h0 = 0.01;
+        let mut c = StepController::new(bounds, 1.0);
+        let mut s = Scalar::new(1.0, Some(h0));
+        let steps = run(&mut c, &mut s);
+        assert!(c.counts().error_rejections >= 1);
+        // every accepted step has an error of at most 1
+        assert!(steps.iter().all(|i| i.step <= h0 * (1.0 + 1e-12)));
+        // after the first few, steps of 0.9 h₀ (the last one shortened to
+        // land on the end)
+        let settled = &steps[5..steps.len() - 1];
+        assert!(
+            settled.iter().all(|i| (i.step - 0.9 * h0).abs() < 1e-9),
+            "{:?}",
+            settled.iter().map(|i| i.step).collect::<Vec<_>>()
+        );
+    }
+
+    /// `x = t²` crosses 0.3 at `t = √0.3`: the step across it is rejected
+    /// and retried until `x` lands within the tolerance 1e-10, the event is
+    /// reported once and written, and the run goes on to the end.
+    #[test]
+    fn a_step_across_an_event_is_retried_to_land_on_it() {
+        struct Crosses;
+        impl EventFunction for Crosses {
+            fn name(&self) -> String {
+                "x = 0.3".into()
+            }
+            fn value(&self, _: &Model, s: &State) -> f64 {
+                s.x[1].x - 0.3
+            }
+            fn tolerance(&self) -> f64 {
+                1e-10
+            }
+        }
+        #[derive(Default)]
+        struct Events(Vec<EventInfo>);
+        impl Observer for Events {
+            fn event(&mut self, e: &EventInfo) {
+                self.0.push(e.clone());
+            }
+        }
+        let bounds = StepBounds {
+            initial: 0.1,
+            min: 1e-9,
+            max: 0.1,
+        };
+        let mut c = StepController::new(bounds, 1.0)
+            .with_events(vec![Box::new(Crosses)])
+            .with_output_every(1000);
+        let mut s = Scalar::new(1.0, None);
+        let mut events = Events::default();
+        let mut steps = Vec::new();
+        while let Advance::Accepted(i) = c.advance(&mut s, &mut events).map_err(|_| ()).unwrap() {
+            steps.push(i);
+        }
+        assert_eq!(events.0.len(), 1, "{:?}", events.0);
+        let e = &events.0[0];
+        assert!((e.time - 0.3f64.sqrt()).abs() < 1e-9, "t = {}", e.time);
+        assert!(e.value.abs() <= 1e-10);
+        let at = steps.iter().find(|i| i.time == e.time).unwrap();
+        assert!(at.output);
+        assert!(c.counts().event_retries >= 1);
+        assert_eq!(steps.last().unwrap().time, 1.0);
+    }
+
+    /// The stepper is asked about its active set before every attempt, at
+    /// the time the step reaches; a change is counted.
+    #[test]
+    fn the_active_set_is_checked_before_each_attempt() {
+        let bounds = StepBounds {
+            initial: 0.1,
+            min: 1e-6,
+            max: 0.1,
+        };
+        let mut c = StepController::new(bounds, 1.0).with_output_times(&[0.45]);
+        let mut s = Scalar::new(1.0, None);
+        s.rank_changes_at = Some(0.45);
+        run(&mut c, &mut s);
+        assert_eq!(c.counts().rank_analyses, 1);
+    }
+}

@@ -1,0 +1,1706 @@
+//! Implicit dynamics: the Lie-group generalised-α method (Arnold & Brüls
+//! 2007; Brüls, Cardona & Arnold 2012, "Lie group generalized-α time
+//! integration of constrained flexible multibody systems", Mech. Mach.
+//! Theory 48) for the index-3 equations of motion
+//!
+//! ```text
+//! M(q) v̇ + g(q, v, t) + Bᵀ(pΦ − kλ) = 0,     −kΦ(q, t) = 0
+//! ```
+//!
+//! with the joints' augmented Lagrangian (docs/theory.md §15, equation
+//! labels D1–D12 there):
+//! - parameters from the spectral radius `ρ∞` (D1);
+//! - the step `q_{n+1} = q_n ∘ exp(h Δq_n)` on the nodes' group, with
+//!   the velocity, acceleration and pseudo-acceleration updates (D2–D4),
+//!   from a predictor at `v̇_{n+1} = 0` (D5);
+//! - Newton on the correction `x = h δΔq` with the iteration matrix
+//!   `S = β′M + γ′C + K T(hΔq)` (D6–D7), whose constraint rows and
+//!   multiplier columns are scaled so that it stays well conditioned as
+//!   `h → 0` (D8);
+//! - consistent initial accelerations and multipliers (D9), initial
+//!   velocities checked against the constraints (D10);
+//! - a local error estimate `(β − 1/6) h² (a_{n+1} − a_n)` for the step
+//!   controller (D11);
+//! - the energy balance of every step ([`super::energy`], D12).
+//!
+//! Node velocities are `(ẋ, Ω)`, `ẋ` global and `Ω` material, as in the
+//! inertia kernels (docs/theory.md §11.1). Multipliers are kept in the
+//! scaling of the model (`k λ` the force with the model's `k`), whatever
+//! the step: a state passes from statics to dynamics and back unchanged.
+//!
+//! The analysis is a [`Stepper`] of the shared [`StepController`]: time
+//! steps are cut back when Newton fails, sized by the error estimate
+//! (unless `adaptive = false`), and land on output times, events and
+//! `end_time`. It runs at once ([`DynamicAnalysis::run`]) or step by step
+//! ([`DynamicAnalysis::start`], [`DynamicAnalysis::advance`],
+//! [`DynamicAnalysis::state`], [`DynamicAnalysis::finish`]).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::control::{
+    Advance, Attempt, ControlStop, EventFunction, StepBounds, StepController, Stepper,
+};
+use super::energy::{Energies, EnergyBalance};
+use super::impact::{self, LockInfo};
+use super::newton::{non_finite_origin, NewtonFailure, NewtonSolver, SINGULAR_PIVOT};
+use super::settings::DynamicSettings;
+use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer};
+use crate::dofs::{DofKind, DofMap, NO_EQUATION};
+use crate::elements::{ConstraintKind, ConstraintScaling, EvalContext, Need};
+use crate::linalg::{smallest_relative_pivot, SparseLu, SparseMatrix};
+use crate::model::{Model, Prescribed};
+use crate::so3::{self, Mat3, Vec3};
+use crate::state::State;
+
+/// `c`: a residual within `c ε` of the force flux through its dof, or a
+/// correction within `c ε` of the size of its unknown, is round-off (as in
+/// statics, docs/theory.md §7.1).
+const FLOOR_FACTOR: f64 = 4.0;
+
+/// A residual that has stopped decreasing (by less than half in an
+/// iteration) while within this many `ε·flux` of zero is at its round-off
+/// plateau and accepted (as [`super::newton`]'s plateau).
+const PLATEAU_FACTOR: f64 = 1024.0;
+
+/// Unknowns whose diagonal mass is below this fraction of the largest of
+/// their kind have no mass: their initial acceleration is taken from their
+/// stiffness row (D9).
+const MASSLESS: f64 = 1e-12;
+
+/// Relative step of the finite differences along the motion that give the
+/// constraints' first and second time derivatives at the start (D9, D10):
+/// the motion over the step is 1e-3 of the model's size (or of the span of
+/// the analysis); with Richardson extrapolation the truncation error is
+/// ~1e-12 and the round-off ~1e-10 of the derivatives.
+const MOTION_STEP: f64 = 1e-3;
+
+/// Initial velocities whose constraint rates exceed this fraction of the
+/// velocity scale violate the joints (D10).
+const VELOCITY_TOLERANCE: f64 = 1e-6;
+
+/// Corrections larger than this times the model size, or than this in
+/// radians, mean the iteration matrix is singular or nearly so.
+const RUNAWAY_CORRECTION: f64 = 1e6;
+
+/// The constants of the generalised-α method (D1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeneralizedAlpha {
+    /// `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`.
+    pub alpha_m: f64,
+    /// `α_f = ρ∞/(ρ∞ + 1)`.
+    pub alpha_f: f64,
+    /// `γ = ½ + α_f − α_m`.
+    pub gamma: f64,
+    /// `β = ¼ (γ + ½)²`.
+    pub beta: f64,
+}
+
+impl GeneralizedAlpha {
+    /// The second-order, unconditionally stable set for the spectral
+    /// radius `rho_infinity` ∈ [0, 1] at infinite frequency (Chung &
+    /// Hulbert 1993; D1).
+    pub fn new(rho_infinity: f64) -> Self {
+        let r = rho_infinity;
+        let alpha_m = (2.0 * r - 1.0) / (r + 1.0);
+        let alpha_f = r / (r + 1.0);
+        let gamma = 0.5 + alpha_f - alpha_m;
+        Self {
+            alpha_m,
+            alpha_f,
+            gamma,
+            beta: 0.25 * (gamma + 0.5).powi(2),
+        }
+    }
+
+    /// `β′ = (1 − α_m)/((1 − α_f) β h²)`: `δv̇ = β′ x` (D6).
+    pub fn beta_prime(&self, h: f64) -> f64 {
+        (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * h * h)
+    }
+
+    /// `γ′ = γ/(β h)`: `δv = γ′ x` (D6).
+    pub fn gamma_prime(&self, h: f64) -> f64 {
+        self.gamma / (self.beta * h)
+    }
+}
+
+/// Why a dynamic analysis stopped before `end_time`.
+#[derive(Debug, thiserror::Error)]
+pub enum DynamicError {
+    /// A step failed with the smallest allowed size.
+    #[error("no convergence at step {step} from t = {time:.6}: the step {size:.3e} failed and a smaller one would be below min_step: {reason}; largest residual at {location}")]
+    Diverged {
+        /// Step that failed.
+        step: usize,
+        /// Last converged time.
+        time: f64,
+        /// Last size tried.
+        size: f64,
+        /// Last failure.
+        reason: NewtonFailure,
+        /// The unknown with the largest residual (relative to its group's
+        /// flux) at the last iteration, with its element.
+        location: String,
+    },
+    /// The initial velocities move the joints apart.
+    #[error("the initial velocities violate {constraint}: its rate is {rate:.3e} (tolerance {tolerance:.1e}); give the connected nodes velocities of one rigid motion, or velocities the joint allows")]
+    InconsistentVelocity {
+        /// The constraint (`joint 3 equation 2`).
+        constraint: String,
+        /// `Φ̇` there.
+        rate: f64,
+        /// Its tolerance.
+        tolerance: f64,
+    },
+    /// The initial accelerations could not be found.
+    #[error("no initial accelerations at t = {time}: {failure}")]
+    Initial {
+        /// Start time.
+        time: f64,
+        /// Why.
+        failure: NewtonFailure,
+    },
+    /// The impact of a latch locking could not be computed.
+    #[error("at t = {time}: the lock of {latches}: {reason}")]
+    Impact {
+        /// The latches locking (`latch 4`).
+        latches: String,
+        /// Time of the lock.
+        time: f64,
+        /// Why.
+        reason: String,
+    },
+    /// A result file could not be written.
+    #[error("writing results: {0}")]
+    Output(#[from] std::io::Error),
+}
+
+/// What a dynamic analysis did.
+#[derive(Debug)]
+pub struct DynamicOutcome {
+    /// Last converged state.
+    pub state: State,
+    /// Accepted time steps.
+    pub steps: usize,
+    /// Steps rejected: cut back after Newton failed, or rejected by the
+    /// error estimate.
+    pub rejected_steps: usize,
+    /// Of which rejected by the error estimate.
+    pub error_rejections: usize,
+    /// Newton iterations of the accepted steps.
+    pub iterations: usize,
+    /// Newton iterations of rejected steps.
+    pub wasted_iterations: usize,
+    /// Steps cut back after Newton failed.
+    pub cutbacks: usize,
+    /// Constraint equations removed as redundant (the most at any time).
+    pub redundant_constraints: usize,
+    /// Rank analyses of the constraints run again during the analysis.
+    pub rank_analyses: usize,
+    /// Steps retried shortened to land on an event.
+    pub event_retries: usize,
+    /// The latches that locked, in order (docs/joints.md §6.2).
+    pub locks: Vec<LockInfo>,
+    /// Time reached.
+    pub time: f64,
+    /// Energies at the last converged state.
+    pub energies: Energies,
+    /// Wall-clock time in seconds.
+    pub wall_time: f64,
+    /// `None` if `end_time` was reached.
+    pub error: Option<DynamicError>,
+}
+
+pub use super::statics::Step;
+
+/// What a motion's state alone does not hold and a dynamic analysis
+/// continued from one of its converged steps needs to go on as if never
+/// stopped ([`DynamicAnalysis::continued`]; kept in restart files).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Continuation {
+    /// The energy balance at the step: work, dissipation and `T₀ + V₀`
+    /// go on from it.
+    pub energies: Energies,
+    /// Size of the step that ended there: the predictor of the next step
+    /// scales `a − v̇` with the ratio of the sizes (D5).
+    pub last_step: Option<f64>,
+}
+
+/// An implicit dynamic analysis of a model (see the module documentation).
+pub struct DynamicAnalysis {
+    model: Arc<Model>,
+    settings: DynamicSettings,
+    scheme: GeneralizedAlpha,
+    solver: NewtonSolver,
+    events: Vec<Box<dyn EventFunction>>,
+    /// The start state is a converged step of this analysis (a restart):
+    /// its velocities, accelerations and multipliers are kept.
+    continued: bool,
+    /// What the run that wrote it knew besides, if given.
+    continuation: Option<Continuation>,
+    run: Option<Run>,
+}
+
+/// The analysis under way.
+struct Run {
+    accepted: State,
+    state: State,
+    /// `Δq_n` of the attempted step, per node (by component) and per
+    /// coordinate.
+    dq: Vec<[f64; 6]>,
+    dq_coordinates: Vec<f64>,
+    /// `a_n` for the attempted step, adjusted to its size (D5).
+    a_start: Vec<[f64; 6]>,
+    a_start_coordinates: Vec<f64>,
+    /// Size of the last accepted step.
+    last_step: Option<f64>,
+    /// `a_{n−1}` (empty before the second step).
+    a_before: Vec<[f64; 6]>,
+    a_before_coordinates: Vec<f64>,
+    controller: Option<StepController>,
+    work: Work,
+    balance: EnergyBalance,
+    energies: Energies,
+    /// Largest diagonal mass of translations and of rotations (`m_scale`
+    /// of D8).
+    mass_scale: [f64; 2],
+    redundant: usize,
+    /// The unknown with the largest residual at the last failed attempt.
+    location: String,
+    /// The latches locked so far, and the rank analyses their locks ran.
+    locks: Vec<LockInfo>,
+    lock_rank_analyses: usize,
+    started: Instant,
+    finished: bool,
+    error: Option<DynamicError>,
+}
+
+/// Work space of the iterations, allocated once per numbering.
+#[derive(Default)]
+struct Work {
+    /// `T(hΔθ)` of every node (D7).
+    factors: Vec<Mat3>,
+    rhs: Vec<f64>,
+    /// The force flux of the step, by dof: the larger of the flux at the
+    /// predictor and at the iterate (see [`Dynamics::norms`]).
+    flux: Vec<f64>,
+    /// Matrix entries in a constraint row or multiplier column, with the
+    /// kinds of their row and column (0 none, 1 distance, 2 angle).
+    scaled: Vec<(usize, u8, u8)>,
+    /// Equations numbered when `scaled` was built (`None` before; a model
+    /// without constraints leaves `scaled` empty once built).
+    n_equations: Option<usize>,
+}
+
+impl Work {
+    /// Rebuilds the lists for the numbering `dofs` and the pattern
+    /// `matrix`, if it changed.
+    fn prepare(&mut self, dofs: &DofMap, matrix: &SparseMatrix, n_nodes: usize) {
+        self.factors.resize(n_nodes, Mat3::identity());
+        self.flux.resize(6 * n_nodes, 0.0);
+        if self.n_equations == Some(dofs.n_equations()) {
+            return;
+        }
+        let code = |eq: usize| match dofs.equation_kind(eq) {
+            DofKind::Multiplier(ConstraintKind::Distance) => 1u8,
+            DofKind::Multiplier(ConstraintKind::Angle) => 2u8,
+            _ => 0u8,
+        };
+        self.scaled.clear();
+        for (k, (row, col, _)) in matrix.entries().enumerate() {
+            let (a, b) = (code(row), code(col));
+            if a != 0 || b != 0 {
+                self.scaled.push((k, a, b));
+            }
+        }
+        self.n_equations = Some(dofs.n_equations());
+        self.rhs.clear();
+        self.rhs.resize(dofs.n_equations(), 0.0);
+    }
+}
+
+/// The scale factors `s` of distance and angle constraints (D8): rows
+/// and multiplier columns of the iteration matrix are multiplied by them,
+/// and the multiplier corrections solved for are `δλ/s`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Scale([f64; 3]);
+
+impl Scale {
+    /// `s = max(k, β′ m_scale)/k` per kind, `k` the model's scaling.
+    fn new(model: &ConstraintScaling, beta_prime: f64, mass: [f64; 2]) -> Self {
+        let s = |k: f64, m: f64| (k.max(beta_prime * m) / k).max(1.0);
+        Self([1.0, s(model.force.0, mass[0]), s(model.moment.0, mass[1])])
+    }
+
+    /// Multiplies the constraint rows and multiplier columns of `matrix`.
+    fn apply(&self, work: &Work, matrix: &mut SparseMatrix) {
+        let values = matrix.values_mut();
+        for &(k, a, b) in &work.scaled {
+            values[k] *= self.0[a as usize] * self.0[b as usize];
+        }
+    }
+
+    fn of(&self, kind: DofKind) -> f64 {
+        match kind {
+            DofKind::Multiplier(ConstraintKind::Distance) => self.0[1],
+            DofKind::Multiplier(ConstraintKind::Angle) => self.0[2],
+            _ => 1.0,
+        }
+    }
+}
+
+/// The analysis seen by the step controller.
+struct Dynamics<'a> {
+    model: &'a Model,
+    settings: &'a DynamicSettings,
+    scheme: GeneralizedAlpha,
+    solver: &'a mut NewtonSolver,
+    run: &'a mut Run,
+}
+
+impl DynamicAnalysis {
+    /// Prepares the analysis of `model` with `settings`: dof numbering,
+    /// sparse pattern, buffers.
+    pub fn new(model: impl Into<Arc<Model>>, settings: DynamicSettings) -> Self {
+        let model = model.into();
+        let solver = NewtonSolver::new(&model);
+        Self {
+            scheme: GeneralizedAlpha::new(settings.rho_infinity),
+            model,
+            settings,
+            solver,
+            events: Vec::new(),
+            continued: false,
+            continuation: None,
+            run: None,
+        }
+    }
+
+    /// Starts from a converged step of this analysis (a restart file's
+    /// state) rather than from rest or the end of another analysis: the
+    /// start keeps the state's velocities, accelerations,
+    /// pseudo-accelerations and multipliers instead of solving for
+    /// consistent ones (D9–D10), so that the steps repeat those of the
+    /// run that wrote the state. With `from` (what that run knew at the
+    /// state) the energy balance goes on and the first step is predicted
+    /// as it was there; without, work and dissipation count from the
+    /// state.
+    pub fn continued(mut self, from: Option<Continuation>) -> Self {
+        self.continued = true;
+        self.continuation = from;
+        self
+    }
+
+    /// Watches `event` during the analysis ([`super::control`]).
+    pub fn with_event(mut self, event: Box<dyn EventFunction>) -> Self {
+        self.events.push(event);
+        self
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Arc<Model> {
+        &self.model
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &DynamicSettings {
+        &self.settings
+    }
+
+    /// The constants of the method.
+    pub fn scheme(&self) -> GeneralizedAlpha {
+        self.scheme
+    }
+
+    /// Number of free unknowns.
+    pub fn n_equations(&self) -> usize {
+        self.solver.dofs.n_equations()
+    }
+
+    /// Number of stored entries of the iteration matrix.
+    pub fn nnz(&self) -> usize {
+        self.solver.nnz()
+    }
+
+    /// Runs from `start` (the model's initial state, or the final state of
+    /// an analysis before) to `end_time`.
+    pub fn run(&mut self, start: State, observer: &mut dyn Observer) -> DynamicOutcome {
+        let mut step = self.start(start, observer);
+        while let Step::Increment(_) = step {
+            step = self.advance(observer);
+        }
+        self.finish()
+    }
+
+    /// Starts the analysis from `start`: the rank analysis of the
+    /// constraints, the check of the initial velocities and the consistent
+    /// initial accelerations and multipliers (step 0).
+    pub fn start(&mut self, start: State, observer: &mut dyn Observer) -> Step {
+        let started = Instant::now();
+        let model = &*self.model;
+        let s = &self.settings;
+        let mut state = start;
+        let t0 = state.time;
+        model.apply_prescribed(&mut state, t0);
+        prescribed_rates(model, &mut state, t0);
+        let mut run = Run {
+            accepted: state.clone(),
+            dq: vec![[0.0; 6]; model.n_nodes()],
+            dq_coordinates: vec![0.0; state.coordinates.len()],
+            a_start: vec![[0.0; 6]; model.n_nodes()],
+            a_start_coordinates: vec![0.0; state.coordinates.len()],
+            last_step: self.continuation.and_then(|c| c.last_step),
+            a_before: Vec::new(),
+            a_before_coordinates: Vec::new(),
+            state,
+            controller: None,
+            work: Work::default(),
+            balance: self
+                .continuation
+                .as_ref()
+                .map_or_else(EnergyBalance::new, |c| {
+                    EnergyBalance::continuing(&c.energies)
+                }),
+            energies: Energies::default(),
+            mass_scale: [0.0; 2],
+            redundant: 0,
+            location: String::new(),
+            locks: Vec::new(),
+            lock_rank_analyses: 0,
+            started,
+            finished: false,
+            error: None,
+        };
+
+        // latches at their value lock, without impact (docs/joints.md §6.2)
+        impact::lock_at_start(model, &mut run.state);
+
+        // rank of the constraints: redundant ones out
+        let rank = self.solver.constraint_rank(model, &run.state, t0);
+        run.redundant = rank.redundant.len();
+        for &k in &rank.redundant {
+            run.state.multipliers[k] = 0.0;
+        }
+        if !rank.redundant.is_empty() {
+            observer.note(&format!(
+                "{} redundant constraint equation(s) removed (over-constrained loops); their multipliers are zero and the others carry the loads",
+                rank.redundant.len()
+            ));
+        }
+
+        // initial velocities against the constraints, D10 (a continued
+        // run's were checked when it started)
+        if !self.continued {
+            if let Err(e) = check_velocities(model, &mut self.solver, &run.state, s.end_time) {
+                run.error = Some(e);
+                self.run = Some(run);
+                return Step::Stopped;
+            }
+        }
+
+        // consistent initial accelerations and multipliers, D9; a
+        // continued run keeps its own (the solve still gives the mass
+        // scales of D8)
+        let kept = self.continued.then(|| run.state.clone());
+        match initial_accelerations(model, &mut self.solver, &mut run, s.end_time) {
+            Ok(()) => {}
+            Err(failure) => {
+                run.error = Some(DynamicError::Initial { time: t0, failure });
+                self.run = Some(run);
+                return Step::Stopped;
+            }
+        }
+        if let Some(kept) = kept {
+            run.state = kept;
+            let (_, assembler, _) = self.solver.system();
+            let ctx = EvalContext {
+                dynamics: true,
+                ..model.context(t0, Need::RESIDUAL)
+            };
+            assembler.assemble(model, &ctx, &run.state);
+        }
+        model.update_internal(&mut run.state);
+        run.accepted.clone_from(&run.state);
+        let residual = self.solver.residual().to_vec();
+        run.energies = run.balance.record(model, &run.state, Some(&residual));
+        observer.energies(&run.energies);
+        let info = IncrementInfo {
+            increment: 0,
+            time: t0,
+            step: 0.0,
+            iterations: 0,
+            residuals: Vec::new(),
+            output: true,
+        };
+        let written = observer.increment(&info, model, &run.state, &residual);
+
+        let bounds = StepBounds {
+            initial: s.time_step,
+            min: s.min_step,
+            max: s.max_step,
+        };
+        run.controller = Some(
+            StepController::new(bounds, s.end_time)
+                .with_output_times(&s.output_times)
+                .with_output_every(s.output_every)
+                .with_events(
+                    impact::latch_events(model)
+                        .into_iter()
+                        .chain(std::mem::take(&mut self.events))
+                        .collect(),
+                ),
+        );
+        let stopped = written.is_err();
+        if let Err(e) = written {
+            run.error = Some(e.into());
+        }
+        self.run = Some(run);
+        if stopped {
+            Step::Stopped
+        } else {
+            Step::Increment(info)
+        }
+    }
+
+    /// One more accepted time step (with the cut-backs and retries it
+    /// takes), or the end of the analysis.
+    pub fn advance(&mut self, observer: &mut dyn Observer) -> Step {
+        let Some(run) = self.run.as_mut() else {
+            return Step::Stopped;
+        };
+        if run.error.is_some() {
+            return Step::Stopped;
+        }
+        if run.finished {
+            return Step::Finished;
+        }
+        let Some(mut controller) = run.controller.take() else {
+            return Step::Stopped;
+        };
+        let mut stepper = Dynamics {
+            model: &self.model,
+            settings: &self.settings,
+            scheme: self.scheme,
+            solver: &mut self.solver,
+            run,
+        };
+        let result = controller.advance(&mut stepper, observer);
+        let run = stepper.run;
+        run.controller = Some(controller);
+        match result {
+            Ok(Advance::Accepted(info)) => Step::Increment(info),
+            Ok(Advance::Finished) => {
+                run.finished = true;
+                Step::Finished
+            }
+            Err(stop) => {
+                run.error = Some(match stop {
+                    ControlStop::Diverged {
+                        increment,
+                        time,
+                        step,
+                        reason,
+                    } => DynamicError::Diverged {
+                        step: increment,
+                        time,
+                        size: step,
+                        reason,
+                        location: std::mem::take(&mut run.location),
+                    },
+                    // no increment limit is set
+                    ControlStop::Limit { time, .. } => DynamicError::Diverged {
+                        step: 0,
+                        time,
+                        size: 0.0,
+                        reason: NewtonFailure::MaxIterations {
+                            iterations: 0,
+                            relative_residual: 0.0,
+                        },
+                        location: String::new(),
+                    },
+                    ControlStop::Stepper(e) => e,
+                });
+                Step::Stopped
+            }
+        }
+    }
+
+    /// The last converged state (`None` before [`Self::start`]).
+    pub fn state(&self) -> Option<&State> {
+        self.run.as_ref().map(|r| &r.accepted)
+    }
+
+    /// The energies at the last converged state.
+    pub fn energies(&self) -> Option<&Energies> {
+        self.run.as_ref().map(|r| &r.energies)
+    }
+
+    /// The size the next step will try.
+    pub fn next_step_size(&self) -> Option<f64> {
+        self.run
+            .as_ref()
+            .and_then(|r| r.controller.as_ref())
+            .map(|c| c.size())
+    }
+
+    /// Why the analysis stopped, if it did.
+    pub fn error(&self) -> Option<&DynamicError> {
+        self.run.as_ref().and_then(|r| r.error.as_ref())
+    }
+
+    /// The iteration matrix `S` (D7–D8) at the last converged state, for
+    /// a step of size `h`, with its constraint rows and multiplier columns
+    /// scaled (D8) if `scaled`: a copy in equation numbering, for studies
+    /// of its conditioning.
+    pub fn iteration_matrix(&mut self, h: f64, scaled: bool) -> Option<SparseMatrix> {
+        let run = self.run.as_mut()?;
+        let model = &*self.model;
+        let scale = Scale::new(&model.scaling, self.scheme.beta_prime(h), run.mass_scale);
+        let (dofs, assembler, _) = self.solver.system();
+        run.work.prepare(dofs, &assembler.matrix, model.n_nodes());
+        let ctx = dynamic_context(model, run.accepted.time, &self.scheme, h);
+        for (node, f) in run.work.factors.iter_mut().enumerate() {
+            *f = so3::tangent(&Vec3::new(
+                h * run.dq[node][3],
+                h * run.dq[node][4],
+                h * run.dq[node][5],
+            ));
+        }
+        assembler.assemble_factored(model, &ctx, &run.accepted, &run.work.factors);
+        if scaled {
+            scale.apply(&run.work, &mut assembler.matrix);
+        }
+        Some(assembler.matrix.clone())
+    }
+
+    /// Ends the analysis: what it did and its last converged state.
+    pub fn finish(&mut self) -> DynamicOutcome {
+        let run = self.run.take();
+        let wall_time = run
+            .as_ref()
+            .map_or(0.0, |r| r.started.elapsed().as_secs_f64());
+        let (state, counts, redundant, energies, error, locks) = match run {
+            Some(r) => {
+                let mut counts = r.controller.map(|c| c.counts()).unwrap_or_default();
+                counts.rank_analyses += r.lock_rank_analyses;
+                (
+                    r.accepted,
+                    counts,
+                    r.redundant,
+                    r.energies,
+                    r.error,
+                    r.locks,
+                )
+            }
+            None => (
+                State::default(),
+                Default::default(),
+                0,
+                Energies::default(),
+                None,
+                Vec::new(),
+            ),
+        };
+        DynamicOutcome {
+            time: state.time,
+            state,
+            steps: counts.increments,
+            rejected_steps: counts.cutbacks + counts.error_rejections,
+            error_rejections: counts.error_rejections,
+            iterations: counts.iterations,
+            wasted_iterations: counts.wasted_iterations,
+            cutbacks: counts.cutbacks,
+            redundant_constraints: redundant.max(self.solver.redundant_count()),
+            rank_analyses: counts.rank_analyses,
+            event_retries: counts.event_retries,
+            locks,
+            energies,
+            wall_time,
+            error,
+        }
+    }
+}
+
+/// The evaluation context of a step of size `h` ending at `time`: inertia
+/// forces in the residual, the stiffness and the inertia matrix with
+/// weights `(γ′, β′)` (D7). The scaling `k` and penalty `p` are the
+/// model's: the penalty is not raised with `β′`, since `p Bᵀ Φ` would then
+/// amplify the round-off of `Φ` into spurious forces as `h → 0`.
+fn dynamic_context<'a>(
+    model: &'a Model,
+    time: f64,
+    scheme: &GeneralizedAlpha,
+    h: f64,
+) -> EvalContext<'a> {
+    EvalContext {
+        dynamics: true,
+        ..model.context(
+            time,
+            Need::with_inertia(scheme.gamma_prime(h), scheme.beta_prime(h)),
+        )
+    }
+}
+
+/// Velocities and accelerations of the prescribed components at `t`, from
+/// central differences of their curves: `ẋ = f′(t) value`; for a
+/// prescribed rotation `R = exp(f ψ~) R₀`, `Ω = Rᵀψ f′` and `Ω̇ = Rᵀψ f″`.
+fn prescribed_rates(model: &Model, state: &mut State, t: f64) {
+    let d = 1e-5 * t.abs().max(1.0);
+    for p in &model.prescribed {
+        let curve = match *p {
+            Prescribed::Translation { curve, .. } | Prescribed::Rotation { curve, .. } => curve,
+        };
+        let c = &model.curves[curve];
+        let (cm, c0, cp) = (c.value(t - d), c.value(t), c.value(t + d));
+        let (rate, second) = ((cp - cm) / (2.0 * d), (cp - 2.0 * c0 + cm) / (d * d));
+        match *p {
+            Prescribed::Translation {
+                node, axis, value, ..
+            } => {
+                state.velocity[node][axis] = value * rate;
+                state.acceleration[node][axis] = value * second;
+                state.pseudo_acceleration[node][axis] = value * second;
+            }
+            Prescribed::Rotation { node, psi, .. } => {
+                let w = state.q[node].inverse() * psi;
+                for k in 0..3 {
+                    state.velocity[node][3 + k] = w[k] * rate;
+                    state.acceleration[node][3 + k] = w[k] * second;
+                    state.pseudo_acceleration[node][3 + k] = w[k] * second;
+                }
+            }
+        }
+    }
+}
+
+/// The state moved along its velocities for a time `e` (nodes on the
+/// group, coordinates additively), at time `t + e` with the prescribed
+/// motions there: the motion `q ∘ exp(e v)` along which the derivatives of
+/// D9–D10 are taken.
+fn moved(model: &Model, state: &State, e: f64) -> State {
+    let mut s = state.clone();
+    for node in 0..s.n_nodes() {
+        let v = state.velocity[node];
+        s.displace_node(
+            node,
+            &(Vec3::new(v[0], v[1], v[2]) * e),
+            &(Vec3::new(v[3], v[4], v[5]) * e),
+        );
+    }
+    for (c, r) in s.coordinates.iter_mut().zip(&state.coordinate_rates) {
+        *c += e * r;
+    }
+    s.time = state.time + e;
+    let t = s.time;
+    model.apply_prescribed(&mut s, t);
+    s
+}
+
+/// The time step of the differences of D9–D10: the motion over it is
+/// [`MOTION_STEP`] of the model's size, or of the span of the analysis.
+fn motion_step(model: &Model, state: &State, end_time: f64) -> f64 {
+    let l = model.length_scale;
+    let (mut v, mut w) = (0.0f64, 0.0f64);
+    for r in &state.velocity {
+        v = v.max(Vec3::new(r[0], r[1], r[2]).norm());
+        w = w.max(Vec3::new(r[3], r[4], r[5]).norm());
+    }
+    let span = (end_time - state.time).abs().max(f64::MIN_POSITIVE);
+    let mut e = span;
+    if v > 0.0 {
+        e = e.min(l / v);
+    }
+    if w > 0.0 {
+        e = e.min(1.0 / w);
+    }
+    MOTION_STEP * e
+}
+
+/// The multiplier rows of the residual (`−kΦ`) at `state`, by dof.
+fn constraint_residual(model: &Model, solver: &mut NewtonSolver, state: &State) -> Vec<f64> {
+    let (_, assembler, _) = solver.system();
+    let ctx = model.context(state.time, Need::RESIDUAL);
+    assembler.assemble(model, &ctx, state);
+    assembler.residual.clone()
+}
+
+/// First and second derivatives of the residual of the multiplier rows
+/// along the motion (`−k Φ̇` and `−k Φ̈` at `v̇ = 0`), by Richardson
+/// extrapolation of central differences (D9–D10).
+pub(super) fn constraint_rates(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    state: &State,
+    end_time: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let e = motion_step(model, state, end_time);
+    let r0 = constraint_residual(model, solver, state);
+    let mut diffs = Vec::new();
+    for h in [e, 0.5 * e] {
+        let rp = constraint_residual(model, solver, &moved(model, state, h));
+        let rm = constraint_residual(model, solver, &moved(model, state, -h));
+        let first: Vec<f64> = rp
+            .iter()
+            .zip(&rm)
+            .map(|(p, m)| (p - m) / (2.0 * h))
+            .collect();
+        let second: Vec<f64> = (0..r0.len())
+            .map(|d| (rp[d] - 2.0 * r0[d] + rm[d]) / (h * h))
+            .collect();
+        diffs.push((first, second));
+    }
+    let rich = |a: &[f64], b: &[f64]| -> Vec<f64> {
+        a.iter().zip(b).map(|(a, b)| (4.0 * b - a) / 3.0).collect()
+    };
+    (
+        rich(&diffs[0].0, &diffs[1].0),
+        rich(&diffs[0].1, &diffs[1].1),
+    )
+}
+
+/// D10: the initial velocities must satisfy `Φ̇ = B v + ∂Φ/∂t = 0`, to
+/// `1e-6` of the velocity scale ([`VELOCITY_TOLERANCE`]).
+fn check_velocities(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    state: &State,
+    end_time: f64,
+) -> Result<(), DynamicError> {
+    if solver.dofs.first_multiplier() == solver.dofs.n_dofs() {
+        return Ok(());
+    }
+    let (rate, _) = constraint_rates(model, solver, state, end_time);
+    let l = model.length_scale;
+    let (mut v, mut w) = (0.0f64, 0.0f64);
+    for r in &state.velocity {
+        v = v.max(Vec3::new(r[0], r[1], r[2]).norm());
+        w = w.max(Vec3::new(r[3], r[4], r[5]).norm());
+    }
+    let span = (end_time - state.time).abs().max(f64::MIN_POSITIVE);
+    let dofs = &solver.dofs;
+    for eq in 0..dofs.n_equations() {
+        let DofKind::Multiplier(kind) = dofs.equation_kind(eq) else {
+            continue;
+        };
+        let d = dofs.dof(eq);
+        let k = model.scaling.of(kind).0;
+        let phi_dot = rate[d] / k;
+        let tolerance = VELOCITY_TOLERANCE
+            * match kind {
+                ConstraintKind::Distance => v + w * l + l / span,
+                ConstraintKind::Angle => w + v / l + 1.0 / span,
+            };
+        if phi_dot.abs() > tolerance {
+            return Err(DynamicError::InconsistentVelocity {
+                constraint: constraint_name(model, solver, d),
+                rate: phi_dot,
+                tolerance,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `joint 3 equation 2` for the multiplier dof `dof`.
+fn constraint_name(model: &Model, solver: &NewtonSolver, dof: usize) -> String {
+    let k = dof - solver.dofs.first_multiplier();
+    for (i, e) in model.elements.iter().enumerate() {
+        let o = model.offsets(i).multipliers;
+        if k >= o && k < o + e.n_multipliers() {
+            return format!("{} {} equation {}", e.kind().name(), e.id(), k - o + 1);
+        }
+    }
+    solver.dof_label(model, dof)
+}
+
+/// D9: consistent initial accelerations and multipliers. Solves
+///
+/// ```text
+/// [ M    −kBᵀ ] [ v̇  ]     [ g(q, v, t) + Bᵀ(pΦ − kλ) ]
+/// [ −kB   0   ] [ δλ ] = − [ −k Φ̈|_{v̇=0}              ]
+/// ```
+///
+/// (rows of unknowns without mass take their stiffness row instead of
+/// `M`), and starts with `a₀ = v̇₀`. Also sets the mass scales of D8.
+fn initial_accelerations(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    run: &mut Run,
+    end_time: f64,
+) -> Result<(), NewtonFailure> {
+    let state = &mut run.state;
+    let t0 = state.time;
+    for a in state.acceleration.iter_mut() {
+        *a = [0.0; 6];
+    }
+    state.coordinate_accelerations.fill(0.0);
+    let has_constraints = solver.dofs.first_multiplier() < solver.dofs.n_dofs();
+    let second = if has_constraints {
+        constraint_rates(model, solver, state, end_time).1
+    } else {
+        Vec::new()
+    };
+    let (dofs, assembler, lu) = solver.system();
+    let mut stiffness = assembler.matrix.clone();
+    let mut mass = assembler.matrix.clone();
+    let ctx = EvalContext {
+        dynamics: true,
+        ..model.context(t0, Need::with_inertia(0.0, 1.0))
+    };
+    assembler.assemble_split(model, &ctx, state, &mut stiffness, &mut mass);
+    if !assembler.residual.iter().all(|r| r.is_finite()) {
+        return Err(NewtonFailure::NonFinite {
+            iteration: 0,
+            origin: non_finite_origin(model, state, t0),
+        });
+    }
+
+    // mass scales and the massless rows
+    let n = dofs.n_equations();
+    let mut diagonal = vec![0.0; n];
+    for (row, col, v) in mass.entries() {
+        if row == col {
+            diagonal[row] = v;
+        }
+    }
+    let mut scale = [0.0f64; 2];
+    for (eq, &m) in diagonal.iter().enumerate() {
+        match dofs.equation_kind(eq) {
+            DofKind::Translation | DofKind::Coordinate { .. } => scale[0] = scale[0].max(m),
+            DofKind::Rotation => scale[1] = scale[1].max(m),
+            DofKind::Multiplier(_) => {}
+        }
+    }
+    run.mass_scale = scale;
+    let massless = |eq: usize| match dofs.equation_kind(eq) {
+        DofKind::Translation | DofKind::Coordinate { .. } => diagonal[eq] <= MASSLESS * scale[0],
+        DofKind::Rotation => diagonal[eq] <= MASSLESS * scale[1],
+        DofKind::Multiplier(_) => false,
+    };
+    let is_multiplier: Vec<bool> = (0..n)
+        .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
+        .collect();
+    let light: Vec<bool> = (0..n).map(massless).collect();
+    // multiplier rows and columns scaled to the mass (D8 with β′ = 1)
+    let s_eq: Vec<f64> = (0..n)
+        .map(|eq| match dofs.equation_kind(eq) {
+            DofKind::Multiplier(kind) => {
+                let (m, k) = match kind {
+                    ConstraintKind::Distance => (scale[0], model.scaling.force.0),
+                    ConstraintKind::Angle => (scale[1], model.scaling.moment.0),
+                };
+                if m > 0.0 {
+                    m / k
+                } else {
+                    1.0
+                }
+            }
+            _ => 1.0,
+        })
+        .collect();
+    let dof_of: Vec<usize> = (0..n).map(|eq| dofs.dof(eq)).collect();
+    {
+        let values = assembler.matrix.values_mut();
+        let (k, m) = (stiffness.values(), mass.values());
+        for (i, (row, col, _)) in stiffness.entries().enumerate() {
+            let v = if is_multiplier[row] || is_multiplier[col] || light[row] {
+                k[i] + m[i]
+            } else {
+                m[i]
+            };
+            values[i] = v * s_eq[row] * s_eq[col];
+        }
+    }
+    let mut rhs: Vec<f64> = (0..n)
+        .map(|eq| {
+            let d = dof_of[eq];
+            if is_multiplier[eq] {
+                -second[d] * s_eq[eq]
+            } else {
+                -assembler.residual[d]
+            }
+        })
+        .collect();
+    let solved = (|| {
+        if lu.is_none() {
+            *lu = Some(SparseLu::analyze(&assembler.matrix)?);
+        }
+        let lu = lu.as_mut().expect("analysed above");
+        lu.factor(&assembler.matrix)?;
+        lu.solve_in_place(&mut rhs)
+    })();
+    if solved.is_err() || !rhs.iter().all(|v| v.is_finite()) {
+        return Err(singular(model, solver, state, 0));
+    }
+    let (dofs, _, _) = solver.system();
+    for (eq, z) in rhs.iter().enumerate() {
+        let d = dofs.dof(eq);
+        if let Some((node, c)) = dofs.node_component(d) {
+            state.acceleration[node][c] = *z;
+        } else if d < dofs.first_multiplier() {
+            state.coordinate_accelerations[d - dofs.first_coordinate()] = *z;
+        } else {
+            state.multipliers[d - dofs.first_multiplier()] += z * s_eq[eq];
+        }
+    }
+    state.pseudo_acceleration.clone_from(&state.acceleration);
+    state
+        .coordinate_pseudo_accelerations
+        .clone_from(&state.coordinate_accelerations);
+    // the residual at the start, for the observer (reactions)
+    let (_, assembler, _) = solver.system();
+    let ctx = EvalContext {
+        dynamics: true,
+        ..model.context(t0, Need::RESIDUAL)
+    };
+    assembler.assemble(model, &ctx, state);
+    Ok(())
+}
+
+/// The failure of a singular or nearly singular iteration matrix: the
+/// unknown without stiffness or mass.
+fn singular(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    state: &State,
+    iteration: usize,
+) -> NewtonFailure {
+    let (_, assembler, _) = solver.system();
+    let matrix = &assembler.matrix;
+    if !(matrix.values().iter().all(|v| v.is_finite())
+        && assembler.residual.iter().all(|v| v.is_finite()))
+    {
+        return NewtonFailure::NonFinite {
+            iteration,
+            origin: non_finite_origin(model, state, state.time),
+        };
+    }
+    match smallest_relative_pivot(matrix) {
+        Ok((eq, pivot)) if pivot < SINGULAR_PIVOT => {
+            let d = solver.dofs.dof(eq);
+            NewtonFailure::Singular {
+                dof: solver.dof_label(model, d),
+                pivot,
+            }
+        }
+        _ => NewtonFailure::NonFinite {
+            iteration,
+            origin: "in the solution of the linear system (a nearly singular iteration matrix)"
+                .into(),
+        },
+    }
+}
+
+impl Dynamics<'_> {
+    /// The predictor (D5): `v̇_{n+1} = 0`, `λ_{n+1} = λ_n`,
+    /// `a_{n+1} = (α_f v̇_n − α_m a_n)/(1 − α_m)`, then `v`, `Δq`, `q`.
+    fn predict(&mut self, h: f64) {
+        let (sc, run) = (self.scheme, &mut *self.run);
+        let dofs = &self.solver.dofs;
+        let n = &run.accepted;
+        let s = &mut run.state;
+        s.clone_from(n);
+        s.time = n.time + h;
+        // a_n − v̇_n is O(h) (a is the acceleration at t_n + (α_m − α_f)h
+        // to first order): scaled with the step when its size changes
+        let ratio = run.last_step.map_or(1.0, |hp| h / hp);
+        let predict = |vn: f64, vdn: f64, an: f64| -> (f64, f64, f64, f64) {
+            let an = vdn + (an - vdn) * ratio;
+            let a = (sc.alpha_f * vdn - sc.alpha_m * an) / (1.0 - sc.alpha_m);
+            let v = vn + h * (1.0 - sc.gamma) * an + h * sc.gamma * a;
+            let dq = vn + h * (0.5 - sc.beta) * an + h * sc.beta * a;
+            (an, a, v, dq)
+        };
+        for node in 0..s.n_nodes() {
+            run.dq[node] = [0.0; 6];
+            for c in 0..6 {
+                if dofs.equation(6 * node + c) == NO_EQUATION {
+                    continue;
+                }
+                let (an, a, v, dq) = predict(
+                    n.velocity[node][c],
+                    n.acceleration[node][c],
+                    n.pseudo_acceleration[node][c],
+                );
+                run.a_start[node][c] = an;
+                s.pseudo_acceleration[node][c] = a;
+                s.velocity[node][c] = v;
+                s.acceleration[node][c] = 0.0;
+                run.dq[node][c] = dq;
+            }
+        }
+        let first = dofs.first_coordinate();
+        for k in 0..s.coordinates.len() {
+            run.dq_coordinates[k] = 0.0;
+            if dofs.equation(first + k) == NO_EQUATION {
+                continue;
+            }
+            let (an, a, v, dq) = predict(
+                n.coordinate_rates[k],
+                n.coordinate_accelerations[k],
+                n.coordinate_pseudo_accelerations[k],
+            );
+            run.a_start_coordinates[k] = an;
+            s.coordinate_pseudo_accelerations[k] = a;
+            s.coordinate_rates[k] = v;
+            s.coordinate_accelerations[k] = 0.0;
+            run.dq_coordinates[k] = dq;
+        }
+        self.place(h);
+    }
+
+    /// `q_{n+1} = q_n ∘ exp(h Δq_n)` (D2) for the free unknowns; the
+    /// prescribed ones at their values and rates at `t_{n+1}`.
+    fn place(&mut self, h: f64) {
+        let run = &mut *self.run;
+        let dofs = &self.solver.dofs;
+        let (n, s) = (&run.accepted, &mut run.state);
+        for node in 0..s.n_nodes() {
+            let dq = &run.dq[node];
+            if dq.iter().all(|&d| d == 0.0) {
+                continue;
+            }
+            s.x[node] = n.x[node];
+            s.q[node] = n.q[node];
+            s.displace_node(
+                node,
+                &(Vec3::new(dq[0], dq[1], dq[2]) * h),
+                &(Vec3::new(dq[3], dq[4], dq[5]) * h),
+            );
+        }
+        let first = dofs.first_coordinate();
+        for k in 0..s.coordinates.len() {
+            if dofs.equation(first + k) != NO_EQUATION {
+                s.coordinates[k] = n.coordinates[k] + h * run.dq_coordinates[k];
+            }
+        }
+        let t = s.time;
+        self.model.apply_prescribed(s, t);
+        prescribed_rates(self.model, s, t);
+    }
+
+    /// Applies the Newton correction `x` (by equation; multipliers already
+    /// unscaled): `Δq += x/h`, `a += x/(βh²)`, `v += γ′x`, `v̇ += β′x`
+    /// (D6), `λ += δλ`, and places the nodes again.
+    fn correct(&mut self, h: f64, x: &[f64]) {
+        let sc = self.scheme;
+        let (gp, bp, ba) = (sc.gamma_prime(h), sc.beta_prime(h), 1.0 / (sc.beta * h * h));
+        let run = &mut *self.run;
+        let dofs = &self.solver.dofs;
+        let s = &mut run.state;
+        for (eq, &xe) in x.iter().enumerate() {
+            let d = dofs.dof(eq);
+            if let Some((node, c)) = dofs.node_component(d) {
+                run.dq[node][c] += xe / h;
+                s.pseudo_acceleration[node][c] += ba * xe;
+                s.velocity[node][c] += gp * xe;
+                s.acceleration[node][c] += bp * xe;
+            } else if d < dofs.first_multiplier() {
+                let k = d - dofs.first_coordinate();
+                run.dq_coordinates[k] += xe / h;
+                s.coordinate_pseudo_accelerations[k] += ba * xe;
+                s.coordinate_rates[k] += gp * xe;
+                s.coordinate_accelerations[k] += bp * xe;
+            } else {
+                s.multipliers[d - dofs.first_multiplier()] += xe;
+            }
+        }
+        self.place(h);
+    }
+
+    /// Largest translation and rotation of the step, `h|Δq|`.
+    fn step_motion(&self, h: f64) -> (f64, f64) {
+        let run = &*self.run;
+        let (mut dx, mut dth) = (0.0f64, 0.0f64);
+        for dq in &run.dq {
+            dx = dx.max(h * Vec3::new(dq[0], dq[1], dq[2]).norm());
+            dth = dth.max(h * Vec3::new(dq[3], dq[4], dq[5]).norm());
+        }
+        let lengths = &run.dq_coordinates;
+        for (k, d) in lengths.iter().enumerate() {
+            let first = self.solver.dofs.first_coordinate();
+            if let DofKind::Coordinate { length } = self.solver.dofs.kind(first + k) {
+                dx = dx.max(h * d.abs() * length);
+            }
+        }
+        (dx, dth)
+    }
+
+    /// The convergence measures of the current iterate (the assembler
+    /// holds its residual): norms, and the unknown with the largest
+    /// residual relative to its group's flux.
+    ///
+    /// The flux of a node is that of the step ([`Work::flux`]): the larger,
+    /// dof by dof, of `Σₑ |rₑ|` at the predictor and at the iterate. The
+    /// inertia force `M v̇` is part of each element's own residual, so at
+    /// the iterate it cancels inside the element and leaves no trace in
+    /// `Σₑ |rₑ|`: on a node carried by a single body (a free rigid body)
+    /// the flux would be the residual itself and the relative residual 1
+    /// whatever its size. At the predictor `v̇ = 0` (D5), and `Σₑ |rₑ|` there
+    /// is the force that `M v̇` balances at the solution.
+    fn norms(&self, floor: f64, motion: (f64, f64)) -> (ConvergenceNorms, usize) {
+        let (dofs, assembler) = (&self.solver.dofs, self.solver_assembler());
+        let step_flux = &self.run.work.flux;
+        let flux_of = |d: usize| {
+            let f = assembler.flux[d];
+            step_flux.get(d).map_or(f, |&g| f.max(g))
+        };
+        let (mut rf, mut rm, mut rq, mut ef, mut em, mut eq_c) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let (mut ff, mut fm) = (0.0, 0.0);
+        for d in 0..6 * dofs.n_nodes() {
+            let f = flux_of(d);
+            if d % 6 < 3 {
+                ff += f * f;
+            } else {
+                fm += f * f;
+            }
+        }
+        let (ff, fm) = (ff.sqrt(), fm.sqrt());
+        let settings = self.settings;
+        let mut constraint = 0.0f64;
+        let mut worst = (0usize, -1.0f64);
+        let eps = f64::EPSILON * floor;
+        for eq in 0..dofs.n_equations() {
+            let d = dofs.dof(eq);
+            let r = assembler.residual[d];
+            let excess = (r.abs() - eps * flux_of(d)).max(0.0);
+            let relative = match dofs.kind(d) {
+                DofKind::Translation => {
+                    rf += r * r;
+                    ef += excess * excess;
+                    excess / ff.max(f64::MIN_POSITIVE)
+                }
+                DofKind::Rotation => {
+                    rm += r * r;
+                    em += excess * excess;
+                    excess / fm.max(f64::MIN_POSITIVE)
+                }
+                DofKind::Coordinate { length } => {
+                    rq += (r / length).powi(2);
+                    eq_c += (excess / length).powi(2);
+                    excess / length / ff.max(f64::MIN_POSITIVE)
+                }
+                DofKind::Multiplier(kind) => {
+                    let (k, round_off, tol) = match kind {
+                        ConstraintKind::Distance => (
+                            self.model.scaling.force.0,
+                            eps * self.model.length_scale,
+                            settings.displacement_tolerance * motion.0,
+                        ),
+                        ConstraintKind::Angle => (
+                            self.model.scaling.moment.0,
+                            eps,
+                            settings.rotation_tolerance,
+                        ),
+                    };
+                    let violation = (r.abs() / k - round_off).max(0.0);
+                    if violation > 0.0 {
+                        constraint = constraint.max(violation / tol.max(f64::MIN_POSITIVE));
+                    }
+                    0.0
+                }
+            };
+            if relative > worst.1 {
+                worst = (d, relative);
+            }
+        }
+        let rel = |e: f64, f: f64| if e == 0.0 { 0.0 } else { e / f };
+        let norms = ConvergenceNorms {
+            residual_force: rf.sqrt(),
+            residual_moment: rm.sqrt(),
+            flux_force: ff,
+            flux_moment: fm,
+            residual_coordinate: rq.sqrt(),
+            relative_residual: rel(ef.sqrt(), ff)
+                .max(rel(em.sqrt(), fm))
+                .max(rel(eq_c.sqrt(), ff)),
+            residual_constraint: constraint,
+            displacement_correction: 0.0,
+            rotation_correction: 0.0,
+        };
+        (norms, worst.0)
+    }
+
+    /// Whether corrections `dx` (translations) and `dth` (rotations) are
+    /// within [`PLATEAU_FACTOR`] ε of the unknowns they correct (the
+    /// largest node position plus the model size, and 1 rad): the state
+    /// can be made no closer to the solution in floating point.
+    fn at_round_off(&self, dx: f64, dth: f64) -> bool {
+        let state = &self.run.state;
+        let size = self.model.length_scale + state.x.iter().map(|x| x.norm()).fold(0.0, f64::max);
+        let round = PLATEAU_FACTOR * f64::EPSILON;
+        dx <= round * size && dth <= round
+    }
+
+    fn solver_assembler(&self) -> &crate::assembly::Assembler {
+        self.solver.assembler()
+    }
+
+    /// Whether the next correction, estimated as the last one (`x`) times
+    /// `ratio`, is below the tolerances: `ε_u` times the step's largest
+    /// translation, `ε_θ` times its largest rotation (relative in
+    /// dynamics), `ε_r` of the flux for the force `k δλ` of a multiplier,
+    /// each above round-off.
+    fn correction_converged(
+        &self,
+        x: &[f64],
+        ratio: f64,
+        motion: (f64, f64),
+        norms: &ConvergenceNorms,
+    ) -> bool {
+        let s = self.settings;
+        let dofs = &self.solver.dofs;
+        let state = &self.run.state;
+        let round = FLOOR_FACTOR * f64::EPSILON;
+        let l = self.model.length_scale;
+        x.iter().enumerate().all(|(eq, &delta)| {
+            let d = dofs.dof(eq);
+            let next = delta.abs() * ratio;
+            match dofs.kind(d) {
+                DofKind::Translation => {
+                    next <= s.displacement_tolerance * motion.0
+                        + round * (state.x[d / 6].norm() + l)
+                }
+                DofKind::Rotation => next <= s.rotation_tolerance * motion.1 + round,
+                DofKind::Coordinate { length } => {
+                    let c = state.coordinates[d - dofs.first_coordinate()];
+                    next * length
+                        <= s.displacement_tolerance * motion.0 + round * (c.abs() + 1.0) * length
+                }
+                DofKind::Multiplier(kind) => {
+                    let (k, flux) = match kind {
+                        ConstraintKind::Distance => (self.model.scaling.force.0, norms.flux_force),
+                        ConstraintKind::Angle => (self.model.scaling.moment.0, norms.flux_moment),
+                    };
+                    let lambda = state.multipliers[d - dofs.first_multiplier()];
+                    (next - round * lambda.abs()) * k <= s.residual_tolerance * flux
+                }
+            }
+        })
+    }
+
+    /// One step of size `h` from the accepted state: predictor, then
+    /// Newton on `S x = −r` (D6–D8).
+    fn newton(
+        &mut self,
+        h: f64,
+        increment: usize,
+        observer: &mut dyn Observer,
+    ) -> Result<(usize, Vec<f64>), NewtonFailure> {
+        let model = self.model;
+        let sc = self.scheme;
+        self.predict(h);
+        let scale = Scale::new(&model.scaling, sc.beta_prime(h), self.run.mass_scale);
+        let t = self.run.state.time;
+        let mut residuals = Vec::new();
+        let mut last: Option<(f64, f64)> = None;
+        let free_size = model.length_scale;
+        let mut x = Vec::new();
+        for iteration in 0..=self.settings.max_iterations {
+            // assemble residual and S = β′M + γ′C + K T(hΔq)
+            {
+                let run = &mut *self.run;
+                let (dofs, assembler, _) = self.solver.system();
+                run.work.prepare(dofs, &assembler.matrix, model.n_nodes());
+                for (node, f) in run.work.factors.iter_mut().enumerate() {
+                    let dq = &run.dq[node];
+                    *f = so3::tangent(&(Vec3::new(dq[3], dq[4], dq[5]) * h));
+                }
+                let ctx = dynamic_context(model, t, &sc, h);
+                assembler.assemble_factored(model, &ctx, &run.state, &run.work.factors);
+                // the flux of the step: Σₑ |rₑ| at the predictor (v̇ = 0)
+                if iteration == 0 {
+                    let n = run.work.flux.len();
+                    run.work.flux.copy_from_slice(&assembler.flux[..n]);
+                }
+            }
+            let motion = self.step_motion(h);
+            let (mut norms, worst) = self.norms(FLOOR_FACTOR, motion);
+            if let Some((dx, dth)) = last {
+                norms.displacement_correction = dx;
+                norms.rotation_correction = dth;
+            }
+            residuals.push(norms.relative_residual);
+            observer.iteration(&IterationInfo {
+                increment,
+                iteration,
+                time: t,
+                norms,
+            });
+            let finite = norms.residual_force.is_finite()
+                && norms.residual_moment.is_finite()
+                && norms.residual_coordinate.is_finite()
+                && norms.residual_constraint.is_finite();
+            if !finite {
+                self.run.location = self.solver.dof_label(model, worst);
+                return Err(NewtonFailure::NonFinite {
+                    iteration,
+                    origin: non_finite_origin(model, &self.run.state, t),
+                });
+            }
+            let tol = self.settings.residual_tolerance;
+            if last.is_some() {
+                let ratio = match residuals[..] {
+                    [.., previous, now] if previous > 0.0 => (now / previous).min(1.0),
+                    _ => 1.0,
+                };
+                let converged = norms.relative_residual <= tol
+                    && norms.residual_constraint <= 1.0
+                    && self.correction_converged(&x, ratio, motion, &norms);
+                // the residual stopped decreasing at its round-off: within
+                // PLATEAU_FACTOR ε of the flux, or left by a correction
+                // that no longer changes the unknowns (the round-off of a
+                // stiff element's force is ε E A |x|/L, not ε of the
+                // force: a stiff beam's residual stops at ~1e-8 of the
+                // flux)
+                let plateau = || {
+                    let (loose, _) = self.norms(PLATEAU_FACTOR, motion);
+                    let (dx, dth) = last.unwrap_or_default();
+                    ratio > 0.5
+                        && loose.residual_constraint <= 1.0
+                        && (loose.relative_residual <= tol || self.at_round_off(dx, dth))
+                };
+                if converged || plateau() {
+                    return Ok((iteration, residuals));
+                }
+            }
+            if iteration == self.settings.max_iterations {
+                self.run.location = format!(
+                    "{} (relative residual {:.3e})",
+                    self.solver.dof_label(model, worst),
+                    norms.relative_residual
+                );
+                return Err(NewtonFailure::MaxIterations {
+                    iterations: iteration,
+                    relative_residual: norms.relative_residual,
+                });
+            }
+
+            // solve S x = −r with the constraint rows and multipliers
+            // scaled (D8)
+            let solved = {
+                let run = &mut *self.run;
+                let (dofs, assembler, lu) = self.solver.system();
+                scale.apply(&run.work, &mut assembler.matrix);
+                for (eq, r) in run.work.rhs.iter_mut().enumerate() {
+                    *r = -assembler.residual[dofs.dof(eq)] * scale.of(dofs.equation_kind(eq));
+                }
+                (|| {
+                    if lu.is_none() {
+                        *lu = Some(SparseLu::analyze(&assembler.matrix)?);
+                    }
+                    let lu = lu.as_mut().expect("analysed above");
+                    lu.factor(&assembler.matrix)?;
+                    lu.solve_in_place(&mut run.work.rhs)
+                })()
+            };
+            x.clone_from(&self.run.work.rhs);
+            let dofs = &self.solver.dofs;
+            let (mut dx, mut dth) = (0.0f64, 0.0f64);
+            for (eq, v) in x.iter_mut().enumerate() {
+                let kind = dofs.equation_kind(eq);
+                *v *= scale.of(kind);
+                let a = if v.is_finite() {
+                    v.abs()
+                } else {
+                    f64::INFINITY
+                };
+                match kind {
+                    DofKind::Translation => dx = dx.max(a),
+                    DofKind::Rotation => dth = dth.max(a),
+                    DofKind::Coordinate { length } => dx = dx.max(a * length),
+                    DofKind::Multiplier(_) => {}
+                }
+            }
+            if solved.is_err()
+                || !(dx <= RUNAWAY_CORRECTION * free_size && dth <= RUNAWAY_CORRECTION)
+            {
+                let failure = singular(model, self.solver, &self.run.state, iteration);
+                self.run.location = match &failure {
+                    NewtonFailure::Singular { dof, .. } => dof.clone(),
+                    _ => self.solver.dof_label(model, worst),
+                };
+                return Err(failure);
+            }
+            self.correct(h, &x);
+            last = Some((dx, dth));
+        }
+        unreachable!("the loop returns at max_iterations")
+    }
+
+    /// D11: the local error estimate `e = (β − 1/6) h² (a_{n+1} − a_n)`
+    /// per node, relative to the tolerance times the step's motion (or
+    /// 1e-3 of the model size, 1e-3 rad, if larger). The difference is
+    /// taken over the last two steps, `h (a_{n+1} − a_{n−1})/(h + h_{n−1})`,
+    /// which cancels the alternating transient that index-3 constraints
+    /// and changes of step excite in `a` (decaying as `ρ∞ⁿ`), and which is
+    /// not an error of the positions.
+    fn error_estimate(&self, h: f64) -> f64 {
+        let run = &*self.run;
+        let c = (self.scheme.beta - 1.0 / 6.0).abs() * h * h;
+        let (dx, dth) = self.step_motion(h);
+        let l = self.model.length_scale;
+        let tol = self.settings.error_tolerance;
+        let s = &run.state;
+        let dofs = &self.solver.dofs;
+        // a_{n+1} − a_n, or over the last two steps when there are two
+        let w = run.last_step.map(|hp| h / (h + hp));
+        let difference = |a1: f64, a0: f64, before: Option<f64>| match (w, before) {
+            (Some(w), Some(am)) => w * (a1 - am),
+            _ => a1 - a0,
+        };
+        let (mut ex, mut eth) = (0.0f64, 0.0f64);
+        for node in 0..s.n_nodes() {
+            let mut e = [0.0; 6];
+            for (k, ek) in e.iter_mut().enumerate() {
+                if dofs.equation(6 * node + k) != NO_EQUATION {
+                    *ek = c * difference(
+                        s.pseudo_acceleration[node][k],
+                        run.a_start[node][k],
+                        run.a_before.get(node).map(|a| a[k]),
+                    );
+                }
+            }
+            ex = ex.max(Vec3::new(e[0], e[1], e[2]).norm());
+            eth = eth.max(Vec3::new(e[3], e[4], e[5]).norm());
+        }
+        let first = dofs.first_coordinate();
+        for k in 0..s.coordinates.len() {
+            if let DofKind::Coordinate { length } = dofs.kind(first + k) {
+                if dofs.equation(first + k) != NO_EQUATION {
+                    let e = c * difference(
+                        s.coordinate_pseudo_accelerations[k],
+                        run.a_start_coordinates[k],
+                        run.a_before_coordinates.get(k).copied(),
+                    );
+                    ex = ex.max(e.abs() * length);
+                }
+            }
+        }
+        (ex / (tol * dx.max(1e-3 * l))).max(eth / (tol * dth.max(1e-3)))
+    }
+}
+
+impl Stepper for Dynamics<'_> {
+    type Error = DynamicError;
+
+    fn current(&self) -> (&Model, &State) {
+        (self.model, &self.run.state)
+    }
+
+    fn time(&self) -> f64 {
+        self.run.accepted.time
+    }
+
+    fn sized_in_time(&self) -> bool {
+        true
+    }
+
+    /// The estimate is relative to the step's motion (`∝ h`), so it grows
+    /// as `h²`.
+    fn error_order(&self) -> f64 {
+        1.0
+    }
+
+    fn update_active_set(
+        &mut self,
+        time: f64,
+        observer: &mut dyn Observer,
+    ) -> Result<bool, DynamicError> {
+        let (model, run) = (self.model, &mut *self.run);
+        if !self.solver.active_set_changed(model, &run.accepted, time) {
+            return Ok(false);
+        }
+        let before = self.solver.redundant_count();
+        let rank = self.solver.constraint_rank(model, &run.accepted, time);
+        for &k in &rank.redundant {
+            run.accepted.multipliers[k] = 0.0;
+            run.state.multipliers[k] = 0.0;
+        }
+        if rank.redundant.len() != before {
+            observer.note(&format!(
+                "at t = {time}: the active constraints changed; {} redundant constraint equation(s) removed",
+                rank.redundant.len()
+            ));
+        }
+        run.redundant = run.redundant.max(rank.redundant.len());
+        Ok(true)
+    }
+
+    fn attempt(
+        &mut self,
+        size: f64,
+        _target: f64,
+        increment: usize,
+        observer: &mut dyn Observer,
+    ) -> Attempt {
+        match self.newton(size, increment, observer) {
+            Ok((iterations, residuals)) => Attempt::Converged {
+                iterations,
+                residuals,
+                error: self.settings.adaptive.then(|| self.error_estimate(size)),
+            },
+            Err(f) => Attempt::Failed(f),
+        }
+    }
+
+    fn attempted_time(&self) -> f64 {
+        self.run.state.time
+    }
+
+    fn reject(&mut self) {
+        let run = &mut *self.run;
+        run.state.clone_from(&run.accepted);
+    }
+
+    fn accept(
+        &mut self,
+        info: &IncrementInfo,
+        observer: &mut dyn Observer,
+    ) -> Result<(), DynamicError> {
+        let (model, run) = (self.model, &mut *self.run);
+        // the controller may snap t onto a landing time within round-off
+        run.state.time = info.time;
+        run.last_step = Some(info.step);
+        run.a_before.clone_from(&run.accepted.pseudo_acceleration);
+        run.a_before_coordinates
+            .clone_from(&run.accepted.coordinate_pseudo_accelerations);
+        model.update_internal(&mut run.state);
+        // latches reached lock: impact, then a restart (docs/theory.md §16)
+        let locks = match impact::lock_latches(
+            model,
+            self.solver,
+            &run.accepted,
+            &mut run.state,
+            info.increment,
+            self.settings.end_time,
+        )? {
+            Some(i) => {
+                run.lock_rank_analyses += 1;
+                run.redundant = run.redundant.max(i.redundant);
+                initial_accelerations(model, self.solver, run, self.settings.end_time).map_err(
+                    |failure| DynamicError::Initial {
+                        time: info.time,
+                        failure,
+                    },
+                )?;
+                run.last_step = None;
+                run.a_before.clear();
+                run.a_before_coordinates.clear();
+                run.balance.impact(i.locks[0].energy_lost, i.work);
+                i.locks
+            }
+            None => Vec::new(),
+        };
+        run.accepted.clone_from(&run.state);
+        let residual = self.solver.residual();
+        run.energies = run.balance.record(model, &run.state, Some(residual));
+        observer.energies(&run.energies);
+        observer.increment(info, model, &run.state, residual)?;
+        for l in &locks {
+            observer.lock(l);
+        }
+        run.locks.extend(locks);
+        Ok(())
+    }
+}

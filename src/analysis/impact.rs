@@ -1,0 +1,457 @@
+//! Latches locking during a dynamic analysis (docs/theory.md §16,
+//! docs/joints.md §6.2): the events that land a time step on a lock, and the
+//! impact of the lock.
+//!
+//! A latch is watched through its event function `g = s (c − c_L)`
+//! ([`LatchEvent`]); the step controller lands a step on `g = 0`. When an
+//! accepted step has brought an open latch from `g < 0` to `g ≥ −tol`, the
+//! latch locks, and the velocities jump as in a perfectly plastic impact
+//! (the reference paper's treatment of a lock, §6.2: momentum conserved,
+//! the velocity jump computed explicitly; Pfeiffer & Glocker 1996, ch. 5):
+//!
+//! ```text
+//! [ M   −kBᵀ ] [ Δv ]   [ 0     ]
+//! [ −kB   0  ] [ π  ] = [ k Φ̇⁻ ],      v⁺ = v⁻ + Δv,
+//! ```
+//!
+//! `M` the assembled mass matrix, `B` the gradients of the constraints,
+//! `kπ` the impulses, so that `Φ̇⁺ = 0`. It is solved in two stages
+//! ([`lock_latches`]): the velocities made consistent with the constraints
+//! already active (their rates `Φ̇⁻`, which index-3 integration leaves
+//! slightly off zero), then the lock (`Φ̇⁻ = ċ⁻` on the latch's row, the
+//! others kept). The energy lost is the second stage's `½ Δvᵀ M Δv`
+//! (Carnot's loss, docs/theory.md §16, LK3), momentum is conserved (the
+//! impulses are internal), and the integrator restarts from the
+//! post-impact state with consistent accelerations (D9).
+
+use super::control::EventFunction;
+use super::dynamics::{constraint_rates, DynamicError};
+use super::energy;
+use super::newton::{NewtonSolver, SINGULAR_PIVOT};
+use crate::dofs::{DofKind, NO_EQUATION};
+use crate::elements::{ConstraintKind, Element, EvalContext, Need};
+use crate::joints::latch::EVENT_TOLERANCE;
+use crate::joints::Latch;
+use crate::linalg::{smallest_relative_pivot, SparseLu};
+use crate::model::{Id, Model};
+use crate::state::State;
+
+/// Unknowns whose diagonal mass is below this fraction of the largest of
+/// their kind have no mass (as for the initial accelerations, D9).
+const MASSLESS: f64 = 1e-12;
+
+/// Entries of a latch's gradient below this (relative to its largest)
+/// do not load an unknown.
+const NEGLIGIBLE_GRADIENT: f64 = 1e-12;
+
+/// A latch that locked during a dynamic analysis ([`super::Observer::lock`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LockInfo {
+    /// The step that landed on the lock.
+    pub increment: usize,
+    /// Time of the lock.
+    pub time: f64,
+    /// The latch.
+    pub latch: Id,
+    /// The joint whose coordinate it locks.
+    pub joint: Id,
+    /// The coordinate at the lock (within the event tolerance of `c_L`).
+    pub coordinate: f64,
+    /// `ċ⁻`: the coordinate's rate just before the lock (with the
+    /// velocities consistent with the other constraints).
+    pub rate_before: f64,
+    /// `kπ`: the impulse of the lock along the coordinate (N·m·s for an
+    /// angle, N·s for a length), opposed to the approach.
+    pub impulse: f64,
+    /// `½ Δvᵀ M Δv`: the energy the impact dissipates. Latches that lock
+    /// in the same step share one impact and report its whole loss.
+    pub energy_lost: f64,
+    /// `T⁻ − T⁺`, the drop of the kinetic energy: the energy lost plus
+    /// [`Self::velocity_correction`] (when no constraint depends on time),
+    /// up to round-off.
+    pub kinetic_energy_drop: f64,
+    /// `T⁻ − T₁`: the kinetic energy of the joints' velocity error at the
+    /// lock (index-3 integration satisfies the constraints at position
+    /// level only), removed before the impact; an error of the
+    /// integration, left in the energy balance's error.
+    pub velocity_correction: f64,
+}
+
+/// `|g|` at or below which a step has landed on `latch`'s lock.
+pub fn event_tolerance(model: &Model, latch: &Latch) -> f64 {
+    if latch.is_angle() {
+        EVENT_TOLERANCE
+    } else {
+        EVENT_TOLERANCE * model.length_scale
+    }
+}
+
+/// The event function of a latch: `g = s (c − c_L)` while it is open, 1
+/// once locked (no more events).
+pub struct LatchEvent {
+    element: usize,
+    name: String,
+    tolerance: f64,
+}
+
+impl EventFunction for LatchEvent {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+    fn value(&self, model: &Model, state: &State) -> f64 {
+        match model.elements[self.element].as_latch() {
+            Some(l) if !l.is_locked(state) => l.gap(state),
+            _ => 1.0,
+        }
+    }
+    fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+}
+
+/// The event functions of the model's latches.
+pub fn latch_events(model: &Model) -> Vec<Box<dyn EventFunction>> {
+    let mut events: Vec<Box<dyn EventFunction>> = Vec::new();
+    for (element, e) in model.elements.iter().enumerate() {
+        if let Some(l) = e.as_latch() {
+            events.push(Box::new(LatchEvent {
+                element,
+                name: format!("latch {}", e.id()),
+                tolerance: event_tolerance(model, l),
+            }));
+        }
+    }
+    events
+}
+
+/// Locks, without impact, the open latches of `state` that are at their
+/// value (within the event tolerance): the start of a dynamic analysis.
+/// The initial velocities are then checked against them (D10).
+pub fn lock_at_start(model: &Model, state: &mut State) {
+    for e in &model.elements {
+        if let Some(l) = e.as_latch() {
+            if !l.is_locked(state) && l.gap(state).abs() <= event_tolerance(model, l) {
+                l.lock(state);
+            }
+        }
+    }
+}
+
+/// What [`lock_latches`] did.
+pub struct Impact {
+    /// The latches locked.
+    pub locks: Vec<LockInfo>,
+    /// Constraint equations found redundant by the rank analysis that
+    /// followed the change of the active set.
+    pub redundant: usize,
+    /// Work of the impulses through drivers and prescribed motions (zero
+    /// when no constraint depends on time).
+    pub work: f64,
+}
+
+/// The velocity jump of one impact system (see the module documentation).
+struct Jump {
+    /// The solution by equation: `Δv`, then `π` (unscaled) at the
+    /// multiplier equations.
+    solution: Vec<f64>,
+    /// `½ Δvᵀ M Δv`.
+    energy: f64,
+}
+
+/// Why an impact system has no answer.
+enum Singular {
+    /// An unknown without mass that nothing holds is struck: node,
+    /// component.
+    Massless(usize, usize),
+    /// The system is singular (at this unknown, if found).
+    System(String),
+}
+
+/// Solves the impact system at `state` with the solver's numbering:
+/// `rhs(eq)` on the multiplier equations (`k Φ̇⁻` to cancel), `struck` the
+/// multiplier equations of the latches locking (which hold nothing else)
+/// with their gradients; applies `Δv` to the velocities of `state`.
+fn jump(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    state: &mut State,
+    rhs_of: &dyn Fn(usize, usize) -> f64,
+    struck: &[(usize, &Latch, &[f64])],
+) -> Result<Jump, Singular> {
+    let time = state.time;
+    let (dofs, assembler, lu) = solver.system();
+    let mut stiffness = assembler.matrix.clone();
+    let mut mass = assembler.matrix.clone();
+    let ctx = EvalContext {
+        dynamics: true,
+        ..model.context(time, Need::with_inertia(0.0, 1.0))
+    };
+    assembler.assemble_split(model, &ctx, state, &mut stiffness, &mut mass);
+    let n = dofs.n_equations();
+    let mut diagonal = vec![0.0; n];
+    for (row, col, v) in mass.entries() {
+        if row == col {
+            diagonal[row] = v;
+        }
+    }
+    let mut scale = [0.0f64; 2];
+    for (eq, &m) in diagonal.iter().enumerate() {
+        match dofs.equation_kind(eq) {
+            DofKind::Translation | DofKind::Coordinate { .. } => scale[0] = scale[0].max(m),
+            DofKind::Rotation => scale[1] = scale[1].max(m),
+            DofKind::Multiplier(_) => {}
+        }
+    }
+    let light: Vec<bool> = (0..n)
+        .map(|eq| match dofs.equation_kind(eq) {
+            DofKind::Translation | DofKind::Coordinate { .. } => {
+                diagonal[eq] <= MASSLESS * scale[0]
+            }
+            DofKind::Rotation => diagonal[eq] <= MASSLESS * scale[1],
+            DofKind::Multiplier(_) => false,
+        })
+        .collect();
+    let is_multiplier: Vec<bool> = (0..n)
+        .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
+        .collect();
+    let struck_rows: Vec<usize> = struck.iter().map(|s| s.0).collect();
+    // unknowns without mass held by a constraint other than the new locks
+    // (a hinge node glued to its body): the constraints carry the impulse
+    let mut held = vec![false; n];
+    for (row, col, v) in stiffness.entries() {
+        if v != 0.0 && light[row] && is_multiplier[col] && !struck_rows.contains(&col) {
+            held[row] = true;
+        }
+    }
+    // an impulse on an unknown without mass that nothing else holds has no
+    // finite answer
+    for &(_, l, grad) in struck {
+        let largest = grad.iter().fold(0.0f64, |a, g| a.max(g.abs()));
+        for (k, &node) in l.pair_nodes().iter().enumerate() {
+            for c in 0..6 {
+                let eq = dofs.equation(6 * node + c);
+                if eq != NO_EQUATION
+                    && light[eq]
+                    && !held[eq]
+                    && grad[6 * k + c].abs() > NEGLIGIBLE_GRADIENT * largest
+                {
+                    return Err(Singular::Massless(node, c));
+                }
+            }
+        }
+    }
+
+    // multiplier rows and columns scaled to the mass (as D9); massless
+    // rows that no constraint holds take their stiffness row (as D9: they
+    // follow quasi-statically)
+    let k_of = |kind: ConstraintKind| model.scaling.of(kind).0;
+    let s_eq: Vec<f64> = (0..n)
+        .map(|eq| match dofs.equation_kind(eq) {
+            DofKind::Multiplier(kind) => {
+                let m = match kind {
+                    ConstraintKind::Distance => scale[0],
+                    ConstraintKind::Angle => scale[1],
+                };
+                if m > 0.0 {
+                    m / k_of(kind)
+                } else {
+                    1.0
+                }
+            }
+            _ => 1.0,
+        })
+        .collect();
+    {
+        let values = assembler.matrix.values_mut();
+        let (k, m) = (stiffness.values(), mass.values());
+        for (i, (row, col, _)) in stiffness.entries().enumerate() {
+            let v = if is_multiplier[row] || is_multiplier[col] || (light[row] && !held[row]) {
+                k[i] + m[i]
+            } else {
+                m[i]
+            };
+            values[i] = v * s_eq[row] * s_eq[col];
+        }
+    }
+    let mut rhs: Vec<f64> = (0..n)
+        .map(|eq| {
+            if is_multiplier[eq] {
+                rhs_of(eq, dofs.dof(eq)) * s_eq[eq]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let solved = (|| {
+        if lu.is_none() {
+            *lu = Some(SparseLu::analyze(&assembler.matrix)?);
+        }
+        let lu = lu.as_mut().expect("analysed above");
+        lu.factor(&assembler.matrix)?;
+        lu.solve_in_place(&mut rhs)
+    })();
+    if solved.is_err() || !rhs.iter().all(|v| v.is_finite()) {
+        let at = match smallest_relative_pivot(&assembler.matrix) {
+            Ok((eq, pivot)) if pivot < SINGULAR_PIVOT => {
+                format!(" (at {})", solver.dof_label(model, solver.dofs.dof(eq)))
+            }
+            _ => String::new(),
+        };
+        return Err(Singular::System(at));
+    }
+
+    // v⁺ = v⁻ + Δv; ½ ΔvᵀMΔv; π unscaled
+    let dofs = &solver.dofs;
+    let mut energy = 0.0;
+    for (row, col, m) in mass.entries() {
+        if !is_multiplier[row] && !is_multiplier[col] {
+            energy += 0.5 * rhs[row] * m * rhs[col];
+        }
+    }
+    for (eq, dv) in rhs.iter_mut().enumerate() {
+        let d = dofs.dof(eq);
+        if let Some((node, c)) = dofs.node_component(d) {
+            state.velocity[node][c] += *dv;
+        } else if d < dofs.first_multiplier() {
+            state.coordinate_rates[d - dofs.first_coordinate()] += *dv;
+        } else {
+            *dv *= s_eq[eq];
+        }
+    }
+    Ok(Jump {
+        solution: rhs,
+        energy,
+    })
+}
+
+/// Locks the open latches that the step from `before` to `state` brought
+/// to their value from the side of approach (`g` from below `−tol` to at
+/// least `−tol`), runs the rank analysis of the constraints again, and
+/// applies the impact to the velocities of `state` (see the module
+/// documentation), in two stages:
+///
+/// 1. the velocities are made consistent with the constraints already
+///    active (`Φ̇ = 0`; index-3 integration satisfies them at position
+///    level only), the latches still open: an M-orthogonal projection whose
+///    energy, `T⁻ − T₁`, is an error of the integration, reported apart;
+/// 2. the impact of the locks from those velocities, `B_L Δv = −ċ`, the
+///    other constraints keeping their rates: its `½ ΔvᵀMΔv` is the energy
+///    lost (Carnot's, exactly, for the velocities of stage 1).
+///
+/// `None` if no latch locked. The accelerations are left to the caller
+/// (D9 at the post-impact state).
+pub fn lock_latches(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    before: &State,
+    state: &mut State,
+    increment: usize,
+    end_time: f64,
+) -> Result<Option<Impact>, DynamicError> {
+    let reached: Vec<&Latch> = model
+        .elements
+        .iter()
+        .filter_map(|e| e.as_latch())
+        .filter(|l| {
+            let tol = event_tolerance(model, l);
+            !l.is_locked(state) && l.gap(before) < -tol && l.gap(state) >= -tol
+        })
+        .collect();
+    if reached.is_empty() {
+        return Ok(None);
+    }
+    let time = state.time;
+    let failed = |why: Singular| {
+        let latches = reached
+            .iter()
+            .map(|l| format!("latch {}", l.id()))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let reason = match why {
+            Singular::Massless(node, c) => format!(
+                "the impulse of the lock acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies the latch joins their mass (rigid bodies, point masses or beams at the joint's nodes, or nodes glued to them)",
+                model.node_ids[node],
+                crate::model::COMPONENT_NAMES[c]
+            ),
+            Singular::System(at) => format!(
+                "the impact equations are singular{at}: the mass matrix is singular on the motion the impulse excites (an unknown without mass that no constraint holds); give the bodies mass"
+            ),
+        };
+        DynamicError::Impact {
+            latches,
+            time,
+            reason,
+        }
+    };
+    let kinetic_before = energy::energies(model, state).kinetic;
+
+    // 1. velocities consistent with the constraints already active
+    let correction = if solver.dofs.first_multiplier() < solver.dofs.n_dofs() {
+        let (rates, _) = constraint_rates(model, solver, state, end_time);
+        jump(model, solver, state, &|_, d| -rates[d], &[])
+            .map_err(failed)?
+            .energy
+    } else {
+        0.0
+    };
+    let kinetic_consistent = energy::energies(model, state).kinetic;
+
+    // 2. the locks: the active set changes, rank analysis again
+    let struck: Vec<(f64, Vec<f64>)> = reached.iter().map(|l| l.rate(state)).collect();
+    for l in &reached {
+        l.lock(state);
+    }
+    let rank = solver.constraint_rank(model, state, time);
+    for &k in &rank.redundant {
+        state.multipliers[k] = 0.0;
+    }
+    let first = solver.dofs.first_multiplier();
+    let rows: Vec<usize> = reached
+        .iter()
+        .map(|l| solver.dofs.equation(first + l.multiplier()))
+        .collect();
+    let ctx = model.context(time, Need::RESIDUAL);
+    // −k B_L Δv = k ċ on the latch rows, zero elsewhere
+    let rhs_of = |eq: usize, _: usize| {
+        rows.iter()
+            .zip(&reached)
+            .zip(&struck)
+            .find(|((&r, _), _)| r == eq)
+            .map_or(0.0, |((_, l), (rate, _))| l.scaling(&ctx).0 * rate)
+    };
+    let hit: Vec<(usize, &Latch, &[f64])> = rows
+        .iter()
+        .zip(&reached)
+        .zip(&struck)
+        .map(|((&r, &l), (_, g))| (r, l, g.as_slice()))
+        .collect();
+    let j = jump(model, solver, state, &rhs_of, &hit).map_err(failed)?;
+    let kinetic_after = energy::energies(model, state).kinetic;
+    let locks = reached
+        .iter()
+        .zip(&rows)
+        .zip(&struck)
+        .map(|((l, &eq), (rate, _))| LockInfo {
+            increment,
+            time,
+            latch: l.id(),
+            joint: l.joint(),
+            coordinate: l.coordinate(state),
+            rate_before: *rate,
+            impulse: if eq == NO_EQUATION {
+                0.0
+            } else {
+                l.scaling(&ctx).0 * j.solution[eq]
+            },
+            energy_lost: j.energy,
+            kinetic_energy_drop: kinetic_before - kinetic_after,
+            velocity_correction: correction,
+        })
+        .collect();
+    Ok(Some(Impact {
+        locks,
+        redundant: rank.redundant.len(),
+        // T⁺ − T₁ = W − ½ΔvᵀMΔv
+        work: kinetic_after - kinetic_consistent + j.energy,
+    }))
+}

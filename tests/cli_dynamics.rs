@@ -1,0 +1,672 @@
+//! Dynamic analyses through the command-line tool: a run alone and in a
+//! sequence, the velocities and energies it writes (checked against the
+//! closed forms of a rigid pendulum), a run that stops early, a restart
+//! that repeats the uninterrupted run, an interrupted run, and bad input
+//! (docs/results.md, docs/model-format.md).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A fresh scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("unfold-dyn-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `unfold run MODEL --out OUT --quiet` and extra arguments.
+fn run(model: &Path, out: &Path, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args([
+            "run",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .arg("--quiet")
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The rows of a CSV file as maps from column name to text.
+fn table(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    lines
+        .map(|l| {
+            assert_eq!(
+                l.split(',').count(),
+                header.len(),
+                "{}: {l}",
+                path.display()
+            );
+            header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(str::to_string))
+                .collect()
+        })
+        .collect()
+}
+
+fn num(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {
+    row[key]
+        .parse()
+        .unwrap_or_else(|_| panic!("{key} = {:?}", row[key]))
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+/// The steps (first column) of every CSV file in `out`, which must agree.
+fn same_steps(out: &Path) -> Vec<usize> {
+    let steps = |p: &Path| -> Vec<usize> {
+        let mut s: Vec<usize> = std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap().parse().unwrap())
+            .collect();
+        s.dedup();
+        s
+    };
+    let reference = steps(&out.join("steps.csv"));
+    for entry in std::fs::read_dir(out).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy();
+        // the modal analyses' tables are by mode
+        if name.ends_with(".csv") && !name.starts_with("mode") {
+            assert_eq!(steps(&path), reference, "{}", path.display());
+        }
+    }
+    reference
+}
+
+/// Mass (kg), distance of the centre of mass from the hinge (m), inertia
+/// about the centre (kg·m²) and gravity (m/s²) of the pendulum below.
+const M: f64 = 2.0;
+const D: f64 = 0.5;
+const J: f64 = 0.1;
+const G: f64 = 9.81;
+
+/// A rigid body hinged to the ground about z at the origin, its centre
+/// of mass (node 2) at (0.5, 0, 0), released from the horizontal under
+/// gravity along −y; `analysis` and `extra` tables added.
+fn pendulum(analysis: &str, extra: &str) -> String {
+    format!(
+        r#"title = "pendulum"
+{analysis}
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 2
+x = [{D}, 0.0, 0.0]
+
+[[supports]]
+node = 1
+fixed = ["all"]
+
+[[rigid_bodies]]
+id = 1
+node = 2
+mass = {M}
+inertia = [{J}, {J}, {J}]
+
+[[joints]]
+id = 7
+type = "revolute"
+nodes = [1, 2]
+axis = [0.0, 0.0, 1.0]
+position = [0.0, 0.0, 0.0]
+
+[gravity]
+acceleration = [0.0, -{G}, 0.0]
+{extra}
+"#
+    )
+}
+
+/// Fixed steps of 5 ms over a quarter swing and more.
+const FIXED: &str = "[analysis]
+type = \"dynamic\"
+end_time = 0.6
+time_step = 0.005
+adaptive = false
+output_times = [0.1234]
+";
+
+#[test]
+fn pendulum_run_writes_velocities_and_a_small_energy_balance() {
+    let dir = scratch("pendulum");
+    let model = dir.join("pendulum.toml");
+    std::fs::write(&model, pendulum(FIXED, "")).unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &["--vtk-ascii"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let steps = same_steps(&out);
+
+    // the output time between two steps is landed on: 24 steps of 5 ms,
+    // one of 3.4 ms to 0.1234, then 96 of 5 ms from there, the last
+    // shortened to land on 0.6
+    let s = summary(&out);
+    assert_eq!(s["status"], "completed");
+    let d = &s["analyses"][0]["dynamic"];
+    assert_eq!(d["steps"], 121, "{d}");
+    assert_eq!(steps.len(), 122);
+    let energies = table(&out.join("energies.csv"));
+    assert!(energies
+        .iter()
+        .any(|r| (num(r, "time") - 0.1234).abs() < 1e-12));
+
+    // energies against the closed forms of the state written: kinetic
+    // ½ m |v|² + ½ J |ω|² of the body from nodes_velocities.csv, potential
+    // m g y of its centre of mass from nodes.csv, both to the 10
+    // significant digits of the files
+    let joints = table(&out.join("joints.csv"));
+    let nodes: Vec<_> = table(&out.join("nodes.csv"))
+        .into_iter()
+        .filter(|r| r["node"] == "2")
+        .collect();
+    let velocities: Vec<_> = table(&out.join("nodes_velocities.csv"))
+        .into_iter()
+        .filter(|r| r["node"] == "2")
+        .collect();
+    let mgd = M * G * D;
+    let square = |r: &std::collections::HashMap<String, String>, k: [&str; 3]| -> f64 {
+        k.iter().map(|c| num(r, c).powi(2)).sum()
+    };
+    let mut largest_error = 0.0f64;
+    let mut largest_drift = 0.0f64;
+    for ((e, j), (n, v)) in energies
+        .iter()
+        .zip(&joints)
+        .zip(nodes.iter().zip(&velocities))
+    {
+        let kinetic =
+            0.5 * M * square(v, ["vx", "vy", "vz"]) + 0.5 * J * square(v, ["wx", "wy", "wz"]);
+        assert!(
+            (num(e, "kinetic") - kinetic).abs() <= 1e-9 * mgd,
+            "t = {}: kinetic {} vs ½ m v² + ½ J ω² = {kinetic}",
+            e["time"],
+            e["kinetic"]
+        );
+        let potential = M * G * num(n, "y");
+        assert!((num(e, "gravity") - potential).abs() <= 1e-9 * mgd);
+        // the rate of the hinge angle (differences along the motion) is the
+        // body's angular velocity about z, to the digits of the files
+        let rate = num(j, "c1_rate");
+        assert!((num(v, "wz") - rate).abs() <= 1e-8 * (1.0 + rate.abs()));
+        // the centre of mass turns about the hinge, |v| = d|θ̇|: the
+        // index-3 equations hold the joint on positions, and the
+        // velocities follow it to the accuracy of the step
+        let speed = square(v, ["vx", "vy", "vz"]).sqrt();
+        largest_drift = largest_drift.max((speed - D * rate.abs()).abs());
+        largest_error = largest_error.max(num(e, "balance_error").abs());
+    }
+    // measured 1.9e-4 m/s at speeds up to 2.2 m/s (ωh ≈ 0.02); 5e-4 m/s
+    // bounds it
+    assert!(largest_drift < 5e-4, "{largest_drift}");
+    // the balance error of a second-order method with ωh ≈ 0.02: measured
+    // 2.6e-4 of m g d (1.0e-3 with steps of 10 ms, 4× larger: second
+    // order); 1e-3 bounds it
+    assert!(largest_error < 1e-3 * mgd, "{largest_error}");
+    let recorded = d["largest_energy_balance_error"].as_f64().unwrap();
+    assert!((recorded - largest_error).abs() <= 1e-6 * largest_error.max(1e-12));
+    // by 0.6 s the pendulum has passed the bottom: the kinetic energy
+    // reached m g d there (energy conservation), within the balance error
+    let kinetic = d["largest_kinetic_energy"].as_f64().unwrap();
+    assert!((kinetic - mgd).abs() < 2e-3 * mgd, "{kinetic}");
+
+    // the grids carry the velocities
+    let grid = std::fs::read_to_string(out.join("vtk/step_00010.vtu")).unwrap();
+    assert!(grid.contains("Name=\"velocity\""), "{grid}");
+    assert!(grid.contains("Name=\"angular_velocity\""));
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    assert!(
+        log.contains("step   10  t = 0.050000  h = 5.000e-3"),
+        "{log}"
+    );
+    assert!(log
+        .lines()
+        .last()
+        .unwrap()
+        .starts_with("completed: 121 steps, 0 rejected"));
+}
+
+/// Static preload, release (dynamic), modes about the final state
+/// (examples/boom_release.toml): one set of files, steps numbered on, the
+/// free vibration at the frequency the modal analysis finds.
+#[test]
+fn static_dynamic_modal_sequence_in_one_record() {
+    let dir = scratch("sequence");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/boom_release.toml");
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = summary(&out);
+    let kinds: Vec<&str> = s["analyses"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["type"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds, ["static", "dynamic", "modal"]);
+    assert!(s["analyses"][0].get("dynamic").is_none());
+    assert_eq!(s["analyses"][1]["dynamic"]["steps"], 600);
+    let steps = same_steps(&out);
+    assert_eq!(steps, (0..steps.len()).collect::<Vec<_>>());
+
+    // static steps: at rest, no work nor balance; dynamic steps: all
+    let energies = table(&out.join("energies.csv"));
+    let first_dynamic = energies
+        .iter()
+        .position(|r| !r["balance_error"].is_empty())
+        .unwrap();
+    assert_eq!(
+        first_dynamic, 5,
+        "4 increments and the start, then dynamics"
+    );
+    assert!(energies[..first_dynamic]
+        .iter()
+        .all(|r| num(r, "kinetic") == 0.0));
+    // the strain energy of the preload, P²L³/(6 EI) = 0.970 J (a tip load
+    // on a cantilever), to the shear and the 5 % deflection
+    let preload = num(&energies[first_dynamic - 1], "strain");
+    assert!((preload - 0.9701).abs() < 0.01, "{preload}");
+    // released: its energy swings between strain and kinetic; the release
+    // excites the higher bending modes, whose energy (3.3e-3 of it, measured)
+    // the numerical dissipation of ρ∞ = 0.9 takes out in the first steps
+    for r in &energies[first_dynamic..] {
+        let total = num(r, "kinetic") + num(r, "strain");
+        assert!((total - preload).abs() < 5e-3 * preload, "{r:?}");
+        assert!(num(r, "balance_error").abs() < 5e-3 * preload);
+    }
+
+    // the tip's free vibration: its period, from the first to the last
+    // zero crossing upwards and downwards (five periods), against 1/f₁ of
+    // the modal analysis about the final state (measured 0.12 %); a single
+    // period is off by up to 0.9 %, its crossings shifted by the higher
+    // bending modes the release excites: over five, 0.5 % bounds it
+    let tip: Vec<(f64, f64)> = table(&out.join("nodes.csv"))
+        .iter()
+        .filter(|r| r["node"] == "11" && num(r, "time") > 1.0)
+        .map(|r| (num(r, "time"), num(r, "uz")))
+        .collect();
+    let crossings = |up: bool| -> Vec<f64> {
+        tip.windows(2)
+            .filter(|w| {
+                if up {
+                    w[0].1 < 0.0 && w[1].1 >= 0.0
+                } else {
+                    w[0].1 > 0.0 && w[1].1 <= 0.0
+                }
+            })
+            .map(|w| w[0].0 + (w[1].0 - w[0].0) * (-w[0].1) / (w[1].1 - w[0].1))
+            .collect()
+    };
+    let mean_period = |c: Vec<f64>| (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64;
+    let (up, down) = (crossings(true), crossings(false));
+    assert!(up.len() >= 5 && down.len() >= 5, "{up:?} {down:?}");
+    let period = 0.5 * (mean_period(up) + mean_period(down));
+    let modes = table(&out.join("modes.csv"));
+    let f1: f64 = num(&modes[0], "frequency_hz");
+    assert!(
+        (period * f1 - 1.0).abs() < 5e-3,
+        "period {period} s, 1/f1 = {}",
+        1.0 / f1
+    );
+    // and Euler–Bernoulli's 3.5616 Hz for the clamped rod, within the
+    // 10 elements and the shear of the model (0.3 %)
+    assert!((f1 / 3.5616 - 1.0).abs() < 3e-3, "{f1}");
+}
+
+/// Dynamic, static, dynamic: the equilibrium after the swing is at rest,
+/// and the motion after it starts from rest (the pendulum hangs still).
+#[test]
+fn an_equilibrium_after_a_motion_is_at_rest() {
+    let dir = scratch("rest");
+    let model = dir.join("rest.toml");
+    let analyses = "[[analysis]]
+type = \"dynamic\"
+end_time = 0.3
+time_step = 0.01
+adaptive = false
+
+[[analysis]]
+type = \"static\"
+end_time = 0.4
+
+[[analysis]]
+type = \"dynamic\"
+end_time = 0.6
+time_step = 0.01
+adaptive = false
+";
+    std::fs::write(&model, pendulum(analyses, "")).unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s = summary(&out);
+    assert_eq!(s["analyses"][2]["dynamic"]["steps"], 20);
+    // hanging at rest in the last analysis: no kinetic energy beyond
+    // round-off (m g d = 9.81 J)
+    let energies = table(&out.join("energies.csv"));
+    let last: Vec<_> = energies
+        .iter()
+        .filter(|r| num(r, "time") > 0.4 + 1e-9)
+        .collect();
+    assert_eq!(last.len(), 20);
+    for r in last {
+        assert!(num(r, "kinetic") < 1e-12 * M * G * D, "{r:?}");
+    }
+}
+
+/// A moment of 1e5 N·m applied at once at t = 0.3 that Newton cannot
+/// follow in 4 iterations, with no smaller step allowed: the run stops at
+/// the last converged step, keeps every file with the same steps, says
+/// why and exits 1.
+#[test]
+fn a_dynamic_run_that_cannot_go_on_stops_with_its_files() {
+    let dir = scratch("failing");
+    let model = dir.join("kick.toml");
+    let analysis = FIXED
+        .replace(
+            "time_step = 0.005",
+            "time_step = 0.01\nmin_step = 0.01\nmax_iterations = 4",
+        )
+        .replace("output_times = [0.1234]\n", "");
+    let kick = r#"
+[[curves]]
+name = "kick"
+points = [[0.0, 0.0], [0.3, 0.0], [0.3001, 1.0]]
+
+[[loads]]
+node = 2
+moment = [0.0, 0.0, 1e5]
+curve = "kick"
+"#;
+    std::fs::write(&model, pendulum(&analysis, kick)).unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("dynamic analysis at t = 0.3: no convergence at step 31"),
+        "{err}"
+    );
+    assert!(err.contains("largest residual at node 2"), "{err}");
+    assert!(err.contains("results up to t = 0.3 are kept"), "{err}");
+    let steps = same_steps(&out);
+    assert_eq!(steps.len(), 31);
+    let s = summary(&out);
+    assert_eq!(s["status"], "failed");
+    assert!(s["message"].as_str().unwrap().contains("below min_step"));
+    assert_eq!(s["analyses"][0]["dynamic"]["steps"], 30);
+    // the restart file holds the last converged step
+    let restart: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("restart.json")).unwrap()).unwrap();
+    assert!((restart["time"].as_f64().unwrap() - 0.3).abs() < 1e-12);
+}
+
+/// The largest relative difference between two arrays of numbers (nested
+/// JSON arrays), relative to the largest magnitude of the first.
+fn difference(a: &serde_json::Value, b: &serde_json::Value) -> (f64, f64) {
+    fn flat(v: &serde_json::Value, out: &mut Vec<f64>) {
+        match v {
+            serde_json::Value::Array(a) => a.iter().for_each(|x| flat(x, out)),
+            serde_json::Value::Number(n) => out.push(n.as_f64().unwrap()),
+            _ => {}
+        }
+    }
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    flat(a, &mut x);
+    flat(b, &mut y);
+    assert_eq!(x.len(), y.len());
+    let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = x
+        .iter()
+        .zip(&y)
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+    (diff, scale)
+}
+
+/// A run restarted from `restart-0.3.json` ends in the state of the run
+/// that was never stopped: positions, orientations, velocities,
+/// accelerations and multipliers to 1e-12 (fixed steps), and its energy
+/// balance goes on.
+#[test]
+fn a_restarted_dynamic_run_repeats_the_uninterrupted_one() {
+    let dir = scratch("restart");
+    let model = dir.join("pendulum.toml");
+    std::fs::write(&model, pendulum(FIXED, "[output]\nrestart_times = [0.3]\n")).unwrap();
+    let whole = dir.join("whole");
+    let o = run(&model, &whole, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let part = dir.join("part");
+    let o = run(
+        &model,
+        &part,
+        &[
+            "--restart",
+            whole.join("restart-0.3.json").to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let read = |out: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(out.join("restart.json")).unwrap()).unwrap()
+    };
+    let (a, b) = (read(&whole), read(&part));
+    for key in [
+        "x",
+        "q",
+        "velocity",
+        "acceleration",
+        "pseudo_acceleration",
+        "multipliers",
+    ] {
+        let (diff, scale) = difference(&a["state"][key], &b["state"][key]);
+        assert!(diff <= 1e-12 * scale, "{key}: {diff:e} of {scale:e}");
+    }
+    let (diff, scale) = difference(
+        &serde_json::json!([
+            a["motion"]["energies"]["balance_error"],
+            a["motion"]["energies"]["kinetic"]
+        ]),
+        &serde_json::json!([
+            b["motion"]["energies"]["balance_error"],
+            b["motion"]["energies"]["kinetic"]
+        ]),
+    );
+    assert!(diff <= 1e-12 * scale.max(1.0), "{diff:e}");
+    // the restarted run started at 0.3 and took the 60 steps left
+    assert_eq!(summary(&part)["analyses"][0]["dynamic"]["steps"], 60);
+}
+
+/// Bad input is refused before any step, exit 2, naming the analysis or
+/// the entity and what is wrong.
+#[test]
+fn bad_dynamic_input_is_refused_with_exit_2() {
+    let dir = scratch("bad");
+    let cases: [(&str, String, &[&str]); 6] = [
+        (
+            "rho",
+            pendulum(
+                &FIXED.replace("adaptive", "rho_infinity = 1.5\nadaptive"),
+                "",
+            ),
+            &["analysis", "rho_infinity must lie in [0, 1]", "1.5"],
+        ),
+        (
+            "step",
+            pendulum(
+                &FIXED.replace("time_step = 0.005", "time_step = -0.005"),
+                "",
+            ),
+            &["analysis", "time_step"],
+        ),
+        (
+            "bounds",
+            pendulum(
+                &FIXED.replace("adaptive = false", "min_step = 0.01\nmax_step = 0.001"),
+                "",
+            ),
+            &[
+                "analysis",
+                "min_step (0.01) must not exceed max_step (0.001)",
+            ],
+        ),
+        (
+            "unknown",
+            pendulum(
+                FIXED,
+                "[[initial_motion]]\nnodes = [2, 99]\nangular_velocity = [0.0, 0.0, 1.0]\n",
+            ),
+            &["initial_motion[1]", "node 99 does not exist"],
+        ),
+        (
+            "support",
+            // the hinge node is clamped: it cannot turn with the body
+            pendulum(
+                FIXED,
+                "[[initial_motion]]\nnodes = [1, 2]\nangular_velocity = [0.0, 0.0, 1.0]\n",
+            ),
+            &[
+                "initial_motion[1]",
+                "node 1 is supported in rz but is given an angular velocity",
+            ],
+        ),
+        (
+            "joint",
+            // a velocity along the arm pulls the body off the hinge
+            pendulum(
+                FIXED,
+                "[[initial_motion]]\nnodes = [2]\nvelocity = [1.0, 0.0, 0.0]\n",
+            ),
+            &["initial velocities violate joint 7", "equation"],
+        ),
+    ];
+    for (name, text, wanted) in cases {
+        let model = dir.join(format!("{name}.toml"));
+        std::fs::write(&model, text).unwrap();
+        let o = run(&model, &dir.join(name), &[]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        for w in wanted {
+            assert!(err.contains(w), "{name}: {w:?} not in {err}");
+        }
+        assert!(err.contains(&format!("{name}.toml")), "{name}: {err}");
+    }
+}
+
+/// SIGINT stops a dynamic run after its current step, as a static one:
+/// exit 130, every file with the same steps, the summary and the restart
+/// file at the last step.
+#[cfg(unix)]
+#[test]
+fn sigint_stops_a_dynamic_run_after_a_step() {
+    use std::time::{Duration, Instant};
+    let dir = scratch("sigint");
+    let model = dir.join("long.toml");
+    // 100,000 steps: minutes if not interrupted
+    let long = FIXED
+        .replace("end_time = 0.6", "end_time = 500.0")
+        .replace("output_times = [0.1234]\n", "");
+    std::fs::write(&model, pendulum(&long, "")).unwrap();
+    let out = dir.join("out");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args([
+            "run",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    loop {
+        let n = std::fs::read_to_string(out.join("steps.csv"))
+            .map(|t| t.lines().count())
+            .unwrap_or(0);
+        if n > 5 {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "no step written");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // SAFETY: kill(2) on our own child's pid
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },
+        0
+    );
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted by SIGINT"), "{err}");
+    let steps = same_steps(&out);
+    let s = summary(&out);
+    assert_eq!(s["status"], "interrupted");
+    assert_eq!(s["output_steps"].as_u64().unwrap() as usize, steps.len());
+    let restart: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("restart.json")).unwrap()).unwrap();
+    assert_eq!(restart["time"], s["final_time"]);
+    assert!(restart["motion"]["energies"].is_object());
+}
+
+/// A latch's results through the command line: `latches.csv` holds the
+/// same steps as `steps.csv`; the latch is open (0) until the step that
+/// lands on the lock and locked (1) from then on; on that step the
+/// coordinate is the locking value, 90°, within the event tolerance of
+/// 1e-8 rad (docs/joints.md §6.2) and stays there.
+#[test]
+fn latch_results_are_written_with_every_step() {
+    let dir = scratch("latch");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/latched_panels.toml");
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let latches = table(&out.join("latches.csv"));
+    let steps = table(&out.join("steps.csv"));
+    assert_eq!(latches.len(), steps.len());
+    let value =
+        |r: &std::collections::HashMap<String, String>, k: &str| -> f64 { r[k].parse().unwrap() };
+    let first = latches
+        .iter()
+        .position(|r| value(r, "locked") == 1.0)
+        .expect("the latch locks within 0.1 s");
+    assert!(first > 0);
+    for r in &latches[..first] {
+        assert_eq!(value(r, "locked"), 0.0);
+        assert!(value(r, "gap") < 0.0);
+    }
+    for r in &latches[first..] {
+        assert_eq!(value(r, "locked"), 1.0);
+        assert!((value(r, "coordinate") - std::f64::consts::FRAC_PI_2).abs() < 1e-8);
+        assert!(value(r, "gap").abs() < 1e-8);
+    }
+}

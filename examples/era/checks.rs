@@ -17,6 +17,7 @@ use unfold::analysis::statics::StaticError;
 use unfold::assembly::Assembler;
 use unfold::dofs::{DofKind, DofMap};
 use unfold::eigen::{self, EigenSettings, Method, ModalSolution, Pencil};
+use unfold::elements::Need;
 use unfold::linalg::SparseMatrix;
 use unfold::model::builder::Analysis;
 use unfold::model::Model;
@@ -45,7 +46,8 @@ pub fn rigid_links(geometry: &Geometry, scale: f64, hinges: Hinges) -> Built {
         members: Members::Rigid,
         hinges,
         support: true,
-        analysis: Analysis::kinematic(),
+        gravity: None,
+        analysis: Analysis::kinematic().into_input(),
     };
     build(geometry, &options, "rank of the rigid-link model")
 }
@@ -57,7 +59,8 @@ pub fn rank(geometry: &Geometry, scale: f64, hinges: Hinges) -> Result<Rank, Box
     let built = rigid_links(geometry, scale, hinges);
     let model = Model::from_input(&built.input)?;
     let unknowns = DofMap::new(&model).n_equations();
-    match preflight::check(&model) {
+    let settings = Analysis::kinematic().settings()?;
+    match preflight::check(&model, &settings) {
         Ok(p) => Ok(Rank {
             unknowns,
             free_motions: p.free_motions,
@@ -79,9 +82,9 @@ fn tangent(model: &Model) -> (DofMap, SparseMatrix, Vec<bool>) {
     let mut assembler = Assembler::new(model, &dofs);
     let mut state = model.initial_state();
     model.apply_prescribed(&mut state, 0.0);
-    assembler.assemble(model, &model.context(0.0, true), &state);
+    assembler.assemble(model, &model.context(0.0, Need::STIFFNESS), &state);
     let multiplier = (0..dofs.n_equations())
-        .map(|eq| dofs.kind(dofs.dof(eq)) == DofKind::Extra)
+        .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
         .collect();
     (dofs, assembler.matrix, multiplier)
 }
@@ -99,10 +102,11 @@ pub fn zero_modes(model: &Model, modes: usize) -> Result<ModalSolution, Box<dyn 
     let mut w = SparseMatrix::from_pattern(n, (0..n).map(|i| (i, i)).collect());
     for eq in 0..n {
         let p = w.position(eq, eq).expect("diagonal");
-        w.values_mut()[p] = match dofs.kind(dofs.dof(eq)) {
+        w.values_mut()[p] = match dofs.equation_kind(eq) {
             DofKind::Translation => 1.0,
             DofKind::Rotation => l2,
-            DofKind::Extra => 0.0,
+            DofKind::Coordinate { length } => length * length,
+            DofKind::Multiplier(_) => 0.0,
         };
     }
     let pencil = Pencil {

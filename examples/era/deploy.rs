@@ -1,55 +1,84 @@
-//! The deployment driven through the mid-hinges: every mid-hinge opened
-//! at the same rate from the folded to the deployed angle, by drivers on
-//! the joint angles (displacement control), and what is measured on the
-//! way.
+//! The deployment in dynamics: the structure built folded, a bottom
+//! corner body of the first longeron clamped (the attachment to the
+//! station), released at rest; the tape springs of the mid-hinges open
+//! it and the latches lock each mid-hinge when its halves come in line,
+//! with the plastic impact of the lock (paper §6.2). An implicit dynamic
+//! analysis (Lie-group generalised-α, docs/theory.md §15) with steps
+//! sized by the error estimate and landing on every lock.
 //!
-//! Along this path every face is in the same state, so the configuration
-//! is known in closed form ([`Geometry::scale_at`]): the longerons move
-//! on straight lines towards (away from) the clamped one, keep their
-//! orientation and stay vertical, and the members are not strained.
+//! What is measured on the way: the opening angle and the moments of
+//! every mid-hinge, the energies, the lock instants; at the end, how far
+//! the structure is from its nominal deployed geometry.
 
 use std::error::Error;
 use std::f64::consts::PI;
 use std::path::Path;
+use std::sync::Arc;
 
 use unfold::analysis::{
-    CutbackInfo, IncrementInfo, IterationInfo, Observer, StaticAnalysis, StaticOutcome,
+    AnalysisSettings, CutbackInfo, DynamicAnalysis, DynamicOutcome, Energies, IncrementInfo,
+    IterationInfo, LockInfo, Observer,
 };
+use unfold::io::results::AnalysisEnd;
 use unfold::io::run::{Recorder, Silent};
-use unfold::model::builder::Analysis;
+use unfold::model::input::AnalysisInput;
 use unfold::model::Model;
-use unfold::so3::{self, Vec3};
 use unfold::state::State;
 
 use super::geometry::Geometry;
 use super::hinge::Hinges;
 use super::model::{build, Built, Members, Options};
 
-/// The model of the deployment: built folded, a longeron clamped, every
-/// mid-hinge driven to `π` along a smooth step, in `increments` equal
-/// increments of `t` of a
-/// kinetostatic analysis (flexible members) or of a kinematic one (rigid
-/// links).
-pub fn model(geometry: &Geometry, members: Members, increments: usize) -> Built {
-    let h = 1.0 / increments.max(1) as f64;
-    let analysis = match members {
-        Members::Flexible => Analysis::kinetostatic(),
-        Members::Rigid => Analysis::kinematic(),
+/// Standard gravity (m/s²).
+pub const G0: f64 = 9.806_65;
+
+/// The parameters of a deployment run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Case {
+    /// Gravity along the longerons, downwards, in units of `G0` (the
+    /// paper's second analysis: 0.01).
+    pub gravity: f64,
+    /// End of the analysis (s).
+    pub end_time: f64,
+    /// First time step (s).
+    pub time_step: f64,
+    /// Largest time step (s).
+    pub max_step: f64,
+    /// Spectral radius at infinite frequency of the generalised-α method.
+    pub rho_infinity: f64,
+    /// Local error tolerance of a step (docs/model-format.md).
+    pub error_tolerance: f64,
+    /// Steps sized by the error estimate (otherwise fixed steps of
+    /// `time_step`, shortened only to land on a lock or when Newton
+    /// fails).
+    pub adaptive: bool,
+}
+
+/// The model of the deployment of `case`: built folded, the first
+/// longeron's bottom corner body clamped, every mid-hinge with its tape
+/// spring and latch.
+pub fn model(geometry: &Geometry, case: &Case) -> Built {
+    let analysis = AnalysisInput {
+        kind: "dynamic".into(),
+        end_time: case.end_time,
+        time_step: Some(case.time_step),
+        max_step: Some(case.max_step),
+        rho_infinity: Some(case.rho_infinity),
+        error_tolerance: Some(case.error_tolerance),
+        adaptive: Some(case.adaptive),
+        ..AnalysisInput::default()
     };
     let options = Options {
         scale: geometry.design.folded_scale,
-        members,
-        hinges: Hinges::Driven { opening: PI },
+        members: Members::Flexible,
+        hinges: Hinges::Free,
         support: true,
-        analysis: analysis
-            .end_time(1.0)
-            .initial_increment(h)
-            .max_increment(h)
-            .min_increment(1e-4 * h),
+        gravity: (case.gravity != 0.0).then_some([0.0, 0.0, -case.gravity * G0]),
+        analysis,
     };
     let title = format!(
-        "Deployment of the ERA {}: every mid-hinge driven open",
-        geometry.name
+        "Deployment of the ERA {} by its mid-hinge tape springs, gravity {} g",
+        geometry.name, case.gravity
     );
     build(geometry, &options, &title)
 }
@@ -62,7 +91,10 @@ pub fn structure(geometry: &Geometry, scale: f64, hinges: Hinges) -> Built {
         members: Members::Flexible,
         hinges,
         support: true,
-        analysis: Analysis::statics().initial_increment(1.0),
+        gravity: None,
+        analysis: unfold::model::builder::Analysis::statics()
+            .initial_increment(1.0)
+            .into_input(),
     };
     let title = format!("The ERA {} at scale {scale}, mid-hinges {hinges:?}", geometry.name);
     build(geometry, &options, &title)
@@ -75,173 +107,154 @@ pub fn deployed(geometry: &Geometry) -> Built {
     built
 }
 
-/// What is measured at a converged increment.
+/// Where every node of the deployment model stands when the structure is
+/// deployed as designed: the nodes of [`deployed`] (built by the same
+/// code in the same order) moved so that the clamped longeron stays where
+/// it is folded.
+pub fn nominal(geometry: &Geometry) -> Result<Vec<unfold::so3::Vec3>, Box<dyn Error>> {
+    let model = Model::from_input(&deployed(geometry).input)?;
+    let s0 = geometry.design.folded_scale;
+    let c0 = geometry.layout.columns[0];
+    let shift = unfold::so3::Vec3::new((s0 - 1.0) * c0[0], (s0 - 1.0) * c0[1], 0.0);
+    Ok(model.reference_x.iter().map(|x| x + shift).collect())
+}
+
+/// One mid-hinge at a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HingeState {
+    /// Opening angle `γ` (rad, `π` locked).
+    pub opening: f64,
+    /// Moment of the tape spring opening the hinge, `−M` of
+    /// docs/joints.md §4.1 (N·m).
+    pub spring: f64,
+    /// Moment of the latch, positive opening (N·m).
+    pub latch: f64,
+    /// Whether it is locked.
+    pub locked: bool,
+}
+
+/// What is measured at a converged step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Record {
-    /// Increment (0: the equilibrium at `t = 0`).
-    pub increment: usize,
-    /// Load parameter.
+    /// Step (0: the start).
+    pub step: usize,
+    /// Time (s).
     pub time: f64,
     /// Newton iterations.
     pub iterations: usize,
-    /// The prescribed opening angle of the mid-hinges (rad).
-    pub opening: f64,
-    /// The scale of the layout it corresponds to.
-    pub scale: f64,
-    /// Largest distance of a longeron node from where the closed form puts
-    /// it (m).
-    pub longeron_error: f64,
-    /// Largest rotation of a corner body from its reference orientation
-    /// (rad): a longeron tilting or spinning.
-    pub corner_rotation: f64,
-    /// Largest axial force in a member (N).
-    pub axial: f64,
-    /// Largest bending moment `√(M₂² + M₃²)` in a member (N·m).
-    pub bending: f64,
-    /// Largest torsion in a member (N·m).
-    pub torsion: f64,
-    /// The load of the first mid-hinge's driver (N·m).
-    pub driver_load: f64,
-    /// Largest `|driver load − spring force|` over the mid-hinges (N·m):
-    /// zero when the drivers only hold the springs (the members carry no
-    /// moment about the hinge axes).
-    pub hinge_imbalance: f64,
-}
-
-/// Where the closed form puts the longeron axes at scale `s`, the
-/// clamped longeron (the first) staying where it is in the folded
-/// configuration.
-pub fn longeron_axes(geometry: &Geometry, s: f64) -> Vec<[f64; 2]> {
-    let s0 = geometry.design.folded_scale;
-    let c0 = geometry.layout.columns[0];
-    geometry
-        .layout
-        .columns
-        .iter()
-        .map(|c| {
-            [
-                s * c[0] - (s - s0) * c0[0],
-                s * c[1] - (s - s0) * c0[1],
-            ]
-        })
-        .collect()
-}
-
-/// Measures `state` (the model of [`model`]) against the closed form.
-pub fn measure(
-    geometry: &Geometry,
-    built: &Built,
-    model: &Model,
-    state: &State,
-    info: &IncrementInfo,
-) -> Record {
-    // the opening the drivers prescribe
-    let parts = &built.parts;
-    let first = parts.hinges().next().expect("a mid-hinge");
-    let target = first
-        .driver
-        .and_then(|d| model.results(d, state).get("target"))
-        .unwrap_or(0.0);
-    let opening = first.reference_opening + target;
-    let scale = geometry.scale_at(opening);
-    let axes = longeron_axes(geometry, scale);
-    let mut record = Record {
-        increment: info.increment,
-        time: info.time,
-        iterations: info.iterations,
-        opening,
-        scale,
-        longeron_error: 0.0,
-        corner_rotation: 0.0,
-        axial: 0.0,
-        bending: 0.0,
-        torsion: 0.0,
-        driver_load: 0.0,
-        hinge_imbalance: 0.0,
-    };
-    for (column, axis) in parts.columns.iter().zip(&axes) {
-        for &node in &column.longeron.nodes {
-            let i = model.node(node);
-            let z = model.reference_x[i].z;
-            let expected = Vec3::new(axis[0], axis[1], z);
-            record.longeron_error = record.longeron_error.max((state.x[i] - expected).norm());
-        }
-        for node in [column.bottom, column.top] {
-            let i = model.node(node);
-            let turn = model.reference_q[i].inverse() * state.q[i];
-            record.corner_rotation = record.corner_rotation.max(so3::log(&turn).norm());
-        }
-    }
-    let beams = parts.faces.iter().flat_map(|f| {
-        f.top
-            .halves
-            .iter()
-            .chain(&f.bottom.halves)
-            .chain(&f.diagonals)
-            .flat_map(|m| m.beams.iter())
-    });
-    let longerons = parts.columns.iter().flat_map(|c| c.longeron.beams.iter());
-    for &beam in beams.chain(longerons) {
-        let s = model.section_forces(beam, state);
-        record.axial = record.axial.max(s.force.x.abs());
-        record.torsion = record.torsion.max(s.moment.x.abs());
-        record.bending = record.bending.max(s.moment.y.hypot(s.moment.z));
-    }
-    for (k, hinge) in parts.hinges().enumerate() {
-        let (Some(driver), Some(spring)) = (hinge.driver, hinge.spring) else {
-            continue;
-        };
-        let load = model.results(driver, state).get("load").unwrap_or(f64::NAN);
-        let force = model.results(spring, state).get("spring").unwrap_or(f64::NAN);
-        if k == 0 {
-            record.driver_load = load;
-        }
-        record.hinge_imbalance = record.hinge_imbalance.max((load - force).abs());
-    }
-    record
+    /// Every mid-hinge, top then bottom of each face.
+    pub hinges: Vec<HingeState>,
+    /// Energies at the step.
+    pub energies: Energies,
+    /// Work done on the structure by the tape springs since the start (J):
+    /// `−∫ M dc`, by the trapezoidal rule over the steps.
+    pub spring_work: f64,
 }
 
 /// Summary of a deployment run.
 #[derive(Clone, Debug)]
 pub struct Figures {
-    /// Unknowns of the analysis (redundant constraints included).
+    /// Unknowns of the analysis.
     pub unknowns: usize,
-    /// Constraint equations found redundant.
-    pub redundant_constraints: usize,
-    /// Converged increments (the initial equilibrium excluded).
-    pub increments: usize,
-    /// Newton iterations per increment (the initial equilibrium excluded).
-    pub iterations_per_increment: f64,
-    /// Largest number of iterations of an increment.
-    pub max_iterations: usize,
-    /// Cut-backs.
-    pub cutbacks: usize,
+    /// Accepted time steps.
+    pub steps: usize,
+    /// Rejected steps (Newton failed, or error estimate).
+    pub rejected: usize,
+    /// Steps retried shorter to land on a lock.
+    pub event_retries: usize,
+    /// Newton iterations of the accepted steps.
+    pub iterations: usize,
+    /// Of rejected steps.
+    pub wasted_iterations: usize,
+    /// Lock times of the mid-hinges, in the order of the hinges (`None`:
+    /// not locked).
+    pub locks: Vec<Option<f64>>,
+    /// Largest distance of a node from its nominal deployed position at
+    /// the end of the motion (m): the locked structure still vibrates.
+    pub geometry_error: f64,
+    /// The same for the equilibrium of the locked structure reached from
+    /// the end of the motion (a static analysis, at rest) (m): its locked
+    /// configuration.
+    pub locked_geometry_error: f64,
+    /// Newton iterations of that equilibrium.
+    pub equilibrium_iterations: usize,
+    /// Energy the impacts of the locks dissipated (J).
+    pub impact_loss: f64,
+    /// Energy balance error at the end, with the tape springs' work
+    /// counted as work done on the structure (J).
+    pub balance_error: f64,
+    /// Largest moment a latch applied (N·m).
+    pub peak_latch_moment: f64,
     /// Wall time of the analysis (s).
     pub wall_time: f64,
 }
 
 /// A deployment run.
 pub struct Run {
-    /// Every converged increment.
+    /// Every converged step.
     pub records: Vec<Record>,
-    /// The states at the times asked for, with their records.
-    pub snapshots: Vec<(Record, State)>,
+    /// States kept along the way (at least every `snapshot_interval`).
+    pub snapshots: Vec<State>,
     /// Counts and timings.
     pub figures: Figures,
     /// The analysis outcome (final state; error if it stopped early).
-    pub outcome: StaticOutcome,
+    pub outcome: DynamicOutcome,
 }
 
-/// Records every increment, keeps the states at the snapshot times and
-/// passes everything on to the result files' recorder.
+/// Records every step, keeps states and passes everything on to the
+/// result files' recorder.
 struct DeployObserver<'a> {
-    geometry: &'a Geometry,
     built: &'a Built,
     recorder: Option<Recorder>,
-    snapshot_times: Vec<f64>,
-    snapshots: Vec<(Record, State)>,
+    interval: f64,
+    snapshots: Vec<State>,
     records: Vec<Record>,
+    energies: Option<Energies>,
     log: bool,
+}
+
+impl DeployObserver<'_> {
+    fn measure(&self, info: &IncrementInfo, model: &Model, state: &State) -> Record {
+        let hinges = self
+            .built
+            .parts
+            .hinges()
+            .map(|h| {
+                let law = h.law.map(|l| model.results(l, state));
+                let latch = h.latch.map(|l| model.results(l, state));
+                let c = law
+                    .as_ref()
+                    .and_then(|r| r.get("coordinate"))
+                    .unwrap_or(f64::NAN);
+                HingeState {
+                    opening: h.reference_opening + c,
+                    spring: -law.and_then(|r| r.get("moment")).unwrap_or(0.0),
+                    latch: latch.as_ref().and_then(|r| r.get("load")).unwrap_or(0.0),
+                    locked: latch.and_then(|r| r.get("locked")) == Some(1.0),
+                }
+            })
+            .collect::<Vec<_>>();
+        let spring_work = match self.records.last() {
+            None => 0.0,
+            Some(before) => {
+                before.spring_work
+                    + before
+                        .hinges
+                        .iter()
+                        .zip(&hinges)
+                        .map(|(a, b)| 0.5 * (a.spring + b.spring) * (b.opening - a.opening))
+                        .sum::<f64>()
+            }
+        };
+        Record {
+            step: info.increment,
+            time: info.time,
+            iterations: info.iterations,
+            hinges,
+            energies: self.energies.unwrap_or_default(),
+            spring_work,
+        }
+    }
 }
 
 impl Observer for DeployObserver<'_> {
@@ -263,6 +276,25 @@ impl Observer for DeployObserver<'_> {
         }
     }
 
+    fn energies(&mut self, energies: &Energies) {
+        self.energies = Some(*energies);
+        if let Some(r) = self.recorder.as_mut() {
+            r.energies(energies);
+        }
+    }
+
+    fn lock(&mut self, info: &LockInfo) {
+        if self.log {
+            println!(
+                "  t = {:.4} s: latch {} locks (rate {:+.3} rad/s, impulse {:.3e} N·m·s, {:.3e} J lost)",
+                info.time, info.latch, info.rate_before, info.impulse, info.energy_lost
+            );
+        }
+        if let Some(r) = self.recorder.as_mut() {
+            r.lock(info);
+        }
+    }
+
     fn increment(
         &mut self,
         info: &IncrementInfo,
@@ -270,29 +302,30 @@ impl Observer for DeployObserver<'_> {
         state: &State,
         residual: &[f64],
     ) -> std::io::Result<()> {
-        let record = measure(self.geometry, self.built, model, state, info);
-        if self.log {
+        let record = self.measure(info, model, state);
+        if self.log && info.increment % 10 == 0 {
+            let open: Vec<String> = record
+                .hinges
+                .iter()
+                .map(|h| format!("{:5.1}", h.opening.to_degrees()))
+                .collect();
             println!(
-                "increment {:3}  t = {:.4}  iterations {}  opening {:6.1}°  scale {:.4}  longerons off by {:.1e} m, turned {:.1e} rad  members: N {:.1e} N, M {:.1e} N·m, T {:.1e} N·m  driver {:+.4} N·m",
-                record.increment,
-                record.time,
-                record.iterations,
-                record.opening.to_degrees(),
-                record.scale,
-                record.longeron_error,
-                record.corner_rotation,
-                record.axial,
-                record.bending,
-                record.torsion,
-                record.driver_load,
+                "  step {:4}  t = {:.4} s  {} iterations  mid-hinges open [{}]°  kinetic energy {:.3e} J",
+                info.increment,
+                info.time,
+                info.iterations,
+                open.join(" "),
+                record.energies.kinetic
             );
         }
-        while let Some(&t) = self.snapshot_times.first() {
-            if info.time < t - 1e-12 {
-                break;
+        let keep = match self.snapshots.last() {
+            None => true,
+            Some(s) => {
+                (info.time / self.interval).floor() > (s.time / self.interval).floor() + 0.5
             }
-            self.snapshots.push((record.clone(), state.clone()));
-            self.snapshot_times.remove(0);
+        };
+        if keep {
+            self.snapshots.push(state.clone());
         }
         self.records.push(record);
         match self.recorder.as_mut() {
@@ -304,47 +337,116 @@ impl Observer for DeployObserver<'_> {
 
 /// Runs the deployment `built` (from [`model`]); with `out`, writes the
 /// result files there (the model file name `file` recorded in them).
-/// Keeps the states at the first increments reaching `snapshot_times`
-/// (increasing).
+/// Keeps a state at least every `snapshot_interval` (s); `nominal` are
+/// the nodes' nominal deployed positions ([`nominal`]).
 pub fn run(
-    geometry: &Geometry,
     built: &Built,
+    nominal: &[unfold::so3::Vec3],
     out: Option<(&Path, &str)>,
-    snapshot_times: &[f64],
+    snapshot_interval: f64,
     log: bool,
 ) -> Result<Run, Box<dyn Error>> {
-    let model = Model::from_input(&built.input)?;
-    let mut analysis = StaticAnalysis::new(&model);
+    let model = Arc::new(Model::from_input(&built.input)?);
+    let plan = built.input.analyses()?;
+    let settings = match &plan[0] {
+        AnalysisSettings::Dynamic(d) => d.clone(),
+        other => return Err(format!("a dynamic analysis, not {}", other.name()).into()),
+    };
+    let mut analysis = DynamicAnalysis::new(model.clone(), settings);
     let recorder = match out {
-        Some((dir, file)) => Some(Recorder::create(dir, file, &model, &analysis, Silent)?),
+        Some((dir, file)) => Some(Recorder::create_dynamic_first(
+            dir, file, &analysis, &plan, Silent,
+        )?),
         None => None,
     };
     let mut observer = DeployObserver {
-        geometry,
         built,
         recorder,
-        snapshot_times: snapshot_times.to_vec(),
+        interval: snapshot_interval,
         snapshots: Vec::new(),
         records: Vec::new(),
+        energies: None,
         log,
     };
-    let outcome = analysis.run(&mut observer);
-    if let Some(recorder) = observer.recorder.take() {
-        let report = recorder.finish(&outcome);
+    let outcome = analysis.run(model.initial_state(), &mut observer);
+    if let Some(mut recorder) = observer.recorder.take() {
+        let end = AnalysisEnd::from(&outcome);
+        recorder.end_analysis(&end);
+        let report = recorder.finish_after(Some(&end), &outcome.state);
         if let Some(e) = report.output_errors.into_iter().next() {
             return Err(e.into());
         }
     }
     let records = observer.records;
-    let steps: Vec<&Record> = records.iter().skip(1).collect();
+    let hinges: Vec<_> = built.parts.hinges().collect();
+    let locks = hinges
+        .iter()
+        .map(|h| {
+            let latch = h.latch?;
+            outcome
+                .locks
+                .iter()
+                .find(|l| l.latch == latch.id())
+                .map(|l| l.time)
+        })
+        .collect();
+    let last = records.last().expect("step 0");
+    let error = |state: &State| {
+        state
+            .x
+            .iter()
+            .zip(nominal)
+            .map(|(x, x0)| (x - x0).norm())
+            .fold(0.0, f64::max)
+    };
+    let geometry_error = error(&outcome.state);
+    // the locked configuration: the equilibrium at the end time, from the
+    // end of the motion brought to rest, the latches as they are
+    let mut rest = outcome.state.clone();
+    for v in rest
+        .velocity
+        .iter_mut()
+        .chain(rest.acceleration.iter_mut())
+        .chain(rest.pseudo_acceleration.iter_mut())
+    {
+        *v = [0.0; 6];
+    }
+    for v in rest
+        .coordinate_rates
+        .iter_mut()
+        .chain(rest.coordinate_accelerations.iter_mut())
+        .chain(rest.coordinate_pseudo_accelerations.iter_mut())
+    {
+        *v = 0.0;
+    }
+    let statics = unfold::model::builder::Analysis::statics()
+        .end_time(rest.time + 1.0)
+        .initial_increment(1.0)
+        .settings()?;
+    let equilibrium =
+        unfold::analysis::StaticAnalysis::new(model.clone(), statics).run(rest, &mut unfold::analysis::NoObserver);
+    if let Some(e) = &equilibrium.error {
+        return Err(format!("the equilibrium of the locked structure: {e}").into());
+    }
+    let locked_geometry_error = error(&equilibrium.state);
+    let peak_latch_moment = records
+        .iter()
+        .flat_map(|r| r.hinges.iter().map(|h| h.latch.abs()))
+        .fold(0.0, f64::max);
     let figures = Figures {
         unknowns: analysis.n_equations(),
-        redundant_constraints: outcome.redundant_constraints,
-        increments: outcome.increments,
-        iterations_per_increment: steps.iter().map(|r| r.iterations).sum::<usize>() as f64
-            / steps.len().max(1) as f64,
-        max_iterations: steps.iter().map(|r| r.iterations).max().unwrap_or(0),
-        cutbacks: outcome.cutbacks,
+        steps: outcome.steps,
+        rejected: outcome.rejected_steps,
+        event_retries: outcome.event_retries,
+        iterations: outcome.iterations,
+        wasted_iterations: outcome.wasted_iterations,
+        locks,
+        geometry_error,
+        locked_geometry_error,
+        equilibrium_iterations: equilibrium.iterations,
+        impact_loss: outcome.locks.iter().map(|l| l.energy_lost).sum(),
+        balance_error: outcome.energies.balance_error - last.spring_work,
+        peak_latch_moment,
         wall_time: outcome.wall_time,
     };
     Ok(Run {
@@ -354,3 +456,6 @@ pub fn run(
         outcome,
     })
 }
+
+/// The opening angle the mid-hinges lock at (rad).
+pub const LOCKED_OPENING: f64 = PI;

@@ -69,6 +69,11 @@ impl Tube {
             .mass_per_length(rho * a)
             .inertia_per_length([rho * 2.0 * i, rho * i, rho * i])
     }
+
+    /// Mass of a member of length `length` (kg).
+    pub fn mass(&self, length: f64) -> f64 {
+        self.mass_per_length() * length
+    }
 }
 
 /// An aluminium fitting modelled as a rigid body: a solid cylinder about
@@ -94,28 +99,36 @@ impl Fitting {
     }
 }
 
-/// The mid-hinge torsion springs: the moment that opens a hinge as a
-/// function of its opening angle `γ` (the angle between the two halves of
-/// the horizontal, `π` when deployed).
-///
-/// This is a stand-in, linear in the angle: the deployment moment
-/// `M(γ) = M_d + k (π − γ)`, `M_d` at the deployed angle. The nonlinear
-/// moment/angle law of the paper (§6.2), with its hysteresis, and the
-/// latch that locks the hinge at the end of its travel replace it in
-/// [`crate::hinge`] (the only place that turns this law into model
-/// entities).
+/// The mid-hinge torsion springs: tape-spring hinges, whose moment
+/// against the hinge's opening angle follows the tape-spring shape of
+/// docs/joints.md §4.1 (deployment moment over the travel, a stiff locked
+/// branch from the locking angle on, a locking peak that must be overcome
+/// to fold the locked hinge again, hysteresis between them), and a latch
+/// that locks the hinge rigidly at the end of its travel (docs/joints.md
+/// §6.2), the halves in line (`γ = π`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HingeLaw {
-    /// Moment left when the hinge reaches the deployed angle (N·m).
-    pub deployed_moment: f64,
-    /// Decrease of the moment per radian of opening (N·m/rad).
-    pub stiffness: f64,
+    /// `M_d`: moment that opens the hinge over its travel (N·m).
+    pub deployment_moment: f64,
+    /// `M_L`: moment that folds the locked hinge again (N·m).
+    pub locking_peak: f64,
+    /// `K`: slope of the locked branch (N·m/rad).
+    pub locked_stiffness: f64,
+    /// `w`: width over which the moment falls from `M_L` back to `M_d`
+    /// when the hinge is folded past its peak (rad).
+    pub snap_width: f64,
+    /// `k_e`: slope of the moment between the bounds of the hysteresis
+    /// (N·m/rad), steeper than `K` and `(M_L − M_d)/w`.
+    pub elastic_slope: f64,
 }
 
 impl HingeLaw {
-    /// The opening moment at the opening angle `gamma` (N·m).
-    pub fn opening_moment(&self, gamma: f64) -> f64 {
-        self.deployed_moment + self.stiffness * (PI - gamma)
+    /// The energy the spring gives the structure as the hinge opens by
+    /// `travel` (rad) up to the lock: `M_d` over the travel less the
+    /// locked branch's `M_d²/(2K)` (J).
+    pub fn deployment_energy(&self, travel: f64) -> f64 {
+        self.deployment_moment * travel
+            - 0.5 * self.deployment_moment.powi(2) / self.locked_stiffness
     }
 }
 
@@ -169,8 +182,11 @@ pub struct Design {
     pub mid_hinge_diagonal_mass: f64,
     /// Elements per member.
     pub mesh: Mesh,
-    /// The mid-hinge springs.
+    /// The mid-hinge springs and latches.
     pub hinge: HingeLaw,
+    /// Stiffness-proportional Rayleigh damping of the members, `β` (s):
+    /// `ζ = β ω / 2` in each mode of the locked structure.
+    pub rayleigh_beta: f64,
 }
 
 impl Default for Design {
@@ -200,9 +216,13 @@ impl Default for Design {
                 diagonal: 3,
             },
             hinge: HingeLaw {
-                deployed_moment: 0.3,
-                stiffness: 0.05,
+                deployment_moment: 0.2,
+                locking_peak: 10.0,
+                locked_stiffness: 200.0,
+                snap_width: 5.0f64.to_radians(),
+                elastic_slope: 400.0,
             },
+            rayleigh_beta: 0.0,
         }
     }
 }

@@ -1,7 +1,8 @@
 //! The mid-hinges: what acts on their angle. This is the one place where
-//! the hinge law becomes model entities; the torsion springs' nonlinear
-//! moment/angle law with hysteresis and the latches that lock the hinges
-//! at the end of their travel (paper §6.2) replace the stand-ins here.
+//! the hinge law becomes model entities: the torsion spring's nonlinear
+//! moment/angle law with its hysteresis (a tape-spring hinge law,
+//! docs/joints.md §4.1) and the latch that locks the hinge at the end of
+//! its travel (docs/joints.md §6.2), as the paper's §6.2 describes them.
 //!
 //! Angles. A mid-hinge is a revolute joint from the first half of its
 //! horizontal (body A, which carries the fitting) to the second (body B),
@@ -9,28 +10,23 @@
 //! ([`super::geometry::Geometry::opening_sense`]). Its coordinate is
 //! `θ = γ − γ_ref`, `γ` the opening angle (between the halves, `π`
 //! deployed) and `γ_ref` its value in the configuration the model is
-//! built in.
+//! built in; the hinge locks at `θ_L = π − γ_ref`.
 
 use std::f64::consts::PI;
 
 use unfold::model::builder::*;
+use unfold::model::input::TapeSpringInput;
 
-use super::design::HingeLaw;
+use super::design::HingeLaw as Law;
 
-/// What holds or moves the mid-hinges.
+/// What holds the mid-hinges.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Hinges {
-    /// Free: the torsion spring alone.
+    /// The tape spring and the latch: the hinge deploys and locks.
     Free,
     /// Locked where the model is built (a driver holding `θ = 0`): the
-    /// stand-in for the latch of a deployed hinge.
+    /// deployed structure, for the checks.
     Locked,
-    /// Driven from the opening of the reference configuration to
-    /// `opening` (rad) along `curve` (a driver on `θ`), spring included.
-    Driven {
-        /// Opening angle at `curve = 1` (rad).
-        opening: f64,
-    },
 }
 
 /// The entities acting on one mid-hinge.
@@ -38,54 +34,59 @@ pub enum Hinges {
 pub struct HingeParts {
     /// The revolute joint.
     pub joint: JointHandle,
-    /// Its torsion spring.
-    pub spring: Option<JointSpringHandle>,
-    /// The driver or lock, if any.
+    /// Its tape spring.
+    pub law: Option<HingeLawHandle>,
+    /// Its latch.
+    pub latch: Option<LatchHandle>,
+    /// The lock of [`Hinges::Locked`].
     pub driver: Option<DriverHandle>,
     /// Opening angle in the reference configuration (rad).
     pub reference_opening: f64,
 }
 
-/// The torsion spring of `law` on `joint`, opened by `reference_opening`
-/// in the reference configuration.
-///
-/// Stand-in: a linear joint spring. The spring's generalised force on the
-/// coordinate is `f_s = k (θ − θ₀)` (docs/joints.md §4: positive resists
-/// an increase of `θ`), so the opening moment is `−f_s = k (θ₀ − θ)`;
-/// equal to `M(γ) = M_d + k (π − γ)` with `θ = γ − γ_ref` when
-/// `θ₀ = M_d / k + π − γ_ref`.
-pub fn spring(law: &HingeLaw, joint: JointHandle, reference_opening: f64) -> JointSpring {
-    let free = law.deployed_moment / law.stiffness + PI - reference_opening;
-    JointSpring::on(joint)
-        .stiffness(law.stiffness)
-        .free_value(free)
+impl HingeParts {
+    /// The coordinate `θ_L` at which the hinge locks (rad).
+    pub fn locking_angle(&self) -> f64 {
+        PI - self.reference_opening
+    }
 }
 
-/// Adds the spring and the driver or lock of `hinges` to `joint`.
+/// The tape spring of `law` on `joint`: the shape of docs/joints.md §4.1
+/// with the locking angle `c_L = π − γ_ref`, so that the moment opens the
+/// hinge by `M_d` (the law's moment is negative: it pushes `θ` up) until
+/// the locked branch takes over just before the halves are in line.
+pub fn tape_spring(law: &Law, joint: JointHandle, reference_opening: f64) -> HingeLaw {
+    HingeLaw::on(joint, law.elastic_slope).tape_spring(TapeSpringInput {
+        deployment_moment: law.deployment_moment,
+        locking_angle: PI - reference_opening,
+        locking_peak: law.locking_peak,
+        locked_stiffness: law.locked_stiffness,
+        snap_width: law.snap_width,
+        rounding: None,
+    })
+}
+
+/// Adds the spring and latch, or the lock, of `hinges` to `joint`.
 pub fn add(
     m: &mut ModelBuilder,
-    law: &HingeLaw,
+    law: &Law,
     joint: JointHandle,
     reference_opening: f64,
     hinges: Hinges,
-    curve: Option<CurveHandle>,
 ) -> HingeParts {
-    let spring = Some(m.add(spring(law, joint, reference_opening)));
-    let driver = match hinges {
-        Hinges::Free => None,
-        Hinges::Locked => Some(m.add(Driver::on(joint).value(0.0))),
-        Hinges::Driven { opening } => {
-            let mut d = Driver::on(joint).value(opening - reference_opening);
-            if let Some(c) = curve {
-                d = d.curve(c);
-            }
-            Some(m.add(d))
-        }
-    };
-    HingeParts {
+    let mut parts = HingeParts {
         joint,
-        spring,
-        driver,
+        law: None,
+        latch: None,
+        driver: None,
         reference_opening,
+    };
+    match hinges {
+        Hinges::Free => {
+            parts.law = Some(m.add(tape_spring(law, joint, reference_opening)));
+            parts.latch = Some(m.add(Latch::on(joint, PI - reference_opening)));
+        }
+        Hinges::Locked => parts.driver = Some(m.add(Driver::on(joint).value(0.0))),
     }
+    parts
 }

@@ -15,7 +15,7 @@
 //! rigid connection).
 
 use unfold::model::builder::*;
-use unfold::model::input::ModelInput;
+use unfold::model::input::{AnalysisInput, ModelInput};
 use unfold::so3::Vec3;
 
 use super::design::Design;
@@ -126,8 +126,10 @@ pub struct Options {
     /// Whether a bottom corner body is clamped (the structure is otherwise
     /// free in space).
     pub support: bool,
+    /// Gravity (m/s²), if any.
+    pub gravity: Option<[f64; 3]>,
     /// The analysis.
-    pub analysis: Analysis,
+    pub analysis: AnalysisInput,
 }
 
 /// A model and its parts.
@@ -188,25 +190,27 @@ fn fitting(m: &mut ModelBuilder, kind: Members, node: NodeHandle, f: super::desi
     }
 }
 
-/// Builds the model of `geometry` in the configuration of `options`. The
-/// drivers of [`Hinges::Driven`] follow a smooth step from `t = 0` to
-/// `t = 1` (zero rate and acceleration at both ends, like a deployment
-/// that starts from rest and ends at rest).
+/// Builds the model of `geometry` in the configuration of `options`.
 pub fn build(geometry: &Geometry, options: &Options, title: &str) -> Built {
     let d: &Design = &geometry.design;
     let c = geometry.at(options.scale);
     let kind = options.members;
     let mut m = ModelBuilder::new(title);
-    m.analysis(options.analysis.clone());
+    let section = |tube: &super::design::Tube, name: &str| {
+        let s = tube.section().named(name);
+        match d.rayleigh_beta {
+            b if b > 0.0 => s.rayleigh_damping(0.0, b),
+            _ => s,
+        }
+    };
     let sections = Sections {
-        longeron: m.section(d.longeron.section().named("longeron")),
-        horizontal: m.section(d.horizontal.section().named("horizontal")),
-        diagonal: m.section(d.diagonal.section().named("diagonal")),
+        longeron: m.section(section(&d.longeron, "longeron")),
+        horizontal: m.section(section(&d.horizontal, "horizontal")),
+        diagonal: m.section(section(&d.diagonal, "diagonal")),
     };
-    let curve = match options.hinges {
-        Hinges::Driven { .. } => Some(m.curve(LoadCurve::smooth_step(0.0, 1.0).named("deploy"))),
-        _ => None,
-    };
+    if let Some(g) = options.gravity {
+        m.gravity(g);
+    }
 
     // longerons and corner bodies
     let layout = &geometry.layout;
@@ -256,7 +260,7 @@ pub fn build(geometry: &Geometry, options: &Options, title: &str) -> Built {
                     .at(mid)
                     .axis([0.0, 0.0, sense]),
             );
-            let hinge = hinge::add(m, &d.hinge, joint, c.opening, options.hinges, curve);
+            let hinge = hinge::add(m, &d.hinge, joint, c.opening, options.hinges);
             Horizontal { halves, hinge }
         };
         let top = horizontal(&mut m, true);
@@ -283,8 +287,10 @@ pub fn build(geometry: &Geometry, options: &Options, title: &str) -> Built {
         m.fix(node, Dofs::ALL);
         node
     });
+    let mut input = m.into_input();
+    input.analysis = options.analysis.clone().into();
     Built {
-        input: m.into_input(),
+        input,
         parts: Parts {
             columns,
             faces,

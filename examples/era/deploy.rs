@@ -96,14 +96,20 @@ pub fn structure(geometry: &Geometry, scale: f64, hinges: Hinges) -> Built {
             .initial_increment(1.0)
             .into_input(),
     };
-    let title = format!("The ERA {} at scale {scale}, mid-hinges {hinges:?}", geometry.name);
+    let title = format!(
+        "The ERA {} at scale {scale}, mid-hinges {hinges:?}",
+        geometry.name
+    );
     build(geometry, &options, &title)
 }
 
 /// The deployed structure, every mid-hinge locked, a longeron clamped.
 pub fn deployed(geometry: &Geometry) -> Built {
     let mut built = structure(geometry, 1.0, Hinges::Locked);
-    built.input.title = Some(format!("The deployed ERA {}, mid-hinges locked", geometry.name));
+    built.input.title = Some(format!(
+        "The deployed ERA {}, mid-hinges locked",
+        geometry.name
+    ));
     built
 }
 
@@ -303,7 +309,7 @@ impl Observer for DeployObserver<'_> {
         residual: &[f64],
     ) -> std::io::Result<()> {
         let record = self.measure(info, model, state);
-        if self.log && info.increment % 10 == 0 {
+        if self.log && info.increment.is_multiple_of(10) {
             let open: Vec<String> = record
                 .hinges
                 .iter()
@@ -320,9 +326,7 @@ impl Observer for DeployObserver<'_> {
         }
         let keep = match self.snapshots.last() {
             None => true,
-            Some(s) => {
-                (info.time / self.interval).floor() > (s.time / self.interval).floor() + 0.5
-            }
+            Some(s) => (info.time / self.interval).floor() > (s.time / self.interval).floor() + 0.5,
         };
         if keep {
             self.snapshots.push(state.clone());
@@ -423,8 +427,8 @@ pub fn run(
         .end_time(rest.time + 1.0)
         .initial_increment(1.0)
         .settings()?;
-    let equilibrium =
-        unfold::analysis::StaticAnalysis::new(model.clone(), statics).run(rest, &mut unfold::analysis::NoObserver);
+    let equilibrium = unfold::analysis::StaticAnalysis::new(model.clone(), statics)
+        .run(rest, &mut unfold::analysis::NoObserver);
     if let Some(e) = &equilibrium.error {
         return Err(format!("the equilibrium of the locked structure: {e}").into());
     }

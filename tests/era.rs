@@ -75,3 +75,23 @@ fn cell_deploys_and_every_mid_hinge_locks() {
         last.spring_work
     );
 }
+
+/// The platform's plan: a hexagon of side two cell widths on the
+/// triangular lattice holds `6 n²` = 24 triangular cells, `3n² + 3n + 1`
+/// = 19 longerons and `(3·24 + 6·2)/2` = 42 faces (each inner face shared
+/// by two cells, the 12 of the outline by one), as paper figure 5 shows.
+#[test]
+fn platform_layout_is_the_hexagon_of_24_cells() {
+    let layout = era::geometry::Layout::new(Structure::PLATFORM, 1.0);
+    assert_eq!(layout.cells.len(), 24);
+    assert_eq!(layout.columns.len(), 19);
+    assert_eq!(layout.faces.len(), 42);
+    assert_eq!(layout.faces.iter().filter(|f| f.boundary).count(), 12);
+    // every cell is an equilateral triangle of the cell side
+    for cell in &layout.cells {
+        for k in 0..3 {
+            let (a, b) = (layout.columns[cell[k]], layout.columns[cell[(k + 1) % 3]]);
+            assert!(((a[0] - b[0]).hypot(a[1] - b[1]) - 1.0).abs() < 1e-12);
+        }
+    }
+}

@@ -133,14 +133,18 @@ impl Layout {
             })
             .collect();
         // cells: (i, j), (i+1, j), (i, j+1) pointing up and (i+1, j),
-        // (i+1, j+1), (i, j+1) pointing down, counter-clockwise
+        // (i+1, j+1), (i, j+1) pointing down, counter-clockwise, each with
+        // its three longerons inside (a down cell's anchor (i, j) may lie
+        // outside: `6 rings²` cells in all)
         let mut cells = Vec::new();
-        for &(i, j) in &lattice {
-            let up = [index(i, j), index(i + 1, j), index(i, j + 1)];
-            let down = [index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)];
-            for t in [up, down] {
-                if let [Some(a), Some(b), Some(c)] = t {
-                    cells.push([a, b, c]);
+        for j in -n - 1..=n {
+            for i in -n - 1..=n {
+                let up = [index(i, j), index(i + 1, j), index(i, j + 1)];
+                let down = [index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)];
+                for t in [up, down] {
+                    if let [Some(a), Some(b), Some(c)] = t {
+                        cells.push([a, b, c]);
+                    }
                 }
             }
         }

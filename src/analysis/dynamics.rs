@@ -1228,8 +1228,7 @@ fn initial_accelerations(
         None
     };
     let rows = damping.as_ref().map(|c| (by_dof.as_slice(), c));
-    let (scale, s_eq) =
-        constrained_mass_system(model, solver, state, &mut run.mass_system, rows)?;
+    let (scale, s_eq) = constrained_mass_system(model, solver, state, &mut run.mass_system, rows)?;
     run.mass_scale = scale;
     let (dofs, assembler, _) = solver.system();
     let mut rhs: Vec<f64> = (0..dofs.n_equations())

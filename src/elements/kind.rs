@@ -76,7 +76,6 @@ impl ElementKind {
         Self::Driver,
         Self::Latch,
         Self::Stop,
-
         Self::RollingDisc,
     ];
 

@@ -294,7 +294,6 @@ fn model_size(input: &ModelInput) -> usize {
         input.drivers.len(),
         input.latches.len(),
         input.stops.len(),
-
         input.rolling_discs.len(),
         generated,
     ]

@@ -542,7 +542,6 @@ impl Entity for Stop {
     }
 }
 
-
 /// A rigid disc rolling without slipping on a fixed plane
 /// (docs/joints.md §3.8): its node at the centre, its axis a material
 /// direction of the node. The disc must touch the plane in the reference

@@ -88,7 +88,8 @@ fn same_steps(out: &Path) -> Vec<usize> {
         let path = entry.unwrap().path();
         let name = path.file_name().unwrap().to_string_lossy();
         // the modal analyses' tables are by mode
-        if name.ends_with(".csv") && !name.starts_with("mode") {
+        // (events.csv lists events, by the step they happened on)
+        if name.ends_with(".csv") && !name.starts_with("mode") && name != "events.csv" {
             assert_eq!(steps(&path), reference, "{}", path.display());
         }
     }
@@ -812,7 +813,10 @@ fn events_csv_lists_the_impacts_of_a_stop() {
         assert!(num(e, "impulse") > 0.0 && num(e, "energy_lost") > 0.0);
     }
     assert_eq!(last["kind"], "contact");
-    assert_eq!(num(last, "rate_after"), 0.0);
+    // the closed stop holds the coordinate: its rate at round-off
+    // (1e-12 of the approach)
+    let closing = num(last, "rate_before").abs();
+    assert!(num(last, "rate_after").abs() <= 1e-12 * closing, "{last:?}");
     let s = summary(&out);
     let d = &s["analyses"][0]["dynamic"];
     assert_eq!(d["impacts"], impacts.len(), "{d}");

@@ -357,6 +357,10 @@ impl Work {
 struct MassSystem {
     stiffness: Option<SparseMatrix>,
     mass: Option<SparseMatrix>,
+    /// `∂r/∂v` and the rest of the split, for the rows of velocity
+    /// constraints (D13).
+    damping: Option<SparseMatrix>,
+    damping_rest: Option<SparseMatrix>,
 }
 
 /// The scale factors `s` of distance and angle constraints (D8): rows
@@ -1431,15 +1435,47 @@ impl Dynamics<'_> {
     fn project_velocities(&mut self) -> Result<(), NewtonFailure> {
         let (model, run) = (self.model, &mut *self.run);
         let dofs = &self.solver.dofs;
-        // no joints; or rolling discs, whose velocity constraints the
-        // integrator already enforces at each step (docs/theory.md §15.7)
-        if dofs.first_multiplier() == dofs.n_dofs() || has_velocity_constraints(model) {
+        if dofs.first_multiplier() == dofs.n_dofs() {
             return Ok(());
         }
         let state = &mut run.state;
-        let rate = constraint_rate(model, self.solver, state, run.span);
-        let (_, s_eq) =
-            constrained_mass_system(model, self.solver, state, &mut run.mass_system, None)?;
+        let mut rate = constraint_rate(model, self.solver, state, run.span);
+        // velocity constraints (rolling discs): their rows of the matrix are
+        // ∂r/∂v = −kA, their right-hand side their own residual −kA v, so
+        // that A(v + δv) = 0 (docs/theory.md §15.7)
+        let rows = has_velocity_constraints(model).then(|| velocity_rows(model, &self.solver.dofs));
+        let mut damping = None;
+        if let Some(rows) = &rows {
+            let (_, assembler, _) = self.solver.system();
+            let buffers = &mut run.mass_system;
+            if !buffers
+                .damping
+                .as_ref()
+                .is_some_and(|c| c.row_indices() == assembler.matrix.row_indices())
+            {
+                buffers.damping = Some(assembler.matrix.clone());
+                buffers.damping_rest = Some(assembler.matrix.clone());
+            }
+            let (mut c, mut rest) = (
+                buffers.damping.take().expect("set above"),
+                buffers.damping_rest.take().expect("set above"),
+            );
+            let ctx = EvalContext {
+                dynamics: true,
+                ..model.context(state.time, Need::with_inertia(1.0, 0.0))
+            };
+            assembler.assemble_split(model, &ctx, state, &mut rest, &mut c);
+            for (d, _) in rows.iter().enumerate().filter(|(_, &r)| r) {
+                rate[d] = assembler.residual[d];
+            }
+            buffers.damping_rest = Some(rest);
+            damping = Some(c);
+        }
+        let velocity_rows = rows.as_deref().zip(damping.as_ref());
+        let scaled =
+            constrained_mass_system(model, self.solver, state, &mut run.mass_system, velocity_rows);
+        run.mass_system.damping = damping;
+        let (_, s_eq) = scaled?;
         let dofs = &self.solver.dofs;
         let rhs = &mut run.work.rhs;
         rhs.clear();

@@ -1267,6 +1267,71 @@ fn initial_accelerations(
     Ok(())
 }
 
+/// D14: closes the position constraints of `state` before a restart,
+/// `q ← q ∘ exp(δq)` with the smallest correction in the metric of the
+/// mass that satisfies `Φ(q) + B δq = 0`,
+///
+/// ```text
+/// [ M    −kBᵀ ] [ δq ]     [ 0    ]
+/// [ −kB   0   ] [ μ  ] = − [ −k Φ ]
+/// ```
+///
+/// (the matrix of D9 and D13). A latch or a stop is detected within its
+/// event tolerance of its value, and without the correction the first
+/// step after the restart would close that gap `Φ₀` alone: `a₁` takes
+/// `−Φ₀/(βh²)` (D2), a kick of the multipliers that the index-3 scheme
+/// then carries as its alternating transient (docs/theory.md §15.8).
+/// One linear solve: `Φ₀` is within the event tolerance (≤ 1e-8 of the
+/// model size), so the residual left is `O(Φ₀²)`. Models with velocity
+/// constraints (rolling) are left as they are.
+fn project_positions(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    run: &mut Run,
+) -> Result<(), NewtonFailure> {
+    let dofs = &solver.dofs;
+    if dofs.first_multiplier() == dofs.n_dofs() || has_velocity_constraints(model) {
+        return Ok(());
+    }
+    let state = &mut run.state;
+    let residual = constraint_residual(model, solver, state);
+    let (_, s_eq) = constrained_mass_system(model, solver, state, &mut run.mass_system, None)?;
+    let dofs = &solver.dofs;
+    let mut rhs: Vec<f64> = (0..dofs.n_equations())
+        .map(|eq| {
+            if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
+                -residual[dofs.dof(eq)] * s_eq[eq]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    solve_mass_system(model, solver, state, &mut rhs)?;
+    let dofs = &solver.dofs;
+    for (eq, z) in rhs.iter_mut().enumerate() {
+        if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
+            *z = 0.0;
+        }
+    }
+    state.update(dofs, &rhs);
+    let t = state.time;
+    model.apply_prescribed(state, t);
+    Ok(())
+}
+
+/// The restart after an impact (a latch locking, a stop closing or
+/// opening): the positions projected on the constraints (D14), then
+/// consistent accelerations and multipliers (D9), `a = v̇`.
+fn restart_after_impact(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    run: &mut Run,
+    end_time: f64,
+) -> Result<(), NewtonFailure> {
+    project_positions(model, solver, run)?;
+    initial_accelerations(model, solver, run, end_time)
+}
+
 /// The failure of a singular or nearly singular iteration matrix: the
 /// unknown without stiffness or mass.
 fn singular(
@@ -1947,7 +2012,7 @@ impl Stepper for Dynamics<'_> {
             Some(i) => {
                 run.lock_rank_analyses += 1;
                 run.redundant = run.redundant.max(i.redundant);
-                initial_accelerations(model, self.solver, run, self.settings.end_time).map_err(
+                restart_after_impact(model, self.solver, run, self.settings.end_time).map_err(
                     |failure| DynamicError::Initial {
                         time: info.time,
                         failure,
@@ -2001,7 +2066,7 @@ impl Dynamics<'_> {
         run.lock_rank_analyses += 1;
         run.redundant = run.redundant.max(i.redundant);
         let restart = |solver: &mut NewtonSolver, run: &mut Run| {
-            initial_accelerations(model, solver, run, end_time).map_err(|failure| {
+            restart_after_impact(model, solver, run, end_time).map_err(|failure| {
                 DynamicError::Initial {
                     time: info.time,
                     failure,

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! with the joints' augmented Lagrangian (docs/theory.md §15, equation
-//! labels D1–D13 there):
+//! labels D1–D15 there):
 //! - parameters from the spectral radius `ρ∞` (D1);
 //! - the step `q_{n+1} = q_n ∘ exp(h Δq_n)` on the nodes' group, with
 //!   the velocity, acceleration and pseudo-acceleration updates (D2–D4),
@@ -24,7 +24,11 @@
 //! - the energy balance of every step ([`super::energy`], D12);
 //! - at `ρ∞ ≥ 0.99`, the projection of the converged velocities on the
 //!   velocity constraints, which keeps the undamped parasitic modes of the
-//!   index-3 constraints from growing (D13).
+//!   index-3 constraints from growing (D13);
+//! - the positions projected on the constraints before the restart after
+//!   an impact (D14), and the normal part of the velocities rescaled with
+//!   the step when its size changes (D15), so that neither kicks the
+//!   multipliers into the alternating transient of the index-3 scheme.
 //!
 //! Node velocities are `(ẋ, Ω)`, `ẋ` global and `Ω` material, as in the
 //! inertia kernels (docs/theory.md §11.1). Multipliers are kept in the
@@ -1553,14 +1557,17 @@ impl Dynamics<'_> {
     /// the normal part of the accepted velocities (`v_N = −δv` of D13,
     /// the `M`-orthogonal projection of `v_n` on the normals of the velocity
     /// constraints) is found once per accepted step; [`Self::predict`] then
-    /// starts from `v_n + (r² − 1) v_N`, `r = h/h_{n−1}`. Below
+    /// starts from `v_n + (s − 1) v_N` and `v̇_n + (s/r)(a_n − v̇_n)`,
+    /// `r = h/h_{n−1}`, `s = r²` for `r ≤ 1` and `r` for `r > 1`. Below
     /// [`PROJECTION_RHO`] the velocities of the index-3 scheme leave the
     /// velocity constraints by `B v_n = O(h²)` (docs/theory.md §15.8): the
     /// step of size `h` carries `r²` times the violation of the last, and
     /// without the rescaling the difference, `(1 − r²) v_N`, goes into
     /// `a_{n+1}` through the position constraints (D2) divided by `βh`:
     /// after a step shortened to land on an output time, the alternating
-    /// transient of `v̇` and of the multipliers. Nothing is done with
+    /// transient of `v̇` and of the multipliers. A longer step takes
+    /// `s = r` rather than `r²`, which would amplify a transient already
+    /// there as the steps grow. Nothing is done with
     /// projected velocities (`v_N = 0`), without constraints, or with
     /// velocity constraints (rolling: their rows hold the velocities).
     fn rescale_normal_velocity(&mut self, h: f64) -> Result<(), NewtonFailure> {

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! with the joints' augmented Lagrangian (docs/theory.md §15, equation
-//! labels D1–D13 there):
+//! labels D1–D15 there):
 //! - parameters from the spectral radius `ρ∞` (D1);
 //! - the step `q_{n+1} = q_n ∘ exp(h Δq_n)` on the nodes' group, with
 //!   the velocity, acceleration and pseudo-acceleration updates (D2–D4),
@@ -24,7 +24,11 @@
 //! - the energy balance of every step ([`super::energy`], D12);
 //! - at `ρ∞ ≥ 0.99`, the projection of the converged velocities on the
 //!   velocity constraints, which keeps the undamped parasitic modes of the
-//!   index-3 constraints from growing (D13).
+//!   index-3 constraints from growing (D13);
+//! - the positions projected on the constraints before the restart after
+//!   an impact (D14), and the normal part of the velocities rescaled with
+//!   the step when its size changes (D15), so that neither kicks the
+//!   multipliers into the alternating transient of the index-3 scheme.
 //!
 //! Node velocities are `(ẋ, Ω)`, `ẋ` global and `Ω` material, as in the
 //! inertia kernels (docs/theory.md §11.1). Multipliers are kept in the
@@ -294,6 +298,10 @@ struct Run {
     mass_system: MassSystem,
     /// The span of the analysis, `end_time − t₀` (D13).
     span: f64,
+    /// The part of the accepted velocities normal to the velocity
+    /// constraints in the metric of the mass (D15), by node and by
+    /// coordinate, once a step of another size than the last needs it.
+    normal_velocity: Option<(Vec<[f64; 6]>, Vec<f64>)>,
     redundant: usize,
     /// The unknown with the largest residual at the last failed attempt.
     location: String,
@@ -509,6 +517,7 @@ impl DynamicAnalysis {
             mass_scale: [0.0; 2],
             mass_system: MassSystem::default(),
             span: (s.end_time - t0).abs(),
+            normal_velocity: None,
             redundant: 0,
             location: String::new(),
             locks: Vec::new(),
@@ -1271,6 +1280,71 @@ fn initial_accelerations(
     Ok(())
 }
 
+/// D14: closes the position constraints of `state` before a restart,
+/// `q ← q ∘ exp(δq)` with the smallest correction in the metric of the
+/// mass that satisfies `Φ(q) + B δq = 0`,
+///
+/// ```text
+/// [ M    −kBᵀ ] [ δq ]     [ 0    ]
+/// [ −kB   0   ] [ μ  ] = − [ −k Φ ]
+/// ```
+///
+/// (the matrix of D9 and D13). A latch or a stop is detected within its
+/// event tolerance of its value, and without the correction the first
+/// step after the restart would close that gap `Φ₀` alone: `a₁` takes
+/// `−Φ₀/(βh²)` (D2), a kick of the multipliers that the index-3 scheme
+/// then carries as its alternating transient (docs/theory.md §15.8).
+/// One linear solve: `Φ₀` is within the event tolerance (≤ 1e-8 of the
+/// model size), so the residual left is `O(Φ₀²)`. Models with velocity
+/// constraints (rolling) are left as they are.
+fn project_positions(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    run: &mut Run,
+) -> Result<(), NewtonFailure> {
+    let dofs = &solver.dofs;
+    if dofs.first_multiplier() == dofs.n_dofs() || has_velocity_constraints(model) {
+        return Ok(());
+    }
+    let state = &mut run.state;
+    let residual = constraint_residual(model, solver, state);
+    let (_, s_eq) = constrained_mass_system(model, solver, state, &mut run.mass_system, None)?;
+    let dofs = &solver.dofs;
+    let mut rhs: Vec<f64> = (0..dofs.n_equations())
+        .map(|eq| {
+            if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
+                -residual[dofs.dof(eq)] * s_eq[eq]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    solve_mass_system(model, solver, state, &mut rhs)?;
+    let dofs = &solver.dofs;
+    for (eq, z) in rhs.iter_mut().enumerate() {
+        if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
+            *z = 0.0;
+        }
+    }
+    state.update(dofs, &rhs);
+    let t = state.time;
+    model.apply_prescribed(state, t);
+    Ok(())
+}
+
+/// The restart after an impact (a latch locking, a stop closing or
+/// opening): the positions projected on the constraints (D14), then
+/// consistent accelerations and multipliers (D9), `a = v̇`.
+fn restart_after_impact(
+    model: &Model,
+    solver: &mut NewtonSolver,
+    run: &mut Run,
+    end_time: f64,
+) -> Result<(), NewtonFailure> {
+    project_positions(model, solver, run)?;
+    initial_accelerations(model, solver, run, end_time)
+}
+
 /// The failure of a singular or nearly singular iteration matrix: the
 /// unknown without stiffness or mass.
 fn singular(
@@ -1318,8 +1392,18 @@ impl Dynamics<'_> {
         // a_n − v̇_n is O(h) (a is the acceleration at t_n + (α_m − α_f)h
         // to first order): scaled with the step when its size changes
         let ratio = run.last_step.map_or(1.0, |hp| h / hp);
+        // with constraints below PROJECTION_RHO, the normal part v_N of
+        // v_n with (v_N, h(a_n − v̇_n)) mapped by the similarity s = r² for
+        // r ≤ 1 and s = r for r > 1 (D15)
+        let (w, ratio_a, normal, normal_coordinates) = match &run.normal_velocity {
+            Some((v, c)) => {
+                let sim = if ratio <= 1.0 { ratio * ratio } else { ratio };
+                (sim - 1.0, sim / ratio, v.as_slice(), c.as_slice())
+            }
+            None => (0.0, ratio, &[][..], &[][..]),
+        };
         let predict = |vn: f64, vdn: f64, an: f64| -> (f64, f64, f64, f64) {
-            let an = vdn + (an - vdn) * ratio;
+            let an = vdn + (an - vdn) * ratio_a;
             let a = (sc.alpha_f * vdn - sc.alpha_m * an) / (1.0 - sc.alpha_m);
             let v = vn + h * (1.0 - sc.gamma) * an + h * sc.gamma * a;
             let dq = vn + h * (0.5 - sc.beta) * an + h * sc.beta * a;
@@ -1332,7 +1416,7 @@ impl Dynamics<'_> {
                     continue;
                 }
                 let (an, a, v, dq) = predict(
-                    n.velocity[node][c],
+                    n.velocity[node][c] + normal.get(node).map_or(0.0, |u| w * u[c]),
                     n.acceleration[node][c],
                     n.pseudo_acceleration[node][c],
                 );
@@ -1350,7 +1434,7 @@ impl Dynamics<'_> {
                 continue;
             }
             let (an, a, v, dq) = predict(
-                n.coordinate_rates[k],
+                n.coordinate_rates[k] + normal_coordinates.get(k).map_or(0.0, |u| w * u),
                 n.coordinate_accelerations[k],
                 n.coordinate_pseudo_accelerations[k],
             );
@@ -1502,6 +1586,65 @@ impl Dynamics<'_> {
             ..model.context(state.time, Need::RESIDUAL)
         };
         assembler.assemble(model, &ctx, state);
+        Ok(())
+    }
+
+    /// D15: before a step of size `h` different from the last, `h_{n−1}`,
+    /// the normal part of the accepted velocities (`v_N = −δv` of D13,
+    /// the `M`-orthogonal projection of `v_n` on the normals of the velocity
+    /// constraints) is found once per accepted step; [`Self::predict`] then
+    /// starts from `v_n + (s − 1) v_N` and `v̇_n + (s/r)(a_n − v̇_n)`,
+    /// `r = h/h_{n−1}`, `s = r²` for `r ≤ 1` and `r` for `r > 1`. Below
+    /// [`PROJECTION_RHO`] the velocities of the index-3 scheme leave the
+    /// velocity constraints by `B v_n = O(h²)` (docs/theory.md §15.8): the
+    /// step of size `h` carries `r²` times the violation of the last, and
+    /// without the rescaling the difference, `(1 − r²) v_N`, goes into
+    /// `a_{n+1}` through the position constraints (D2) divided by `βh`:
+    /// after a step shortened to land on an output time, the alternating
+    /// transient of `v̇` and of the multipliers. A longer step takes
+    /// `s = r` rather than `r²`, which would amplify a transient already
+    /// there as the steps grow. Nothing is done with
+    /// projected velocities (`v_N = 0`), without constraints, or with
+    /// velocity constraints (rolling: their rows hold the velocities).
+    fn rescale_normal_velocity(&mut self, h: f64) -> Result<(), NewtonFailure> {
+        let (model, run) = (self.model, &mut *self.run);
+        let changed = run.last_step.is_some_and(|hp| h != hp);
+        let dofs = &self.solver.dofs;
+        if !changed
+            || run.normal_velocity.is_some()
+            || self.scheme.projects_velocities()
+            || dofs.first_multiplier() == dofs.n_dofs()
+            || has_velocity_constraints(model)
+        {
+            return Ok(());
+        }
+        let state = &run.accepted;
+        let rate = constraint_rate(model, self.solver, state, run.span);
+        let (_, s_eq) =
+            constrained_mass_system(model, self.solver, state, &mut run.mass_system, None)?;
+        let dofs = &self.solver.dofs;
+        let mut rhs: Vec<f64> = (0..dofs.n_equations())
+            .map(|eq| {
+                if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
+                    -rate[dofs.dof(eq)] * s_eq[eq]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        solve_mass_system(model, self.solver, state, &mut rhs)?;
+        let dofs = &self.solver.dofs;
+        let mut nodes = vec![[0.0; 6]; state.n_nodes()];
+        let mut coordinates = vec![0.0; state.coordinates.len()];
+        for (eq, z) in rhs.iter().enumerate() {
+            let d = dofs.dof(eq);
+            if let Some((node, c)) = dofs.node_component(d) {
+                nodes[node][c] = -z;
+            } else if d < dofs.first_multiplier() {
+                coordinates[d - dofs.first_coordinate()] = -z;
+            }
+        }
+        run.normal_velocity = Some((nodes, coordinates));
         Ok(())
     }
 
@@ -1686,6 +1829,7 @@ impl Dynamics<'_> {
     ) -> Result<(usize, Vec<f64>), NewtonFailure> {
         let model = self.model;
         let sc = self.scheme;
+        self.rescale_normal_velocity(h)?;
         self.predict(h);
         let scale = Scale::new(&model.scaling, sc.beta_prime(h), self.run.mass_scale);
         let t = self.run.state.time;
@@ -1967,6 +2111,7 @@ impl Stepper for Dynamics<'_> {
         // the controller may snap t onto a landing time within round-off
         run.state.time = info.time;
         run.last_step = Some(info.step);
+        run.normal_velocity = None;
         run.a_before.clone_from(&run.accepted.pseudo_acceleration);
         run.a_before_coordinates
             .clone_from(&run.accepted.coordinate_pseudo_accelerations);
@@ -1983,7 +2128,7 @@ impl Stepper for Dynamics<'_> {
             Some(i) => {
                 run.lock_rank_analyses += 1;
                 run.redundant = run.redundant.max(i.redundant);
-                initial_accelerations(model, self.solver, run, self.settings.end_time).map_err(
+                restart_after_impact(model, self.solver, run, self.settings.end_time).map_err(
                     |failure| DynamicError::Initial {
                         time: info.time,
                         failure,
@@ -2037,7 +2182,7 @@ impl Dynamics<'_> {
         run.lock_rank_analyses += 1;
         run.redundant = run.redundant.max(i.redundant);
         let restart = |solver: &mut NewtonSolver, run: &mut Run| {
-            initial_accelerations(model, solver, run, end_time).map_err(|failure| {
+            restart_after_impact(model, solver, run, end_time).map_err(|failure| {
                 DynamicError::Initial {
                     time: info.time,
                     failure,

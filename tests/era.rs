@@ -175,3 +175,50 @@ fn platform_layout_is_the_hexagon_of_24_cells() {
         }
     }
 }
+
+/// The platform reduced (examples/era.md, "The platform"): four cells in
+/// a triangle, three around a central one, sharing its faces; folded, a
+/// mechanism of one degree of freedom, like the cell. Deployed without
+/// gravity to 1.3 s (its last lock comes near 1.15 s), every one of its
+/// 18 mid-hinges locks and the locked structure takes the nominal
+/// deployed geometry within 1e-3 of the cell size.
+#[test]
+fn reduced_platform_deploys_and_every_mid_hinge_locks_into_the_nominal_geometry() {
+    let geometry = Geometry::new(&Design::default(), Structure::REDUCED);
+    assert_eq!(geometry.layout.cells.len(), 4);
+    assert_eq!(geometry.layout.faces.len(), 9);
+    let folded = checks::rank(&geometry, geometry.design.folded_scale, Hinges::Free).unwrap();
+    assert_eq!(folded.free_motions, 1, "{folded:?}");
+    let locked = checks::rank(&geometry, 1.0, Hinges::Locked).unwrap();
+    assert_eq!(locked.free_motions, 0, "{locked:?}");
+
+    let case = deploy::Case {
+        end_time: 1.3,
+        ..era::case(Structure::REDUCED, 0.0)
+    };
+    let built = deploy::model(&geometry, &case);
+    let nominal = deploy::nominal(&geometry).unwrap();
+    let run = deploy::run(&built, &nominal, None, 0.1, false).unwrap();
+    assert!(run.outcome.error.is_none(), "{:?}", run.outcome.error);
+    let f = &run.figures;
+    assert_eq!(f.locks.len(), 18);
+    assert!(f.locks.iter().all(Option::is_some), "{:?}", f.locks);
+    // locked at the locking angle, within the event tolerance of the
+    // latches (1e-8 rad, docs/joints.md §6.2)
+    for lock in &run.outcome.locks {
+        let hinge = built
+            .parts
+            .hinges()
+            .find(|h| h.latch.map(|l| l.id()) == Some(lock.latch))
+            .unwrap();
+        assert!((lock.coordinate - hinge.locking_angle()).abs() <= 1e-8);
+    }
+    for h in &run.records.last().unwrap().hinges {
+        assert!(h.locked && (h.opening - PI).abs() < 1e-5, "{h:?}");
+    }
+    assert!(
+        f.locked_geometry_error < 1e-3 * geometry.design.side,
+        "{} m",
+        f.locked_geometry_error
+    );
+}

@@ -56,11 +56,23 @@ pub enum Structure {
         /// Cell widths per side of the hexagon.
         rings: i32,
     },
+    /// A triangle of triangular cells whose side is `rings` cell widths:
+    /// `rings²` cells (4 for `rings = 2`: three cells around a central
+    /// one, each sharing a face with it).
+    Triangle {
+        /// Cell widths per side of the triangle.
+        rings: i32,
+    },
 }
 
 impl Structure {
     /// The ERA platform: 24 cells in a hexagon of side two cell widths.
     pub const PLATFORM: Self = Self::Hexagon { rings: 2 };
+
+    /// The platform reduced: 4 cells in a triangle of side two cell
+    /// widths, three around a central one (the same faces shared, every
+    /// longeron but the corners' carrying three or four faces).
+    pub const REDUCED: Self = Self::Triangle { rings: 2 };
 
     /// A name for files and titles.
     pub fn name(self) -> String {
@@ -68,6 +80,7 @@ impl Structure {
             Self::Cell => "cell".into(),
             Self::PLATFORM => "platform".into(),
             Self::Hexagon { rings } => format!("hexagon{rings}"),
+            Self::Triangle { rings } => format!("triangle{rings}"),
         }
     }
 }
@@ -78,6 +91,7 @@ impl Layout {
         match structure {
             Structure::Cell => Self::cell(side),
             Structure::Hexagon { rings } => Self::hexagon(side, rings),
+            Structure::Triangle { rings } => Self::triangle(side, rings),
         }
     }
 
@@ -125,6 +139,48 @@ impl Layout {
         // by rings about the centre, so that the central longeron comes
         // first (the one clamped)
         lattice.sort_by_key(|&(i, j)| i.abs().max(j.abs()).max((i + j).abs()));
+        Self::lattice(side, &lattice)
+    }
+
+    /// The triangle of side `rings` cell widths on the triangular lattice
+    /// of spacing `side`: longerons at `side (i + j/2, j √3/2)` with
+    /// `i, j ≥ 0`, `i + j ≤ rings`, centred on the origin; the longeron
+    /// nearest the centre first (the one clamped). Faces fold as in
+    /// [`Layout::hexagon`].
+    pub fn triangle(side: f64, rings: i32) -> Self {
+        let n = rings;
+        let mut lattice = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n - j {
+                lattice.push((i, j));
+            }
+        }
+        // distance from the centroid (n/3, n/3), in units of side²/3
+        let distance = |&(i, j): &(i32, i32)| {
+            let (x, y) = (3 * i - n, 3 * j - n);
+            x * x + x * y + y * y
+        };
+        lattice.sort_by_key(distance);
+        let mut layout = Self::lattice(side, &lattice);
+        let centre = layout.columns.iter().fold([0.0, 0.0], |c, p| {
+            let k = lattice.len() as f64;
+            [c[0] + p[0] / k, c[1] + p[1] / k]
+        });
+        for p in &mut layout.columns {
+            *p = [p[0] - centre[0], p[1] - centre[1]];
+        }
+        layout
+    }
+
+    /// The cells and faces of the longerons at the lattice points
+    /// `lattice` (`(i, j)` at `side (i + j/2, j √3/2)`): every triangle
+    /// of neighbouring points is a cell.
+    fn lattice(side: f64, lattice: &[(i32, i32)]) -> Self {
+        let n = lattice
+            .iter()
+            .map(|&(i, j)| i.abs().max(j.abs()))
+            .max()
+            .unwrap_or(0);
         let index = |i: i32, j: i32| lattice.iter().position(|&p| p == (i, j));
         let columns = lattice
             .iter()

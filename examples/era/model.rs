@@ -189,7 +189,11 @@ fn hinge(
     point: Vec3,
     axis: Vec3,
 ) -> JointHandle {
-    m.add(Joint::revolute(a, b).at(point).axis([axis.x, axis.y, axis.z]))
+    m.add(
+        Joint::revolute(a, b)
+            .at(point)
+            .axis([axis.x, axis.y, axis.z]),
+    )
 }
 
 /// A rigid body of `fitting` on `node` (flexible members only: the rigid
@@ -278,8 +282,20 @@ pub fn build(geometry: &Geometry, options: &Options, title: &str) -> Built {
         });
         let bodies = [a.bottom, b.bottom];
         for k in 0..2 {
-            hinge(&mut m, diagonals[k].start(), bodies[k], p.diagonal[k], VERTICAL);
-            hinge(&mut m, diagonals[k].end(), top.halves[0].end(), p.top_mid, VERTICAL);
+            hinge(
+                &mut m,
+                diagonals[k].start(),
+                bodies[k],
+                p.diagonal[k],
+                VERTICAL,
+            );
+            hinge(
+                &mut m,
+                diagonals[k].end(),
+                top.halves[0].end(),
+                p.top_mid,
+                VERTICAL,
+            );
         }
         faces.push(FaceParts {
             columns: face.columns,

@@ -14,8 +14,8 @@
 //!    files (`era_<structure>_deployed.toml`,
 //!    `era_<structure>_deployment_<g>g.toml`);
 //! 2. checks the design: the rank of the constraints of the rigid-link
-//!    model (no motion left when the mid-hinges are locked, three per
-//!    longeron less three when they are free), the zero modes of the
+//!    model (no motion left when the mid-hinges are locked, one, the
+//!    deployment, when they are free), the zero modes of the
 //!    stiffness of the deployed structure, clamped; and counts the
 //!    unknowns and the mean bandwidth;
 //! 3. runs the deployment in dynamics twice, without gravity and with

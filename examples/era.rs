@@ -1,10 +1,11 @@
-//! The ERA deployable platform flown on MIR (Cardona, §6.2): one cell, or
-//! the hexagon of 24 cells, built with the `unfold` model builders,
+//! The ERA deployable platform flown on MIR (Cardona, §6.2): one cell, the
+//! triangle of 4 cells (the platform reduced) or the hexagon of 24 cells,
+//! built with the `unfold` model builders,
 //! checked as a mechanism and as a structure, and deployed in dynamics by
 //! the tape springs of its mid-hinges until every latch has locked.
 //!
 //! ```text
-//! cargo run --release --example era -- [cell|platform] [output directory]
+//! cargo run --release --example era -- [cell|triangle|platform] [output directory] [gravities, g: 0,0.01]
 //! ```
 //!
 //! The program
@@ -13,8 +14,8 @@
 //!    files (`era_<structure>_deployed.toml`,
 //!    `era_<structure>_deployment_<g>g.toml`);
 //! 2. checks the design: the rank of the constraints of the rigid-link
-//!    model (no motion left when the mid-hinges are locked, three per
-//!    longeron less three when they are free), the zero modes of the
+//!    model (no motion left when the mid-hinges are locked, one, the
+//!    deployment, when they are free), the zero modes of the
 //!    stiffness of the deployed structure, clamped; and counts the
 //!    unknowns and the mean bandwidth;
 //! 3. runs the deployment in dynamics twice, without gravity and with
@@ -384,14 +385,30 @@ fn main() -> Result<(), Box<dyn Error>> {
     let structure = match args.first().map(String::as_str) {
         None | Some("cell") => Structure::Cell,
         Some("platform") => Structure::PLATFORM,
+        Some("triangle") => Structure::REDUCED,
         Some(other) => {
-            eprintln!("unknown structure {other:?}: cell or platform");
+            eprintln!("unknown structure {other:?}: cell, triangle or platform");
             std::process::exit(2);
         }
     };
     let default_out = format!("results/era_{}", structure.name());
     let out = PathBuf::from(args.get(1).map_or(default_out.as_str(), String::as_str));
-    let report = run(structure, &GRAVITIES, &out, true)?;
+    // the gravities (g) to deploy under: both of the paper's by default
+    let gravities = match args.get(2) {
+        None => GRAVITIES.to_vec(),
+        Some(list) => match list
+            .split(',')
+            .map(str::parse::<f64>)
+            .collect::<Result<Vec<_>, _>>()
+        {
+            Ok(g) => g,
+            Err(e) => {
+                eprintln!("gravities {list:?}: {e} (a list such as 0,0.01)");
+                std::process::exit(2);
+            }
+        },
+    };
+    let report = run(structure, &gravities, &out, true)?;
     if report.deployments.iter().any(|d| !d.completed) {
         std::process::exit(1);
     }

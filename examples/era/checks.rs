@@ -2,9 +2,8 @@
 //!
 //! - [`rank`]: the rank of the constraints of the rigid-link model
 //!   (docs/joints.md §5): the motions the joints leave free with the
-//!   mid-hinges locked (none: a structure) or free (three per longeron
-//!   less the three of the clamped one, the planar count of
-//!   `examples/era.md`);
+//!   mid-hinges locked (none: a structure) or free (one: the deployment,
+//!   the count of `examples/era.md`);
 //! - [`zero_modes`]: the zero eigenvalues of the stiffness of the
 //!   flexible model on its constraints (`K x + Bᵀμ = λ W x`, `B x = 0`,
 //!   `W` a unit metric): the mechanisms of the model with its beams;

@@ -180,7 +180,7 @@ pub struct Figures {
     pub geometry_error: f64,
     /// The same for the equilibrium of the locked structure reached from
     /// the end of the motion (a static analysis, at rest) (m): its locked
-    /// configuration.
+    /// configuration (NaN when the motion stopped early).
     pub locked_geometry_error: f64,
     /// Newton iterations of that equilibrium.
     pub equilibrium_iterations: usize,
@@ -423,16 +423,22 @@ pub fn run(
     {
         *v = 0.0;
     }
-    let statics = unfold::model::builder::Analysis::statics()
-        .end_time(rest.time + 1.0)
-        .initial_increment(1.0)
-        .settings()?;
-    let equilibrium = unfold::analysis::StaticAnalysis::new(model.clone(), statics)
-        .run(rest, &mut unfold::analysis::NoObserver);
-    if let Some(e) = &equilibrium.error {
-        return Err(format!("the equilibrium of the locked structure: {e}").into());
-    }
-    let locked_geometry_error = error(&equilibrium.state);
+    // (only when the motion reached its end: a structure stopped halfway
+    // is still a mechanism)
+    let (locked_geometry_error, equilibrium_iterations) = if outcome.error.is_none() {
+        let statics = unfold::model::builder::Analysis::statics()
+            .end_time(rest.time + 1.0)
+            .initial_increment(1.0)
+            .settings()?;
+        let equilibrium = unfold::analysis::StaticAnalysis::new(model.clone(), statics)
+            .run(rest, &mut unfold::analysis::NoObserver);
+        if let Some(e) = &equilibrium.error {
+            return Err(format!("the equilibrium of the locked structure: {e}").into());
+        }
+        (error(&equilibrium.state), equilibrium.iterations)
+    } else {
+        (f64::NAN, 0)
+    };
     let peak_latch_moment = records
         .iter()
         .flat_map(|r| r.hinges.iter().map(|h| h.latch.abs()))
@@ -447,7 +453,7 @@ pub fn run(
         locks,
         geometry_error,
         locked_geometry_error,
-        equilibrium_iterations: equilibrium.iterations,
+        equilibrium_iterations,
         impact_loss: outcome.locks.iter().map(|l| l.energy_lost).sum(),
         balance_error: outcome.energies.balance_error - last.spring_work,
         peak_latch_moment,

@@ -153,10 +153,6 @@ pub struct Design {
     pub height: f64,
     /// Distance of the hinge points (clevises) from the longeron axis (m).
     pub clevis_radius: f64,
-    /// Clocking of the clevises (rad): the clevis of a top horizontal sits
-    /// at this angle counter-clockwise from the direction of the face, that
-    /// of a bottom horizontal at this angle clockwise.
-    pub clocking: f64,
     /// Height of the diagonals' clevises above the bottom corner body's
     /// centre (m).
     pub diagonal_clevis_height: f64,
@@ -195,7 +191,6 @@ impl Default for Design {
             side: 1.0,
             height: 1.0,
             clevis_radius: 0.06,
-            clocking: 15.0f64.to_radians(),
             diagonal_clevis_height: 0.04,
             folded_scale: 0.2,
             longeron: Tube::carbon(0.025, 0.0015),

@@ -2,13 +2,14 @@
 //! (one cell, or the hexagon of 24 cells), and every hinge point in a
 //! configuration between folded and deployed.
 //!
-//! The mechanism moves in planar motion (every hinge axis is vertical,
-//! `examples/era.md`): the longerons stay vertical at their heights and
-//! move in plan. The configurations used here are the deployed layout
-//! scaled towards the centre by `s` (`s = 1` deployed), every longeron
-//! keeping its orientation. In such a configuration every face is in the
-//! same state, so that one opening angle of the mid-hinges corresponds to
-//! one scale ([`Geometry::scale_at`]).
+//! The mechanism has one degree of freedom (`examples/era.md`): in each
+//! face the hinges of the top horizontal are vertical and those of the
+//! bottom one normal to the face, so that the two longerons of a face
+//! can only move apart along the face, without turning. Its
+//! configurations are the deployed layout scaled towards the centre by
+//! `s` (`s = 1` deployed), every longeron keeping its orientation; every
+//! face is then in the same state, so that one opening angle of the
+//! mid-hinges corresponds to one scale ([`Geometry::scale_at`]).
 //!
 //! Frames: `z` is the longeron direction (up); the bottom corner bodies'
 //! centres are at `z = 0`, the top ones' at `z = h`.
@@ -55,11 +56,23 @@ pub enum Structure {
         /// Cell widths per side of the hexagon.
         rings: i32,
     },
+    /// A triangle of triangular cells whose side is `rings` cell widths:
+    /// `rings²` cells (4 for `rings = 2`: three cells around a central
+    /// one, each sharing a face with it).
+    Triangle {
+        /// Cell widths per side of the triangle.
+        rings: i32,
+    },
 }
 
 impl Structure {
     /// The ERA platform: 24 cells in a hexagon of side two cell widths.
     pub const PLATFORM: Self = Self::Hexagon { rings: 2 };
+
+    /// The platform reduced: 4 cells in a triangle of side two cell
+    /// widths, three around a central one (the same faces shared, every
+    /// longeron but the corners' carrying three or four faces).
+    pub const REDUCED: Self = Self::Triangle { rings: 2 };
 
     /// A name for files and titles.
     pub fn name(self) -> String {
@@ -67,6 +80,7 @@ impl Structure {
             Self::Cell => "cell".into(),
             Self::PLATFORM => "platform".into(),
             Self::Hexagon { rings } => format!("hexagon{rings}"),
+            Self::Triangle { rings } => format!("triangle{rings}"),
         }
     }
 }
@@ -77,6 +91,7 @@ impl Layout {
         match structure {
             Structure::Cell => Self::cell(side),
             Structure::Hexagon { rings } => Self::hexagon(side, rings),
+            Structure::Triangle { rings } => Self::triangle(side, rings),
         }
     }
 
@@ -124,6 +139,48 @@ impl Layout {
         // by rings about the centre, so that the central longeron comes
         // first (the one clamped)
         lattice.sort_by_key(|&(i, j)| i.abs().max(j.abs()).max((i + j).abs()));
+        Self::lattice(side, &lattice)
+    }
+
+    /// The triangle of side `rings` cell widths on the triangular lattice
+    /// of spacing `side`: longerons at `side (i + j/2, j √3/2)` with
+    /// `i, j ≥ 0`, `i + j ≤ rings`, centred on the origin; the longeron
+    /// nearest the centre first (the one clamped). Faces fold as in
+    /// [`Layout::hexagon`].
+    pub fn triangle(side: f64, rings: i32) -> Self {
+        let n = rings;
+        let mut lattice = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n - j {
+                lattice.push((i, j));
+            }
+        }
+        // distance from the centroid (n/3, n/3), in units of side²/3
+        let distance = |&(i, j): &(i32, i32)| {
+            let (x, y) = (3 * i - n, 3 * j - n);
+            x * x + x * y + y * y
+        };
+        lattice.sort_by_key(distance);
+        let mut layout = Self::lattice(side, &lattice);
+        let centre = layout.columns.iter().fold([0.0, 0.0], |c, p| {
+            let k = lattice.len() as f64;
+            [c[0] + p[0] / k, c[1] + p[1] / k]
+        });
+        for p in &mut layout.columns {
+            *p = [p[0] - centre[0], p[1] - centre[1]];
+        }
+        layout
+    }
+
+    /// The cells and faces of the longerons at the lattice points
+    /// `lattice` (`(i, j)` at `side (i + j/2, j √3/2)`): every triangle
+    /// of neighbouring points is a cell.
+    fn lattice(side: f64, lattice: &[(i32, i32)]) -> Self {
+        let n = lattice
+            .iter()
+            .map(|&(i, j)| i.abs().max(j.abs()))
+            .max()
+            .unwrap_or(0);
         let index = |i: i32, j: i32| lattice.iter().position(|&p| p == (i, j));
         let columns = lattice
             .iter()
@@ -275,19 +332,30 @@ impl Geometry {
         g
     }
 
+    /// Unit normal of face `f` in plan, to the left of `a → b` seen from
+    /// above (horizontal; the same in every configuration, since the
+    /// configurations scale the layout).
+    pub fn face_normal(&self, f: usize) -> Vec3 {
+        let [a, b] = self.layout.faces[f].columns;
+        let (pa, pb) = (self.layout.columns[a], self.layout.columns[b]);
+        let t = Vec3::new(pb[0] - pa[0], pb[1] - pa[1], 0.0).normalize();
+        Vec3::new(-t.y, t.x, 0.0)
+    }
+
     /// The two clevis points of `kind` on face `f` (at longerons `a` and
-    /// `b`) with the longerons at `columns`. The clevises are fixed on the
-    /// corner bodies, whose orientation never changes: their directions
-    /// are those of the deployed layout.
+    /// `b`) with the longerons at `columns`: at the clevis radius from
+    /// each longeron's axis towards the other longeron (the corner bodies
+    /// never turn, so that these directions are those of the deployed
+    /// layout).
     fn clevises(&self, columns: &[[f64; 2]], f: usize, kind: Clevis) -> [Vec3; 2] {
         let d = &self.design;
         let [a, b] = self.layout.faces[f].columns;
         let (pa, pb) = (self.layout.columns[a], self.layout.columns[b]);
         let theta = (pb[1] - pa[1]).atan2(pb[0] - pa[0]);
-        let (clock, z) = match kind {
-            Clevis::Top => (d.clocking, d.height),
-            Clevis::Bottom => (-d.clocking, 0.0),
-            Clevis::Diagonal => (d.clocking, d.diagonal_clevis_height),
+        let z = match kind {
+            Clevis::Top => d.height,
+            Clevis::Bottom => 0.0,
+            Clevis::Diagonal => d.diagonal_clevis_height,
         };
         let at = |column: [f64; 2], angle: f64| {
             let e = direction(angle);
@@ -299,22 +367,25 @@ impl Geometry {
                 z,
             )
         };
-        [
-            at(columns[a], theta + clock),
-            at(columns[b], theta + PI + clock),
-        ]
+        [at(columns[a], theta), at(columns[b], theta + PI)]
     }
 
     /// The mid-hinge of a horizontal between the corner hinges `p` and
-    /// `q`: at a half length from both, on the side `fold` of `p → q`.
-    fn mid_hinge(&self, p: Vec3, q: Vec3, fold: f64) -> Vec3 {
+    /// `q`, at a half length from both: for the top horizontal in the
+    /// horizontal plane on the side `fold` of `p → q` (seen from above),
+    /// for the bottom one in the face plane, above the chord.
+    fn mid_hinge(&self, p: Vec3, q: Vec3, fold: f64, top: bool) -> Vec3 {
         let chord = q - p;
         let w = chord.norm();
-        let left = Vec3::new(-chord.y, chord.x, 0.0) / w;
         let rise = (self.half_length * self.half_length - 0.25 * w * w)
             .max(0.0)
             .sqrt();
-        0.5 * (p + q) + fold * rise * left
+        let out = if top {
+            fold * Vec3::new(-chord.y, chord.x, 0.0) / w
+        } else {
+            Vec3::new(0.0, 0.0, 1.0)
+        };
+        0.5 * (p + q) + rise * out
     }
 
     /// The configuration at scale `s`.
@@ -332,9 +403,9 @@ impl Geometry {
                 let bottom = self.clevises(&columns, f, Clevis::Bottom);
                 FacePoints {
                     top,
-                    top_mid: self.mid_hinge(top[0], top[1], fold),
+                    top_mid: self.mid_hinge(top[0], top[1], fold, true),
                     bottom,
-                    bottom_mid: self.mid_hinge(bottom[0], bottom[1], fold),
+                    bottom_mid: self.mid_hinge(bottom[0], bottom[1], fold, false),
                     diagonal: self.clevises(&columns, f, Clevis::Diagonal),
                 }
             })
@@ -366,25 +437,34 @@ impl Geometry {
 
     /// The scale at which the mid-hinges are open by `gamma`: the chord
     /// `w = 2 l sin(γ/2)` of a face whose longerons are `s a` apart is
-    /// `w² = (s a − 2 r cos α)² + (2 r sin α)²` (the clevises at radius
-    /// `r`, clocked by `α`), so `s a = 2 r cos α + √(w² − (2 r sin α)²)`.
+    /// `w = s a − 2 r` (the clevises at radius `r` on the face line).
     pub fn scale_at(&self, gamma: f64) -> f64 {
         let d = &self.design;
         let w = 2.0 * self.half_length * (0.5 * gamma).sin();
-        let (r, alpha) = (d.clevis_radius, d.clocking);
-        let lateral = 2.0 * r * alpha.sin();
-        (2.0 * r * alpha.cos() + (w * w - lateral * lateral).max(0.0).sqrt()) / d.side
+        (w + 2.0 * d.clevis_radius) / d.side
     }
 
-    /// The signed angle from `u` to `w` about `+z` (rad).
-    fn signed_angle(u: Vec3, w: Vec3) -> f64 {
-        u.cross(&w).z.atan2(u.dot(&w))
+    /// The signed angle from `u` to `w` about the unit vector `axis`
+    /// (rad).
+    fn signed_angle(u: Vec3, w: Vec3, axis: Vec3) -> f64 {
+        u.cross(&w).dot(&axis).atan2(u.dot(&w))
     }
 
-    /// The sense of the vertical axis about which the second half of the
-    /// horizontal between `p` and `q` turns, relative to the first, when
-    /// the mid-hinge opens: `+1` or `−1`. Measured in the folded
-    /// configuration (in the deployed one the halves are aligned).
+    /// The axis of the hinges of the top horizontal of face `f` (the
+    /// vertical: its halves fold in plan) or of the bottom one (the face
+    /// normal: its halves fold in the face plane).
+    pub fn hinge_axis(&self, f: usize, top: bool) -> Vec3 {
+        if top {
+            Vec3::new(0.0, 0.0, 1.0)
+        } else {
+            self.face_normal(f)
+        }
+    }
+
+    /// The sense of [`Geometry::hinge_axis`] about which the second half
+    /// of a horizontal turns, relative to the first, when its mid-hinge
+    /// opens: `+1` or `−1`. Measured in the folded configuration (in the
+    /// deployed one the halves are aligned).
     pub fn opening_sense(&self, f: usize, top: bool) -> f64 {
         let c = self.folded();
         let face = &c.faces[f];
@@ -393,7 +473,7 @@ impl Geometry {
         } else {
             (face.bottom[0], face.bottom[1], face.bottom_mid)
         };
-        Self::signed_angle(p - m, q - m).signum()
+        Self::signed_angle(p - m, q - m, self.hinge_axis(f, top)).signum()
     }
 
     /// Length of a diagonal: from its bottom hinge to the top mid-hinge
@@ -401,13 +481,6 @@ impl Geometry {
     pub fn diagonal_length(&self) -> f64 {
         let c = self.deployed();
         (c.faces[0].top_mid - c.faces[0].diagonal[0]).norm()
-    }
-
-    /// Horizontal offset of a horizontal's line from the longeron axes at
-    /// its ends, `r sin α` (m): the lever arm by which the horizontals
-    /// stop a longeron from spinning about its axis.
-    pub fn clevis_offset(&self) -> f64 {
-        self.design.clevis_radius * self.design.clocking.sin()
     }
 }
 

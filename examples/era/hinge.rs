@@ -6,7 +6,8 @@
 //!
 //! Angles. A mid-hinge is a revolute joint from the first half of its
 //! horizontal (body A, which carries the fitting) to the second (body B),
-//! about the vertical oriented so that opening is a positive rotation
+//! about its axis (vertical at the top, normal to the face at the bottom)
+//! oriented so that opening is a positive rotation
 //! ([`super::geometry::Geometry::opening_sense`]). Its coordinate is
 //! `θ = γ − γ_ref`, `γ` the opening angle (between the halves, `π`
 //! deployed) and `γ_ref` its value in the configuration the model is

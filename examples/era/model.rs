@@ -6,9 +6,13 @@
 //! Per face (`examples/era.md`): the top and the bottom horizontal, each
 //! of two halves hinged to the corner bodies and to each other at the
 //! mid-hinge, and two diagonals from the bottom corner bodies up to the
-//! top mid-hinge, hinged at both ends: ten revolute joints, every axis
-//! vertical. The first half of a horizontal carries the mid-hinge
-//! fitting; the second half and both diagonals are hinged to it.
+//! top mid-hinge, hinged at both ends: ten revolute joints. The hinges of
+//! the top horizontal and of the diagonals are vertical (the top halves
+//! fold in plan, each with its diagonal, about the vertical through its
+//! corner hinge); those of the bottom horizontal are normal to the face
+//! (its halves fold in the face plane, the mid-hinge rising). The first
+//! half of a horizontal carries the mid-hinge fitting; the second half
+//! and both diagonals are hinged to it.
 //!
 //! Each longeron with its two corner bodies is one part: the corner
 //! bodies are rigid bodies on the longeron's end nodes (shared nodes: a
@@ -150,7 +154,7 @@ struct Sections {
     diagonal: SectionHandle,
 }
 
-const VERTICAL: [f64; 3] = [0.0, 0.0, 1.0];
+const VERTICAL: Vec3 = Vec3::new(0.0, 0.0, 1.0);
 
 /// A member from `a` to `b`.
 fn member(
@@ -177,9 +181,19 @@ fn member(
     }
 }
 
-/// A vertical hinge between `a` and `b` at `point`.
-fn hinge(m: &mut ModelBuilder, a: NodeHandle, b: NodeHandle, point: Vec3) -> JointHandle {
-    m.add(Joint::revolute(a, b).at(point).axis(VERTICAL))
+/// A hinge between `a` and `b` at `point` about `axis`.
+fn hinge(
+    m: &mut ModelBuilder,
+    a: NodeHandle,
+    b: NodeHandle,
+    point: Vec3,
+    axis: Vec3,
+) -> JointHandle {
+    m.add(
+        Joint::revolute(a, b)
+            .at(point)
+            .axis([axis.x, axis.y, axis.z]),
+    )
 }
 
 /// A rigid body of `fitting` on `node` (flexible members only: the rigid
@@ -248,18 +262,15 @@ pub fn build(geometry: &Geometry, options: &Options, title: &str) -> Built {
             };
             let n = d.mesh.half_horizontal;
             let halves = [0, 1].map(|k| member(m, kind, ends[k], mid, n, sections.horizontal));
+            let axis = geometry.hinge_axis(f, top);
             for k in 0..2 {
-                hinge(m, halves[k].start(), bodies[k], ends[k]);
+                hinge(m, halves[k].start(), bodies[k], ends[k], axis);
             }
             fitting(m, kind, halves[0].end(), d.mid_hinge_fitting(top));
-            // the mid-hinge, about the vertical oriented so that opening
-            // is positive
+            // the mid-hinge, about the axis oriented so that opening is
+            // positive
             let sense = geometry.opening_sense(f, top);
-            let joint = m.add(
-                Joint::revolute(halves[0].end(), halves[1].end())
-                    .at(mid)
-                    .axis([0.0, 0.0, sense]),
-            );
+            let joint = hinge(m, halves[0].end(), halves[1].end(), mid, sense * axis);
             let hinge = hinge::add(m, &d.hinge, joint, c.opening, options.hinges);
             Horizontal { halves, hinge }
         };
@@ -271,8 +282,20 @@ pub fn build(geometry: &Geometry, options: &Options, title: &str) -> Built {
         });
         let bodies = [a.bottom, b.bottom];
         for k in 0..2 {
-            hinge(&mut m, diagonals[k].start(), bodies[k], p.diagonal[k]);
-            hinge(&mut m, diagonals[k].end(), top.halves[0].end(), p.top_mid);
+            hinge(
+                &mut m,
+                diagonals[k].start(),
+                bodies[k],
+                p.diagonal[k],
+                VERTICAL,
+            );
+            hinge(
+                &mut m,
+                diagonals[k].end(),
+                top.halves[0].end(),
+                p.top_mid,
+                VERTICAL,
+            );
         }
         faces.push(FaceParts {
             columns: face.columns,

@@ -762,20 +762,16 @@ fn remove_leftovers(dir: &Path, writes: impl Fn(&str) -> bool) -> io::Result<()>
     Ok(())
 }
 
-/// Records in `dir` a run of `model` (read from `model_file`, analyses
-/// `plan`, the first of which is `first`) rejected before its first
-/// analysis started, by the checks of
-/// [`crate::analysis::preflight`]: `summary.json` alone, status `failed`
-/// with `message`. The directory is locked as for a run, and the files of
-/// an earlier run are removed (none would belong to this model), its
-/// restart files too but `keep` (the restart file given to this run, if
-/// any); no other file is written.
+/// Records in `dir` a run rejected before its first analysis started, by
+/// the checks of [`crate::analysis::preflight`]: `summary.json` alone
+/// (`summary`, the run's summary as it started, for example
+/// [`Summary::start`]), status `failed` with `message`. The directory is
+/// locked as for a run, and the files of an earlier run are removed (none
+/// would belong to this model), its restart files too but `keep` (the
+/// restart file given to this run, if any); no other file is written.
 pub fn write_rejected(
     dir: &Path,
-    model_file: &str,
-    model: &Model,
-    first: &StaticAnalysis,
-    plan: &[AnalysisSettings],
+    mut summary: Summary,
     message: &str,
     keep: Option<&Path>,
 ) -> io::Result<()> {
@@ -785,7 +781,6 @@ pub fn write_rejected(
     super::restart::remove_earlier(dir, keep)?;
     // an empty grid folder of an earlier run goes too
     let _ = std::fs::remove_dir(dir.join("vtk"));
-    let mut summary = Summary::start(model_file, model, first, plan);
     summary.status = RunStatus::Failed;
     summary.message = Some(message.to_string());
     let text = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;

@@ -255,6 +255,38 @@ pub fn format_time(t: f64) -> String {
     }
 }
 
+/// The message of a dynamic analysis that stopped with `error` at `state`,
+/// for a person: the error itself, except for initial velocities that move
+/// a latch locked at the start (at its value in the start state `state`,
+/// within the event tolerance), where the generic advice (one rigid
+/// motion) does not fit.
+pub fn dynamic_error_message(model: &Model, state: &State, error: &DynamicError) -> String {
+    let DynamicError::InconsistentVelocity {
+        constraint,
+        rate,
+        tolerance,
+    } = error
+    else {
+        return error.to_string();
+    };
+    let latch = model.elements.iter().find_map(|e| {
+        let l = e.as_latch()?;
+        (*constraint == format!("{} {} equation 1", e.kind().name(), e.id())).then_some((e.id(), l))
+    });
+    let Some((id, latch)) = latch else {
+        return error.to_string();
+    };
+    let c = latch.coordinate(state);
+    let unit = if latch.is_angle() { " rad" } else { "" };
+    format!(
+        "latch {id} is at its locking value at t = {} (joint {} at {}{unit}, the latch's value {}{unit}), so it is locked from the start, but the initial velocities move the joint: its rate is {rate:.3e} (tolerance {tolerance:.1e}); give the joint's nodes velocities that keep the coordinate still, or start the joint away from the latch's value",
+        format_time(state.time),
+        latch.joint(),
+        format_time(c),
+        format_time(latch.value())
+    )
+}
+
 /// The size of a model in one line: nodes and elements of each kind.
 pub fn describe(model: &Model) -> String {
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();

@@ -299,10 +299,13 @@ fn describe(model: &Model) -> String {
     unfold::io::run::describe(model)
 }
 
-/// Prints the model's warnings to stderr.
+/// Prints the model's warnings and notes to stderr.
 fn print_warnings(path: &Path, model: &Model) {
     for w in &model.warnings {
         eprintln!("warning: {}: {w}", path.display());
+    }
+    for n in &model.notes {
+        eprintln!("note: {}: {n}", path.display());
     }
 }
 
@@ -531,6 +534,14 @@ impl Console for Terminal {
 
     fn warning(&mut self, text: &str) {
         self.bar.suspend(|| eprintln!("warning: {text}"));
+    }
+
+    fn note(&mut self, text: &str) {
+        if self.bar.is_hidden() {
+            println!("{text}");
+        } else {
+            self.bar.println(text);
+        }
     }
 }
 

@@ -159,6 +159,11 @@ pub struct DynamicRecord {
     pub contacts_closed: usize,
     /// See [`Self::locks`].
     pub contacts_released: usize,
+    /// Energy dissipated by the impacts of these events (the sum of
+    /// `energy_lost` of `events.csv`, each impact counted once: latches
+    /// that lock in one step, and stops struck in one step, share one
+    /// impact and report its whole loss on each row).
+    pub impact_energy_lost: f64,
 }
 
 impl DynamicRecord {
@@ -180,8 +185,33 @@ impl DynamicRecord {
             impacts: count(ContactKind::Impact),
             contacts_closed: count(ContactKind::Close),
             contacts_released: count(ContactKind::Release),
+            impact_energy_lost: impact_energy_lost(outcome),
         }
     }
+}
+
+/// The energy the impacts of `outcome` dissipated: per step, one loss for
+/// its locks and one for its stop events (each shared by the rows of the
+/// step, docs/joints.md §6.2 and §6.3).
+fn impact_energy_lost(outcome: &DynamicOutcome) -> f64 {
+    let once = |rows: &mut dyn Iterator<Item = (usize, f64)>| {
+        let mut total = 0.0;
+        let mut last = None;
+        for (step, lost) in rows {
+            if last != Some(step) {
+                total += lost;
+                last = Some(step);
+            }
+        }
+        total
+    };
+    once(&mut outcome.locks.iter().map(|l| (l.increment, l.energy_lost)))
+        + once(
+            &mut outcome
+                .contacts
+                .iter()
+                .map(|c| (c.increment, c.energy_lost)),
+        )
 }
 
 /// What one analysis of a run did, whatever its type: the counts that the

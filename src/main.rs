@@ -46,8 +46,7 @@ use unfold::analysis::{
 use unfold::io::histories::{Format, Group, Histories, HistoryError, Request, UnitLabels};
 use unfold::io::model_file::read_model;
 use unfold::io::restart::{fingerprint, Restart, RestartError, RestartWriter, Resume};
-use unfold::io::results::AnalysisEnd;
-use unfold::io::results::Summary;
+use unfold::io::results::{AnalysisEnd, Summary};
 use unfold::io::run::{
     dynamic_error_message, format_time, signal_name, stop_on_signals, Console, Recorder,
     SignalEvent, StopRequest,

@@ -40,15 +40,16 @@ use indicatif::{ProgressBar, ProgressStyle};
 use unfold::analysis::preflight;
 use unfold::analysis::statics::StaticError;
 use unfold::analysis::{
-    AnalysisSettings, DynamicAnalysis, DynamicError, IncrementInfo, ModalAnalysis, ModalError,
-    ModalOutcome, ModalSettings, NewtonFailure, StaticAnalysis,
+    AnalysisSettings, DynamicAnalysis, DynamicError, DynamicSettings, IncrementInfo, ModalAnalysis,
+    ModalError, ModalOutcome, ModalSettings, NewtonFailure, StaticAnalysis,
 };
 use unfold::io::histories::{Format, Group, Histories, HistoryError, Request, UnitLabels};
 use unfold::io::model_file::read_model;
 use unfold::io::restart::{fingerprint, Restart, RestartError, RestartWriter, Resume};
-use unfold::io::results::AnalysisEnd;
+use unfold::io::results::{AnalysisEnd, Summary};
 use unfold::io::run::{
-    format_time, signal_name, stop_on_signals, Console, Recorder, SignalEvent, StopRequest,
+    dynamic_error_message, format_time, signal_name, stop_on_signals, Console, Recorder,
+    SignalEvent, StopRequest,
 };
 use unfold::io::vtk::Encoding;
 use unfold::model::input::ModelInput;
@@ -297,10 +298,13 @@ fn describe(model: &Model) -> String {
     unfold::io::run::describe(model)
 }
 
-/// Prints the model's warnings to stderr.
+/// Prints the model's warnings and notes to stderr.
 fn print_warnings(path: &Path, model: &Model) {
     for w in &model.warnings {
         eprintln!("warning: {}: {w}", path.display());
+    }
+    for n in &model.notes {
+        eprintln!("note: {}: {n}", path.display());
     }
 }
 
@@ -327,8 +331,19 @@ fn check(path: &Path) -> ExitCode {
         );
         return ExitCode::from(EXIT_INPUT);
     }
+    // a run that starts with a motion: the start of its dynamic analysis
+    if let Some(settings) = first_motion(&analyses) {
+        if let Err(e) = preflight::check_motion(&model, settings) {
+            eprintln!(
+                "error: {}: dynamic analysis at t = 0: {}",
+                path.display(),
+                dynamic_error_message(&model, &model.initial_state(), &e)
+            );
+            return ExitCode::from(dynamic_exit_code(&e));
+        }
+    }
     let Some(first_static) = analyses.iter().find_map(|a| a.as_static()) else {
-        // modal analyses only: nothing to solve before them
+        // modal and dynamic analyses only: no equilibrium to check
         println!(
             "{}: valid model: {}; {} unknowns",
             path.display(),
@@ -387,6 +402,28 @@ fn supported(path: &Path, plan: &[AnalysisSettings]) -> bool {
         );
     }
     all
+}
+
+/// The dynamic analysis that a run of `plan` starts with, modal analyses
+/// before it aside (they leave the state as it is): its start, from the
+/// model's initial state and velocities, needs no analysis before it.
+fn first_motion(plan: &[AnalysisSettings]) -> Option<&DynamicSettings> {
+    plan.iter().find(|a| a.as_modal().is_none())?.as_dynamic()
+}
+
+/// The exit code of a run whose dynamic analysis stopped with `error`:
+/// initial velocities that the constraints forbid, or a model without
+/// mass or stiffness somewhere (a singular matrix of the initial
+/// accelerations), are invalid input.
+fn dynamic_exit_code(error: &DynamicError) -> u8 {
+    match error {
+        DynamicError::InconsistentVelocity { .. }
+        | DynamicError::Initial {
+            failure: NewtonFailure::Singular { .. },
+            ..
+        } => EXIT_INPUT,
+        _ => EXIT_FAILED,
+    }
 }
 
 /// One line per modal and dynamic analysis of `plan`, for `unfold check`.
@@ -497,6 +534,14 @@ impl Console for Terminal {
     fn warning(&mut self, text: &str) {
         self.bar.suspend(|| eprintln!("warning: {text}"));
     }
+
+    fn note(&mut self, text: &str) {
+        if self.bar.is_hidden() {
+            println!("{text}");
+        } else {
+            self.bar.println(text);
+        }
+    }
 }
 
 fn run(
@@ -552,10 +597,7 @@ fn run(
         let analysis = StaticAnalysis::new(model.clone(), first.clone());
         let rejected = unfold::io::results::write_rejected(
             out,
-            &label,
-            &model,
-            &analysis,
-            &plan,
+            Summary::start(&label, &model, &analysis, &plan),
             &e.to_string(),
             restart,
         );
@@ -563,6 +605,34 @@ fn run(
             eprintln!("error: cannot write results: {w}");
         }
         return ExitCode::from(EXIT_INPUT);
+    }
+    // a run that starts with a motion: the checks of its start (those of
+    // `check`), before any result file; a restart continues a run that
+    // passed them
+    if let (None, Some(settings)) = (restart, first_motion(&plan)) {
+        if let Err(e) = preflight::check_motion(&model, settings) {
+            if dynamic_exit_code(&e) == EXIT_INPUT {
+                // invalid input: summary.json alone says why
+                let message = format!(
+                    "dynamic analysis at t = 0: {}",
+                    dynamic_error_message(&model, &model.initial_state(), &e)
+                );
+                eprintln!("error: {}: {message}", path.display());
+                let analysis = DynamicAnalysis::new(model.clone(), settings.clone());
+                let end_time = plan.last().map_or(settings.end_time, |a| a.end_time());
+                let summary = Summary::start_with(
+                    &label,
+                    &model,
+                    analysis.n_equations(),
+                    analysis.nnz(),
+                    end_time,
+                );
+                if let Err(w) = unfold::io::results::write_rejected(out, summary, &message, None) {
+                    eprintln!("error: cannot write results: {w}");
+                }
+                return ExitCode::from(EXIT_INPUT);
+            }
+        }
     }
     // a restart: the analysis it continues and its start state
     let (first, start, continued) = match restart.map(|r| resume(r, &input, &model, &plan)) {
@@ -758,22 +828,16 @@ fn run(
         }
         Some(Failure::Dynamic(e)) => {
             eprintln!(
-                "error: {}: dynamic analysis at t = {}: {e}",
+                "error: {}: dynamic analysis at t = {}: {}",
                 path.display(),
-                format_time(state.time)
+                format_time(state.time),
+                dynamic_error_message(&model, &state, e)
             );
-            // initial velocities the joints forbid, or a model without
-            // mass or stiffness somewhere, are invalid input
-            if let DynamicError::InconsistentVelocity { .. }
-            | DynamicError::Initial {
-                failure: NewtonFailure::Singular { .. },
-                ..
-            } = e
-            {
-                return ExitCode::from(EXIT_INPUT);
+            let code = dynamic_exit_code(e);
+            if code == EXIT_FAILED {
+                eprintln!("note: {kept}");
             }
-            eprintln!("note: {kept}");
-            return ExitCode::from(EXIT_FAILED);
+            return ExitCode::from(code);
         }
         None => {}
     }

@@ -21,9 +21,19 @@
 //!    reference configuration.
 //!
 //! Equilibrium itself is not sought: that is the analysis.
+//!
+//! A run whose first analysis other than a modal one is dynamic is checked
+//! by the start of that analysis instead ([`check_motion`]): the initial
+//! velocities against the joints, latches, stops and rolling contacts
+//! (docs/theory.md D10) and the consistent initial accelerations (D9),
+//! which are its step 0 and need no time step.
 
+use std::sync::Arc;
+
+use super::dynamics::{DynamicAnalysis, DynamicError};
 use super::newton::{NewtonFailure, NewtonSolver};
-use super::settings::StaticSettings;
+use super::observers::History;
+use super::settings::{DynamicSettings, StaticSettings};
 use super::statics::StaticError;
 use crate::dofs::DofKind;
 use crate::elements::ElementKind;
@@ -85,6 +95,22 @@ pub fn check(model: &Model, settings: &StaticSettings) -> Result<Preflight, Stat
         free_motions: free,
         warnings: redundant_drivers(model, &rank.redundant),
     })
+}
+
+/// Runs the start of a dynamic analysis of `model` with `settings` from
+/// the model's initial state, as a run whose first analysis (modal ones
+/// aside) it is: latches and stops at their values locked or closed, the
+/// initial velocities checked against every constraint, the initial
+/// accelerations and multipliers solved for. Returns the number of free
+/// unknowns, or the error with which the run would stop at `t = 0`.
+pub fn check_motion(model: &Arc<Model>, settings: &DynamicSettings) -> Result<usize, DynamicError> {
+    let mut analysis = DynamicAnalysis::new(model.clone(), settings.clone());
+    let unknowns = analysis.n_equations();
+    analysis.start(model.initial_state(), &mut History::new());
+    match analysis.finish().error {
+        Some(e) => Err(e),
+        None => Ok(unknowns),
+    }
 }
 
 /// A warning for each redundant equation (`redundant`: indices among the

@@ -159,6 +159,11 @@ pub struct DynamicRecord {
     pub contacts_closed: usize,
     /// See [`Self::locks`].
     pub contacts_released: usize,
+    /// Energy dissipated by the impacts of these events (the sum of
+    /// `energy_lost` of `events.csv`, each impact counted once: latches
+    /// that lock in one step, and stops struck in one step, share one
+    /// impact and report its whole loss on each row).
+    pub impact_energy_lost: f64,
 }
 
 impl DynamicRecord {
@@ -180,8 +185,33 @@ impl DynamicRecord {
             impacts: count(ContactKind::Impact),
             contacts_closed: count(ContactKind::Close),
             contacts_released: count(ContactKind::Release),
+            impact_energy_lost: impact_energy_lost(outcome),
         }
     }
+}
+
+/// The energy the impacts of `outcome` dissipated: per step, one loss for
+/// its locks and one for its stop events (each shared by the rows of the
+/// step, docs/joints.md §6.2 and §6.3).
+fn impact_energy_lost(outcome: &DynamicOutcome) -> f64 {
+    let once = |rows: &mut dyn Iterator<Item = (usize, f64)>| {
+        let mut total = 0.0;
+        let mut last = None;
+        for (step, lost) in rows {
+            if last != Some(step) {
+                total += lost;
+                last = Some(step);
+            }
+        }
+        total
+    };
+    once(&mut outcome.locks.iter().map(|l| (l.increment, l.energy_lost)))
+        + once(
+            &mut outcome
+                .contacts
+                .iter()
+                .map(|c| (c.increment, c.energy_lost)),
+        )
 }
 
 /// What one analysis of a run did, whatever its type: the counts that the
@@ -762,20 +792,16 @@ fn remove_leftovers(dir: &Path, writes: impl Fn(&str) -> bool) -> io::Result<()>
     Ok(())
 }
 
-/// Records in `dir` a run of `model` (read from `model_file`, analyses
-/// `plan`, the first of which is `first`) rejected before its first
-/// analysis started, by the checks of
-/// [`crate::analysis::preflight`]: `summary.json` alone, status `failed`
-/// with `message`. The directory is locked as for a run, and the files of
-/// an earlier run are removed (none would belong to this model), its
-/// restart files too but `keep` (the restart file given to this run, if
-/// any); no other file is written.
+/// Records in `dir` a run rejected before its first analysis started, by
+/// the checks of [`crate::analysis::preflight`]: `summary.json` alone
+/// (`summary`, the run's summary as it started, for example
+/// [`Summary::start`]), status `failed` with `message`. The directory is
+/// locked as for a run, and the files of an earlier run are removed (none
+/// would belong to this model), its restart files too but `keep` (the
+/// restart file given to this run, if any); no other file is written.
 pub fn write_rejected(
     dir: &Path,
-    model_file: &str,
-    model: &Model,
-    first: &StaticAnalysis,
-    plan: &[AnalysisSettings],
+    mut summary: Summary,
     message: &str,
     keep: Option<&Path>,
 ) -> io::Result<()> {
@@ -785,7 +811,6 @@ pub fn write_rejected(
     super::restart::remove_earlier(dir, keep)?;
     // an empty grid folder of an earlier run goes too
     let _ = std::fs::remove_dir(dir.join("vtk"));
-    let mut summary = Summary::start(model_file, model, first, plan);
     summary.status = RunStatus::Failed;
     summary.message = Some(message.to_string());
     let text = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;

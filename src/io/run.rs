@@ -48,8 +48,11 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use super::modes::ModalFiles;
 use super::restart::RestartWriter;
-use super::results::{file_error, AnalysisEnd, EventRow, ResultWriter, RunStatus, Summary};
+use super::results::{
+    file_error, AnalysisEnd, DynamicRecord, EventRow, ResultWriter, RunStatus, Summary,
+};
 use super::vtk::Encoding;
+use crate::analysis::impact;
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
     AnalysisSettings, ContactInfo, Continuation, CutbackInfo, DynamicAnalysis, DynamicError,
@@ -57,7 +60,7 @@ use crate::analysis::{
     StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
-use crate::model::Model;
+use crate::model::{Id, Model};
 use crate::state::State;
 
 mod modal;
@@ -73,6 +76,11 @@ pub trait Console {
     fn finish(&mut self, _text: &str) {}
     /// A warning of the analysis (shown even when lines are not).
     fn warning(&mut self, _text: &str) {}
+    /// A note on the outcome of the run (a latch that never locked), to be
+    /// shown even when lines are not; `text` starts with `note:`.
+    fn note(&mut self, text: &str) {
+        self.line(text);
+    }
 }
 
 /// A console that shows nothing.
@@ -255,6 +263,76 @@ pub fn format_time(t: f64) -> String {
     }
 }
 
+/// The message of a dynamic analysis that stopped with `error` at `state`,
+/// for a person: the error itself, except for initial velocities that move
+/// a latch locked at the start (at its value in the start state `state`,
+/// within the event tolerance), where the generic advice (one rigid
+/// motion) does not fit.
+pub fn dynamic_error_message(model: &Model, state: &State, error: &DynamicError) -> String {
+    let DynamicError::InconsistentVelocity {
+        constraint,
+        rate,
+        tolerance,
+    } = error
+    else {
+        return error.to_string();
+    };
+    let latch = model.elements.iter().find_map(|e| {
+        let l = e.as_latch()?;
+        (*constraint == format!("{} {} equation 1", e.kind().name(), e.id())).then_some((e.id(), l))
+    });
+    let Some((id, latch)) = latch else {
+        return error.to_string();
+    };
+    let c = latch.coordinate(state);
+    let unit = if latch.is_angle() { " rad" } else { "" };
+    format!(
+        "latch {id} is at its locking value at t = {} (joint {} at {}{unit}, the latch's value {}{unit}), so it is locked from the start, but the initial velocities move the joint: its rate is {rate:.3e} (tolerance {tolerance:.1e}); give the joint's nodes velocities that keep the coordinate still, or start the joint away from the latch's value",
+        format_time(state.time),
+        latch.joint(),
+        format_time(c),
+        format_time(latch.value())
+    )
+}
+
+/// The events of dynamic analyses in a few words (`1 lock, 3 impacts,
+/// 1 contact closed, energy lost in impacts 7.401e0`), or `None` if they
+/// had none: the counts of `events.csv`'s rows of each kind and the energy
+/// their impacts dissipated.
+fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
+    let sum = |f: fn(&DynamicRecord) -> usize| records.iter().map(|d| f(d)).sum::<usize>();
+    let plural = |n: usize, one: &str, many: &str| match n {
+        0 => None,
+        1 => Some(format!("1 {one}")),
+        n => Some(format!("{n} {many}")),
+    };
+    let parts: Vec<String> = [
+        plural(sum(|d| d.locks), "lock", "locks"),
+        plural(sum(|d| d.impacts), "impact", "impacts"),
+        plural(
+            sum(|d| d.contacts_closed),
+            "contact closed",
+            "contacts closed",
+        ),
+        plural(
+            sum(|d| d.contacts_released),
+            "contact released",
+            "contacts released",
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if parts.is_empty() {
+        return None;
+    }
+    let lost: f64 = records.iter().map(|d| d.impact_energy_lost).sum();
+    Some(format!(
+        "{}, energy lost in impacts {lost:.3e}",
+        parts.join(", ")
+    ))
+}
+
 /// The size of a model in one line: nodes and elements of each kind.
 pub fn describe(model: &Model) -> String {
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
@@ -380,6 +458,94 @@ pub struct Recorder {
     /// What it needs besides its last converged state to go on (for
     /// restart files).
     motion: Option<Continuation>,
+    /// The latches of the model over the running analysis.
+    latches: Vec<LatchWatch>,
+}
+
+/// What the recorder follows of a latch over an analysis, for the notes
+/// of docs/joints.md §6.2 ("Where latches lock"): a latch passed by a
+/// static or kinematic analysis, which does not lock it, and a latch that
+/// a whole dynamic analysis never locked.
+struct LatchWatch {
+    /// The latch's index among the model's elements.
+    element: usize,
+    /// Its id and its joint's.
+    id: Id,
+    joint: Id,
+    /// `c_L`, `s` and whether `c` is an angle.
+    value: f64,
+    approach: f64,
+    angle: bool,
+    /// Locked when the analysis started.
+    locked_at_start: bool,
+    /// Locked by now.
+    locked: bool,
+    /// The range of `c` over the converged increments.
+    low: f64,
+    high: f64,
+    /// `g = s (c − c_L)` was below `−tol` at a converged increment.
+    before: bool,
+    /// Said already that the analysis carried it past its value.
+    passed: bool,
+}
+
+impl LatchWatch {
+    /// The latches of `model` at `state`.
+    fn of(model: &Model, state: &State) -> Vec<Self> {
+        model
+            .elements
+            .iter()
+            .enumerate()
+            .filter_map(|(element, e)| {
+                let l = e.as_latch()?;
+                let c = l.coordinate(state);
+                let locked = l.is_locked(state);
+                Some(Self {
+                    element,
+                    id: e.id(),
+                    joint: l.joint(),
+                    value: l.value(),
+                    approach: l.approach(),
+                    angle: l.is_angle(),
+                    locked_at_start: locked,
+                    locked,
+                    low: c,
+                    high: c,
+                    before: l.gap(state) < -impact::event_tolerance(model, l),
+                    passed: false,
+                })
+            })
+            .collect()
+    }
+
+    /// The start of an analysis at `state` (its first converged
+    /// increment): `watch` as the analysis before left it (whether each
+    /// latch was short of its value), the rest from `state`.
+    fn start(watch: &mut Vec<Self>, model: &Model, state: &State) {
+        let mut now = Self::of(model, state);
+        for (w, before) in now.iter_mut().zip(watch.iter()) {
+            w.before |= before.before;
+        }
+        *watch = now;
+    }
+
+    /// `c` with its unit, and in degrees for an angle.
+    fn show(&self, c: f64) -> String {
+        if self.angle {
+            format!("{} rad ({:.2}°)", format_time(c), c.to_degrees())
+        } else {
+            format_time(c)
+        }
+    }
+
+    /// The direction of approach in words.
+    fn direction(&self) -> &'static str {
+        if self.approach > 0.0 {
+            "increasing"
+        } else {
+            "decreasing"
+        }
+    }
 }
 
 /// The analysis being recorded.
@@ -543,6 +709,7 @@ impl Recorder {
             energy_extremes: (0.0, 0.0),
             energies: None,
             motion: None,
+            latches: Vec::new(),
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -572,6 +739,9 @@ impl Recorder {
         // warnings are shown by the caller; the log keeps them with the run
         for w in &model.warnings {
             recorder.log.line(&format!("warning: {w}"));
+        }
+        for n in &model.notes {
+            recorder.log.line(&format!("note: {n}"));
         }
         for line in model.load_history() {
             recorder.line(&format!("load history: {line}"));
@@ -614,7 +784,7 @@ impl Recorder {
             d.largest_energy_balance_error = d.largest_energy_balance_error.max(error);
             d.largest_kinetic_energy = d.largest_kinetic_energy.max(kinetic);
             self.line(&format!(
-                "dynamic analysis to t = {}: {} steps, {} rejected ({} by the error estimate), {} iterations, {:.3} s; energy balance error {:.3e} (largest {:.3e}; largest kinetic energy {:.3e})",
+                "dynamic analysis to t = {}: {} steps, {} rejected ({} by the error estimate), {} iterations, {:.3} s; energy balance error {:.3e} (largest {:.3e}; largest kinetic energy {:.3e}){}",
                 format_time(end.time),
                 d.steps,
                 d.rejected_steps,
@@ -623,9 +793,11 @@ impl Recorder {
                 d.wall_time_s,
                 d.energy_balance_error,
                 d.largest_energy_balance_error,
-                d.largest_kinetic_energy
+                d.largest_kinetic_energy,
+                events_summary(&[d]).map_or(String::new(), |e| format!("; {e}"))
             ));
         }
+        self.never_locked(&end);
         let c = &self.current;
         self.summary
             .add_end(c.kind, c.start_time, c.end_time, &end, c.initial_iterations);
@@ -671,16 +843,105 @@ impl Recorder {
         self.writer.dir()
     }
 
+    /// Follows the latches to the converged increment `info` at `state`:
+    /// a note when a static or kinematic analysis carries one past its
+    /// value in its direction of approach (only dynamic analyses lock
+    /// latches).
+    fn watch_latches(&mut self, info: &IncrementInfo, model: &Model, state: &State) {
+        let statics = self.current.kind != "dynamic";
+        let mut notes = Vec::new();
+        for w in &mut self.latches {
+            let Some(l) = model.elements.get(w.element).and_then(|e| e.as_latch()) else {
+                continue;
+            };
+            if w.locked {
+                continue;
+            }
+            w.locked = l.is_locked(state);
+            let c = l.coordinate(state);
+            w.low = w.low.min(c);
+            w.high = w.high.max(c);
+            let (g, tolerance) = (l.gap(state), impact::event_tolerance(model, l));
+            if g < -tolerance {
+                w.before = true;
+            } else if statics && w.before && g > tolerance && !w.passed {
+                w.passed = true;
+                notes.push(format!(
+                    "latch {}: the {} analysis carried joint {} past the latch's value {} at t = {} (to {}); latches lock only in a dynamic analysis: a static or kinematic one leaves them open (docs/joints.md §6.2)",
+                    w.id,
+                    self.current.kind,
+                    w.joint,
+                    w.show(w.value),
+                    format_time(info.time),
+                    w.show(c)
+                ));
+            }
+        }
+        for n in notes {
+            self.note_line(&n);
+        }
+    }
+
+    /// At the end of a dynamic analysis that reached its end: a note for
+    /// each latch open at its start that it never locked, with the range
+    /// its coordinate covered.
+    fn never_locked(&mut self, end: &AnalysisEnd) {
+        if self.current.kind != "dynamic" || end.error.is_some() {
+            return;
+        }
+        let notes: Vec<String> = self
+            .latches
+            .iter()
+            .filter(|w| !w.locked_at_start && !w.locked)
+            .map(|w| {
+                // a coordinate that crossed the value against the approach
+                let crossed = w.low <= w.value && w.value <= w.high;
+                format!(
+                    "latch {} never locked in the dynamic analysis to t = {}: joint {} stayed within [{}, {}]{}, and the latch locks when the coordinate reaches {} {}",
+                    w.id,
+                    format_time(end.time),
+                    w.joint,
+                    w.show(w.low),
+                    w.show(w.high),
+                    if crossed {
+                        " and passed the latch's value only against its approach"
+                    } else {
+                        ""
+                    },
+                    w.show(w.value),
+                    w.direction()
+                )
+            })
+            .collect();
+        for n in notes {
+            self.note_line(&n);
+        }
+    }
+
+    /// A note of the run's outcome: in `log.txt`, and shown even when the
+    /// increments are not.
+    fn note_line(&mut self, text: &str) {
+        let text = format!("note: {text}");
+        self.log.line(&text);
+        self.console.note(&text);
+    }
+
     /// Appends `row` to `events.csv`; a write error fails the run at its
     /// end (the analysis goes on: its other results are being written).
     fn write_event(&mut self, row: &EventRow) {
+        let (element, what) = match row.kind {
+            "lock" => ("latch", "locks joint"),
+            "impact" => ("stop", "impact of joint"),
+            "contact" => ("stop", "contact closed on joint"),
+            _ => ("stop", "contact released on joint"),
+        };
         self.line(&format!(
-            "step {:4}  t = {:.6}: {} at element {} (joint {}): rate {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}",
+            "step {:4}  t = {:.6}: {element} {}: {what} {} at c = {:.6}: rate {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}",
             row.increment,
             row.time,
-            row.kind,
             row.element,
             row.joint,
+            row.coordinate,
             row.rate_before,
             row.rate_after,
             row.impulse,
@@ -762,6 +1023,8 @@ impl Recorder {
             .iter()
             .filter_map(|a| a.dynamic.as_ref())
             .collect();
+        // the locks and impacts of the run, when it had some
+        let events = events_summary(&dynamic).map_or(String::new(), |e| format!("{e}; "));
         let last_line = if !dynamic.is_empty()
             && dynamic.len() == s.analyses.iter().filter(|a| a.kind != "modal").count()
         {
@@ -770,7 +1033,7 @@ impl Recorder {
             let rejected: usize = dynamic.iter().map(|d| d.rejected_steps).sum();
             let balance = dynamic.last().map_or(0.0, |d| d.energy_balance_error);
             format!(
-                "{}: {steps} steps, {rejected} rejected, {} iterations ({:.2} per step), t = {}, {:.3} s, energy balance error {balance:.3e}; results in {}",
+                "{}: {steps} steps, {rejected} rejected, {} iterations ({:.2} per step), t = {}, {:.3} s, energy balance error {balance:.3e}; {events}results in {}",
                 s.status.name(),
                 s.iterations,
                 if steps > 0 { s.iterations as f64 / steps as f64 } else { 0.0 },
@@ -787,7 +1050,7 @@ impl Recorder {
                 format!(" (of which {steps} time steps, {rejected} rejected)")
             };
             format!(
-                "{}: {} increments{steps}, {} iterations ({} for {initial}; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; results in {}",
+                "{}: {} increments{steps}, {} iterations ({} for {initial}; {:.2} per increment), {} cut-backs, t = {}, {:.3} s; {events}results in {}",
                 s.status.name(),
                 s.increments,
                 s.iterations,
@@ -867,7 +1130,14 @@ impl Observer for Recorder {
         if info.increment == 0 {
             self.current.start_time = info.time;
             self.current.initial_iterations = info.iterations;
+            if self.latches.is_empty() && info.time == 0.0 {
+                // the run's start: from the model's initial state, which
+                // the initial equilibrium may have moved past a latch
+                self.latches = LatchWatch::of(model, &model.initial_state());
+            }
+            LatchWatch::start(&mut self.latches, model, state);
         }
+        self.watch_latches(info, model, state);
         // a later analysis starts at the final state of the one before,
         // written already: its equilibrium there is logged, not written
         let restart =
@@ -1001,8 +1271,13 @@ impl Observer for Recorder {
     }
 
     fn event(&mut self, info: &EventInfo) {
+        let word = if self.current.kind == "dynamic" {
+            "step"
+        } else {
+            "increment"
+        };
         self.line(&format!(
-            "increment {:4}  t = {:.6}: event \"{}\" (value {:.3e})",
+            "{word} {:4}  t = {:.6}: landed on event \"{}\" (value {:.3e})",
             info.increment + self.increment_offset,
             info.time,
             info.name,

@@ -99,6 +99,9 @@ pub struct Model {
     pub curve_uses: Vec<CurveUse>,
     /// Input that is valid but probably not what was meant.
     pub warnings: Vec<ModelWarning>,
+    /// Remarks on valid input worth stating once: how a value given in
+    /// other units was read (a stiffness per degree in N·m/rad).
+    pub notes: Vec<ModelWarning>,
     /// Gravity acceleration and its curve.
     pub gravity: Option<(Vec3, CurveIndex)>,
     /// Diagonal of the bounding box of the nodes (1 if zero): the length

@@ -183,6 +183,19 @@ pub(super) fn hinge_law(
         }
     };
     let ((load, unload), elastic) = (branches?, elastic?);
+    // slopes per degree, as read
+    if let Some(k) = s.elastic_slope {
+        cx.ck.per_degree(entity, "elastic_slope", k, "N·m", unit);
+    }
+    if let Some(t) = &s.tape_spring {
+        cx.ck.per_degree(
+            entity,
+            "tape_spring locked_stiffness",
+            t.locked_stiffness,
+            "N·m",
+            unit,
+        );
+    }
     let law = Hysteresis {
         load,
         unload,

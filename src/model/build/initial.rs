@@ -57,10 +57,17 @@ impl Builder<'_> {
                     continue;
                 };
                 if let Some(first) = &given[i] {
+                    // the first is the node's own entry or an earlier
+                    // initial_motion
+                    let from = if first.starts_with("node ") {
+                        "its [[nodes]] entry (velocity, angular_velocity)".to_string()
+                    } else {
+                        first.clone()
+                    };
                     self.ck.push(
                         ModelErrorKind::Invalid,
                         &entity,
-                        format!("node {id} already has an initial velocity from {first}"),
+                        format!("node {id} already has an initial velocity from {from}; give each node its initial velocity once"),
                     );
                     continue;
                 }
@@ -90,12 +97,18 @@ impl Builder<'_> {
                     w_material[c - 3].abs() > 1e-12 * scale
                 };
                 if f && moving {
+                    // the node is named once: by the entity, or after an
+                    // initial_motion that lists it
+                    let node = if entity.starts_with("node ") {
+                        "the node".to_string()
+                    } else {
+                        format!("node {}", self.node_ids[i])
+                    };
                     self.ck.push(
                         ModelErrorKind::Invalid,
                         entity,
                         format!(
-                            "node {} is supported in {} but is given {} there; a supported component does not move",
-                            self.node_ids[i],
+                            "{node} is supported in {} but is given {} there; a supported component does not move",
                             AXES[c],
                             if c < 3 {
                                 "a velocity"

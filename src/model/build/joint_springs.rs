@@ -112,6 +112,13 @@ pub(super) fn joint_spring(
         unit,
     );
     let (spring, damper) = (spring.ok()?, damper.ok()?);
+    // coefficients per degree, as read
+    if let (Some(k), Some(_)) = (s.stiffness, &spring) {
+        cx.ck.per_degree(entity, "stiffness", k, "N·m", unit);
+    }
+    if let (Some(c), Some(_)) = (s.damping, &damper) {
+        cx.ck.per_degree(entity, "damping", c, "N·m·s", unit);
+    }
     if spring.is_none() && damper.is_none() {
         cx.ck.push(
             ModelErrorKind::Missing,

@@ -83,6 +83,7 @@ enum AngleLimit {
 struct Checker {
     errors: Vec<ModelError>,
     warnings: Vec<ModelWarning>,
+    notes: Vec<ModelWarning>,
 }
 
 impl Checker {
@@ -104,6 +105,31 @@ impl Checker {
             entity: entity.into(),
             message: message.into(),
         });
+    }
+
+    fn note(&mut self, entity: impl Into<String>, message: impl Into<String>) {
+        self.notes.push(ModelWarning {
+            entity: entity.into(),
+            message: message.into(),
+        });
+    }
+
+    /// Notes how a coefficient given per degree (`unit = "deg"`) is read:
+    /// `what` (`stiffness`), `value` per degree, `per` the rest of its
+    /// unit (`N·m`, `N·m·s`), `unit` the radians in the model's angle
+    /// unit (1 for radians: no note).
+    fn per_degree(&mut self, entity: &str, what: &str, value: f64, per: &str, unit: f64) {
+        if unit == 1.0 || value == 0.0 {
+            return;
+        }
+        self.note(
+            entity,
+            format!(
+                "{what} = {value} with unit = \"deg\" is {value} {per}/deg = {:.6e} {per}/rad (the angle in the {what} is in degrees too; {value} {per}/rad would be {what} = {:.6e})",
+                value / unit,
+                value * unit
+            ),
+        );
     }
 
     /// Checks that every value is finite.
@@ -410,6 +436,7 @@ impl Model {
             curves: curves.curves,
             curve_uses: curves.uses,
             warnings: ck.warnings,
+            notes: ck.notes,
             gravity,
             length_scale,
             scaling: Default::default(),

@@ -1,0 +1,299 @@
+//! The checks of the start of a dynamic run through the command-line
+//! tool: `unfold check` runs those of `unfold run` (initial velocities
+//! against joints, latches and rolling contacts) with the same message and
+//! exit code 2, a run rejected there leaves `summary.json` alone (status
+//! `failed`), a latch at its value at `t = 0` gets its own advice, and the
+//! messages about initial velocities name each node once
+//! (README.md, docs/results.md, docs/model-format.md).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A fresh scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("unfold-start-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs `unfold` with `args`: (exit code, stdout, stderr).
+fn unfold(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// `unfold check MODEL` and `unfold run MODEL --out OUT --quiet`.
+fn check_and_run(model: &Path, out: &Path) -> ((i32, String), (i32, String, String)) {
+    let (code, _, err) = unfold(&["check", model.to_str().unwrap()]);
+    let run = unfold(&[
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    ((code, err), run)
+}
+
+/// The files in `dir`, sorted.
+fn files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+/// A compound pendulum hinged to the ground about z at the origin, its
+/// body at (0, −0.5, 0), in a dynamic analysis; `extra` tables added.
+fn pendulum(extra: &str) -> String {
+    format!(
+        r#"title = "compound pendulum"
+[analysis]
+type = "dynamic"
+end_time = 1.0
+time_step = 0.001
+max_step = 0.01
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 2
+x = [0.0, -0.5, 0.0]
+
+[[supports]]
+node = 1
+fixed = ["all"]
+
+[[rigid_bodies]]
+id = 1
+node = 2
+mass = 2.0
+inertia = [0.01, 0.01, 0.01]
+
+[[joints]]
+id = 3
+type = "revolute"
+nodes = [1, 2]
+axis = [0.0, 0.0, 1.0]
+position = [0.0, 0.0, 0.0]
+
+[gravity]
+acceleration = [0.0, -9.81, 0.0]
+{extra}
+"#
+    )
+}
+
+/// An upright disc of radius 0.5 rolling along +y at 2 m/s
+/// (docs/model-format.md, `[[rolling_discs]]`), its spin `spin` about
+/// the global x axis: −4 rad/s rolls, other values slip.
+fn disc(spin: f64) -> String {
+    format!(
+        r#"title = "rolling disc"
+[analysis]
+type = "dynamic"
+end_time = 0.1
+time_step = 0.01
+adaptive = false
+
+[gravity]
+acceleration = [0.0, 0.0, -9.81]
+curve = "constant"
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.5]
+rotation = [0.0, 90.0, 0.0]
+unit = "deg"
+velocity = [0.0, 2.0, 0.0]
+angular_velocity = [{spin}, 0.0, 0.0]
+
+[[rigid_bodies]]
+id = 1
+node = 1
+mass = 1.0
+inertia = [0.0625, 0.0625, 0.125]
+
+[[rolling_discs]]
+id = 2
+node = 1
+radius = 0.5
+axis = [0.0, 0.0, 1.0]
+normal = [0.0, 0.0, 1.0]
+"#
+    )
+}
+
+/// Initial velocities that the constraints forbid: `unfold check` finds
+/// them as `unfold run` does, with the same message and exit code 2; the
+/// run leaves `summary.json` alone, `failed` with that message, and no
+/// result file that could pass for results (no `nodes.csv`, no grid, no
+/// restart file); a result set of an earlier run in the directory is
+/// removed. Velocities that the constraints allow pass both.
+#[test]
+fn check_finds_the_initial_velocities_a_run_refuses() {
+    let dir = scratch("velocities");
+    let cases = [
+        (
+            // a velocity along the arm pulls the body off the hinge
+            "joint",
+            pendulum("[[initial_motion]]\nnodes = [2]\nvelocity = [0.0, 0.05, 0.0]\n"),
+            "the initial velocities violate joint 3 equation",
+        ),
+        (
+            // spinning at −3 rad/s while moving at 2 m/s: the rim slips
+            "slip",
+            disc(-3.0),
+            "the initial velocities violate rolling disc 2 equation",
+        ),
+    ];
+    for (name, text, wanted) in cases {
+        let model = dir.join(format!("{name}.toml"));
+        std::fs::write(&model, text).unwrap();
+        let out = dir.join(name);
+        // results of an earlier, valid run of a model in the directory
+        std::fs::write(
+            dir.join("ok.toml"),
+            if name == "slip" {
+                disc(-4.0)
+            } else {
+                pendulum("")
+            },
+        )
+        .unwrap();
+        let ((code, err), _) = check_and_run(&dir.join("ok.toml"), &out);
+        assert_eq!(code, 0, "{name}: {err}");
+        assert!(out.join("nodes.csv").exists());
+
+        let ((code, check_err), (run_code, _, run_err)) = check_and_run(&model, &out);
+        assert_eq!(code, 2, "{name}: {check_err}");
+        assert_eq!(run_code, 2, "{name}: {run_err}");
+        let line = format!(
+            "error: {}: dynamic analysis at t = 0: {wanted}",
+            model.display()
+        );
+        assert!(
+            check_err.contains(&line),
+            "{name}: {line:?} not in {check_err}"
+        );
+        // the same message, and nothing else, from check and run
+        assert_eq!(check_err, run_err, "{name}");
+        assert_eq!(files(&out), ["summary.json"], "{name}");
+        let s = summary(&out);
+        assert_eq!(s["status"], "failed", "{name}");
+        let message = s["message"].as_str().unwrap();
+        assert!(message.contains(wanted), "{name}: {message}");
+        assert_eq!(s["output_steps"], 0, "{name}");
+    }
+}
+
+/// The same velocity check when a modal analysis comes first (it leaves
+/// the state as it is): `check` and `run` refuse the model before the
+/// modal analysis, which writes nothing.
+#[test]
+fn a_modal_analysis_first_does_not_hide_the_velocity_check() {
+    let dir = scratch("modal-first");
+    let text = pendulum("[[initial_motion]]\nnodes = [2]\nvelocity = [0.0, 0.05, 0.0]\n").replace(
+        "[analysis]\ntype = \"dynamic\"",
+        "[[analysis]]\ntype = \"modal\"\nmodes = 1\n\n[[analysis]]\ntype = \"dynamic\"",
+    );
+    let model = dir.join("m.toml");
+    std::fs::write(&model, text).unwrap();
+    let out = dir.join("out");
+    let ((code, err), (run_code, _, run_err)) = check_and_run(&model, &out);
+    assert_eq!((code, run_code), (2, 2), "{err}\n{run_err}");
+    assert!(err.contains("violate joint 3 equation"), "{err}");
+    assert_eq!(files(&out), ["summary.json"]);
+}
+
+/// A latch at its value at `t = 0` (within the event tolerance) starts
+/// locked: initial velocities that turn its joint are refused with advice
+/// that names the latch and says it is locked from the start, by `check`
+/// and `run` alike (exit 2).
+#[test]
+fn a_latch_locked_at_the_start_gets_its_own_advice() {
+    let dir = scratch("latch");
+    let model = dir.join("latch.toml");
+    // ω = 0.1 rad/s about the hinge: v = ω × r = (0.05, 0, 0) at the body
+    std::fs::write(
+        &model,
+        pendulum(
+            "[[initial_motion]]\nnodes = [2]\nangular_velocity = [0.0, 0.0, 0.1]\n\n[[latches]]\nid = 9\njoint = 3\nvalue = 1e-10\n",
+        ),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let ((code, err), (run_code, _, run_err)) = check_and_run(&model, &out);
+    assert_eq!((code, run_code), (2, 2), "{err}\n{run_err}");
+    for wanted in [
+        "dynamic analysis at t = 0: latch 9 is at its locking value at t = 0",
+        "so it is locked from the start, but the initial velocities move the joint",
+        "start the joint away from the latch's value",
+    ] {
+        assert!(err.contains(wanted), "{wanted:?} not in {err}");
+    }
+    assert!(!err.contains("one rigid motion"), "{err}");
+    assert_eq!(err, run_err);
+    assert_eq!(files(&out), ["summary.json"]);
+}
+
+/// A node given an initial velocity twice, and a velocity on a supported
+/// component: the messages say where the first velocity came from and name
+/// the node once.
+#[test]
+fn initial_velocity_messages_name_the_node_once() {
+    let dir = scratch("messages");
+    let cases = [
+        (
+            "twice",
+            pendulum("[[initial_motion]]\nnodes = [2]\nvelocity = [0.1, 0.0, 0.0]\n").replace(
+                "x = [0.0, -0.5, 0.0]",
+                "x = [0.0, -0.5, 0.0]\nangular_velocity = [0.0, 0.0, 0.1]",
+            ),
+            "initial_motion[1]: node 2 already has an initial velocity from its [[nodes]] entry",
+        ),
+        (
+            "twice-motion",
+            pendulum(
+                "[[initial_motion]]\nnodes = [2]\nvelocity = [0.1, 0.0, 0.0]\n\n[[initial_motion]]\nnodes = [2]\nvelocity = [0.1, 0.0, 0.0]\n",
+            ),
+            "initial_motion[2]: node 2 already has an initial velocity from initial_motion[1]",
+        ),
+        (
+            "supported",
+            pendulum("").replace(
+                "x = [0.0, 0.0, 0.0]",
+                "x = [0.0, 0.0, 0.0]\nvelocity = [0.1, 0.0, 0.0]",
+            ),
+            "node 1: the node is supported in x but is given a velocity there",
+        ),
+    ];
+    for (name, text, wanted) in cases {
+        let model = dir.join(format!("{name}.toml"));
+        std::fs::write(&model, text).unwrap();
+        let ((code, err), (run_code, _, run_err)) = check_and_run(&model, &dir.join(name));
+        assert_eq!((code, run_code), (2, 2), "{name}: {err}");
+        assert!(
+            err.contains(&format!("{}: {wanted}", model.display())),
+            "{name}: {wanted:?} not in {err}"
+        );
+        assert_eq!(err, run_err, "{name}");
+        assert!(!err.contains("from node"), "{name}: {err}");
+    }
+}

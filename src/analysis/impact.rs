@@ -517,8 +517,9 @@ pub struct ContactInfo {
     pub time: f64,
     /// The stop.
     pub stop: Id,
-    /// The joint whose coordinate it limits.
-    pub joint: Id,
+    /// The joint whose coordinate it limits (`None` for a contact with a
+    /// plane).
+    pub joint: Option<Id>,
     /// What happened.
     pub kind: ContactKind,
     /// The coordinate at the event.

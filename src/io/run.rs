@@ -675,12 +675,12 @@ impl Recorder {
     /// end (the analysis goes on: its other results are being written).
     fn write_event(&mut self, row: &EventRow) {
         self.line(&format!(
-            "step {:4}  t = {:.6}: {} at element {} (joint {}): rate {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}",
+            "step {:4}  t = {:.6}: {} at element {}{}: rate {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}",
             row.increment,
             row.time,
             row.kind,
             row.element,
-            row.joint,
+            row.joint.map_or(String::new(), |j| format!(" (joint {j})")),
             row.rate_before,
             row.rate_after,
             row.impulse,
@@ -976,7 +976,7 @@ impl Observer for Recorder {
             time: info.time,
             element: info.latch,
             kind: "lock",
-            joint: info.joint,
+            joint: Some(info.joint),
             coordinate: info.coordinate,
             rate_before: info.rate_before,
             rate_after: 0.0,

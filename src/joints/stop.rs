@@ -29,6 +29,7 @@ use crate::elements::{
     CellShape, ConstraintKind, Element, ElementKind, ElementOutput, EvalContext, Offsets,
 };
 use crate::model::Id;
+use crate::so3::Vec3;
 use crate::state::State;
 
 /// Names of stop results: the coordinate, the contact (`−1` closed at the
@@ -80,8 +81,12 @@ impl Contact {
 pub struct Stop {
     id: Id,
     /// The joint whose coordinate it limits.
-    joint: Id,
-    source: PairCoordinate,
+    joint: Option<Id>,
+    /// The joint coordinate (`None` for a contact with a plane).
+    source: Option<PairCoordinate>,
+    /// A contact of a node with a plane instead of a joint coordinate.
+    plane: Option<Plane>,
+    nodes: Vec<usize>,
     /// `c_min`, `c_max` (`±∞` when absent).
     lower: f64,
     upper: f64,
@@ -89,6 +94,21 @@ pub struct Stop {
     restitution: f64,
     active: Vec<usize>,
     offsets: Offsets,
+}
+
+/// A sphere of radius `r` centred on a node against a fixed plane through
+/// `p` with unit normal `n`: the "coordinate" of the stop is the gap
+/// `g = n·(x − p) − r` (reference paper, eq. 16), limited below by 0.
+#[derive(Clone, Copy, Debug)]
+pub struct Plane {
+    /// The node.
+    pub node: usize,
+    /// `n`, unit.
+    pub normal: Vec3,
+    /// `p`.
+    pub point: Vec3,
+    /// `r ≥ 0`.
+    pub radius: f64,
 }
 
 /// Internal variables after the unwrapped angle (angles only).
@@ -110,10 +130,13 @@ impl Stop {
         restitution: f64,
     ) -> Self {
         let active = source.active();
+        let nodes = source.nodes.clone();
         Self {
             id,
-            joint,
-            source,
+            joint: Some(joint),
+            source: Some(source),
+            plane: None,
+            nodes,
             lower,
             upper,
             restitution,
@@ -122,8 +145,27 @@ impl Stop {
         }
     }
 
-    /// The joint whose coordinate it limits.
-    pub fn joint(&self) -> Id {
+    /// A contact between a sphere on a node and a fixed plane
+    /// (`plane.normal` unit), with restitution `restitution`: the stop of
+    /// the gap `g = n·(x − p) − r ≥ 0`.
+    pub fn on_plane(id: Id, plane: Plane, restitution: f64) -> Self {
+        Self {
+            id,
+            joint: None,
+            source: None,
+            plane: Some(plane),
+            nodes: vec![plane.node],
+            lower: 0.0,
+            upper: f64::INFINITY,
+            restitution,
+            active: vec![0, 1, 2],
+            offsets: Offsets::default(),
+        }
+    }
+
+    /// The joint whose coordinate it limits (`None` for a contact with a
+    /// plane).
+    pub fn joint(&self) -> Option<Id> {
         self.joint
     }
 
@@ -139,16 +181,23 @@ impl Stop {
 
     /// Whether the coordinate is an angle.
     pub fn is_angle(&self) -> bool {
-        self.source.is_angle()
+        self.source.as_ref().is_some_and(PairCoordinate::is_angle)
     }
 
     /// The nodes of its pair.
     pub fn pair_nodes(&self) -> &[usize] {
-        &self.source.nodes
+        &self.nodes
+    }
+
+    /// The joint coordinate of a stop on one.
+    fn src(&self) -> &PairCoordinate {
+        self.source
+            .as_ref()
+            .expect("a stop without a plane is on a joint coordinate")
     }
 
     fn slot(&self, k: usize) -> usize {
-        self.offsets.internal + usize::from(self.source.is_angle()) + k
+        self.offsets.internal + usize::from(self.is_angle()) + k
     }
 
     /// Index of its multiplier among the state's multipliers.
@@ -214,7 +263,7 @@ impl Stop {
     }
 
     fn reference(&self, state: &State) -> f64 {
-        if self.source.is_angle() {
+        if self.is_angle() {
             state.internal[self.offsets.internal]
         } else {
             0.0
@@ -224,7 +273,10 @@ impl Stop {
     /// The coordinate `c` at `state` (an angle on the branch of the last
     /// converged state).
     pub fn coordinate(&self, state: &State) -> f64 {
-        self.source.value(state, self.reference(state))
+        match &self.plane {
+            Some(p) => p.normal.dot(&(state.x[p.node] - p.point)) - p.radius,
+            None => self.src().value(state, self.reference(state)),
+        }
     }
 
     /// The smaller gap, `min(c − c_min, c_max − c)`, and the limit it is
@@ -272,16 +324,22 @@ impl Stop {
     /// `ċ = B v`: the rate of the coordinate at the state's velocities,
     /// and its gradient `B` over the pair's local unknowns (6 per node).
     pub fn rate(&self, state: &State) -> (f64, Vec<f64>) {
-        let n = 6 * self.source.nodes.len();
+        if let Some(p) = &self.plane {
+            // B = [nᵀ 0]: ġ = n·ẋ
+            let v = state.velocity[p.node];
+            let grad = vec![p.normal.x, p.normal.y, p.normal.z, 0.0, 0.0, 0.0];
+            return (p.normal.dot(&Vec3::new(v[0], v[1], v[2])), grad);
+        }
+        let n = 6 * self.src().nodes.len();
         let mut grad = vec![0.0; n];
         with_scratch(|sc| {
-            sc.local.gather(state, &self.source.nodes, 0..0);
+            sc.local.gather(state, &self.src().nodes, 0..0);
             let mut v = [0.0];
-            let f = self.source.function(self.reference(state));
+            let f = self.src().function(self.reference(state));
             sc.local.gradient(1, &self.active, &f, &mut v, &mut grad);
         });
         let mut rate = 0.0;
-        for (k, &node) in self.source.nodes.iter().enumerate() {
+        for (k, &node) in self.src().nodes.iter().enumerate() {
             for c in 0..6 {
                 rate += grad[6 * k + c] * state.velocity[node][c];
             }
@@ -290,7 +348,7 @@ impl Stop {
     }
 
     fn kind_of_equation(&self) -> Equation {
-        if self.source.is_angle() {
+        if self.is_angle() {
             Equation::Moment
         } else {
             Equation::Force
@@ -311,7 +369,7 @@ impl Element for Stop {
         self.id
     }
     fn nodes(&self) -> &[usize] {
-        &self.source.nodes
+        &self.nodes
     }
     fn n_multipliers(&self) -> usize {
         1
@@ -320,7 +378,7 @@ impl Element for Stop {
     /// number of events, the largest load carried, the coordinate where
     /// it closed.
     fn n_internal(&self) -> usize {
-        usize::from(self.source.is_angle()) + 4
+        usize::from(self.is_angle()) + 4
     }
     fn set_offsets(&mut self, offsets: Offsets) {
         self.offsets = offsets;
@@ -335,7 +393,7 @@ impl Element for Stop {
         Some(self)
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
-        let nq = 6 * self.source.nodes.len();
+        let nq = 6 * self.nodes.len();
         let contact = self.contact(state);
         if contact == Contact::Open {
             // open: k λ = 0
@@ -346,8 +404,33 @@ impl Element for Stop {
             }
             return;
         }
+        if let Some(p) = &self.plane {
+            // closed: Φ = n·(x − p) − r − g_c, linear in x: residual
+            // nᵀ(pΦ − kλ) on x, −kΦ on the multiplier row; tangent
+            // p n nᵀ, −k n (no curvature term)
+            let (k, pen) = self.scaling(ctx);
+            let phi = self.coordinate(state) - self.held_value(state);
+            let lambda = state.multipliers[self.offsets.multipliers];
+            let n = [p.normal.x, p.normal.y, p.normal.z];
+            let w = pen * phi - k * lambda;
+            for (c, nc) in n.iter().enumerate() {
+                out.residual[c] += nc * w;
+            }
+            out.residual[nq] += -k * phi;
+            if let Some(t) = out.stiffness.as_deref_mut() {
+                let size = nq + 1;
+                for (c, nc) in n.iter().enumerate() {
+                    t[nq * size + c] += -k * nc;
+                    t[c * size + nq] += -k * nc;
+                    for (r, nr) in n.iter().enumerate() {
+                        t[c * size + r] += pen * nc * nr;
+                    }
+                }
+            }
+            return;
+        }
         // closed: Φ = c(q) − c_c
-        let c = self.source.function(self.reference(state));
+        let c = self.src().function(self.reference(state));
         let value = self.held_value(state);
         let phi = |conf: &Conf, o: &mut [HyperDual]| {
             c(conf, o);
@@ -356,7 +439,7 @@ impl Element for Stop {
         let m = self.offsets.multipliers;
         let lambda = &state.multipliers[m..m + 1];
         with_scratch(|sc| {
-            sc.local.gather(state, &self.source.nodes, 0..0);
+            sc.local.gather(state, &self.src().nodes, 0..0);
             add_constraints(
                 ctx,
                 &mut sc.local,
@@ -372,9 +455,9 @@ impl Element for Stop {
     }
     fn update_internal(&self, ctx: &EvalContext, state: &State, internal: &mut [f64]) {
         // the contact and the events are set by the analysis
-        let first = usize::from(self.source.is_angle());
-        if self.source.is_angle() {
-            internal[0] = self.source.value(state, internal[0]);
+        let first = usize::from(self.is_angle());
+        if self.is_angle() {
+            internal[0] = self.src().value(state, internal[0]);
         }
         if self.contact(state) != Contact::Open {
             let n = self.load(ctx, state).abs();

@@ -251,3 +251,326 @@ fn a_ball_bounces_on_a_plane_and_comes_to_rest() {
     // the energy balance holds through the impacts (1e-6 of m g h)
     assert!(out.energies.balance_error.abs() <= 1e-6 * MASS * G * h);
 }
+
+/// A ball dropped from z₀ = 1 m (its centre) on the plane through the
+/// origin tilted by α = 30° about x (normal n = (0, −sin α, cos α)),
+/// frictionless. It falls vertically through d = z₀ − r/cos α to the
+/// plane, v⁻ = (0, 0, −√(2gd)); the impact reverses the normal component
+/// times e and keeps the tangential one: v⁺ = v⁻ − (1 + e)(n·v⁻) n
+/// (Newton's law with the impulse along n). Its normal motion is then the
+/// bouncing ball under g cos α; once the contact closes it slides down
+/// the slope with the acceleration g sin α, the contact force m g cos α.
+#[test]
+fn a_ball_bounces_on_a_tilted_plane_and_slides_down() {
+    let (e, alpha, z0) = (0.5, 30f64.to_radians(), 1.0);
+    let n = Vec3::new(0.0, -alpha.sin(), alpha.cos());
+    let (model, out, rec) = run(&ball(
+        1.6,
+        [0.0, 0.0, z0],
+        &format!(
+            "type = \"plane\"\nnode = 1\nnormal = [0.0, {}, {}]\nradius = {RADIUS}\nrestitution = {e}",
+            n.y, n.z
+        ),
+        "",
+    ));
+    eprintln!(
+        "{} events, {} steps; last {:?} at {}",
+        rec.contacts.len(),
+        out.steps,
+        rec.contacts.last().map(|c| c.kind),
+        rec.contacts.last().map_or(0.0, |c| c.time)
+    );
+    let d = z0 - RADIUS / alpha.cos();
+    let v_minus = Vec3::new(0.0, 0.0, -(2.0 * G * d).sqrt());
+    let first = &rec.contacts[0];
+    assert_eq!(first.kind, ContactKind::Impact);
+    // the approach rate n·v⁻ (1e-6 relative: the integration of the fall)
+    let vn = n.dot(&v_minus);
+    assert!(
+        (first.rate_before - vn).abs() <= 1e-6 * vn.abs(),
+        "{first:?}"
+    );
+    assert!((first.rate_after + e * first.rate_before).abs() <= 1e-6 * vn.abs());
+    // the velocity after the impact (the state recorded at its step),
+    // against v⁻ − (1 + e)(n·v⁻) n: 1e-6 of |v⁻|
+    let after = &rec
+        .steps
+        .iter()
+        .find(|(i, _)| i.time == first.time)
+        .expect("the impact's step")
+        .1;
+    let v_plus = v_minus - n * ((1.0 + e) * vn);
+    let v = translation(after, 0);
+    eprintln!("v⁺ = {v:?}, expected {v_plus:?}");
+    assert!((v - v_plus).norm() <= 1e-6 * v_minus.norm());
+    // the tangential velocity is kept by the impact (frictionless):
+    // against the exact one, 1e-6 of |v⁻|
+    let tangential = |v: Vec3| v - n * n.dot(&v);
+    assert!((tangential(v) - tangential(v_minus)).norm() <= 1e-6 * v_minus.norm());
+    // the loss of each impact: (1 − e²) ½ m (n·v⁻)² (1e-10 relative)
+    for c in rec
+        .contacts
+        .iter()
+        .filter(|c| c.kind == ContactKind::Impact)
+    {
+        let loss = (1.0 - e * e) * 0.5 * MASS * c.rate_before.powi(2);
+        assert!((c.energy_lost - loss).abs() <= 1e-10 * loss, "{c:?}");
+    }
+    // at rest on the plane: closed once, no chattering (≤ 15 events)
+    let last = rec.contacts.last().unwrap();
+    assert_eq!(last.kind, ContactKind::Close);
+    assert!(rec.contacts.len() <= 15, "{}", rec.contacts.len());
+    let sliding: Vec<&(IncrementInfo, State)> = rec
+        .steps
+        .iter()
+        .filter(|(i, _)| i.time > last.time)
+        .collect();
+    assert!(sliding.len() > 10);
+    let c = contact(&model);
+    let down = Vec3::new(0.0, -alpha.cos(), -alpha.sin());
+    for w in sliding.windows(2) {
+        let ((i0, s0), (i1, s1)) = (w[0], w[1]);
+        // the contact force m g cos α: 1e-7 relative (measured: within
+        // 1.7e-8, alternating from step to step, the multiplier of index-3
+        // integration as the steps grow to 0.1 s after the contact
+        // closed); the gap within the event tolerance
+        let f = force(&model, s1);
+        assert!(
+            (f - MASS * G * alpha.cos()).abs() <= 1e-7 * MASS * G,
+            "t = {}: {f}",
+            i1.time
+        );
+        assert!(c.coordinate(s1).abs() <= GAP_TOLERANCE);
+        // the acceleration down the slope g sin α, from the velocities
+        // (1e-6 relative: exact for a constant acceleration up to the
+        // round-off of the differences)
+        let a = down.dot(&(translation(s1, 0) - translation(s0, 0))) / (i1.time - i0.time);
+        assert!(
+            (a - G * alpha.sin()).abs() <= 1e-6 * G,
+            "t = {}: {a}",
+            i1.time
+        );
+        // no velocity across the plane
+        assert!(n.dot(&translation(s1, 0)).abs() <= 1e-8);
+    }
+    let worst = rec
+        .steps
+        .iter()
+        .fold(0.0f64, |m, (_, s)| m.max(-c.coordinate(s)));
+    eprintln!("largest penetration {worst:.3e} m");
+    assert!(worst <= GAP_TOLERANCE);
+}
+
+/// The ball resting on the plane at the start (closed without impact) is
+/// pulled up by a force growing as 2 m g t: the contact force
+/// N = m g (1 − 2t) falls to zero at t = 0.5, where the contact opens (a
+/// release, located on N = 0 within 1e-6 of the largest force); the ball
+/// then rises with z̈ = g (2t − 1): its gap is g (t − ½)³/3.
+#[test]
+fn a_contact_with_a_plane_is_released_when_its_force_vanishes() {
+    let text = ball(
+        0.7,
+        [0.0, 0.0, RADIUS],
+        &format!("type = \"plane\"\nnode = 1\nnormal = [0.0, 0.0, 1.0]\nradius = {RADIUS}"),
+        &format!(
+            "[[loads]]\nnode = 1\nforce = [0.0, 0.0, {}]\ncurve = \"ramp\"\n",
+            2.0 * MASS * G
+        ),
+    );
+    let (model, _, rec) = run(&text);
+    assert_eq!(rec.contacts.len(), 1, "{:?}", rec.contacts);
+    let c = &rec.contacts[0];
+    assert_eq!(c.kind, ContactKind::Release);
+    // N is linear in t: located to round-off (1e-9)
+    assert!((c.time - 0.5).abs() <= 1e-9, "{}", c.time);
+    let contact = contact(&model);
+    for (i, s) in rec.steps.iter().filter(|(i, _)| i.time < 0.45) {
+        let n = force(&model, s);
+        assert!(
+            (n - MASS * G * (1.0 - 2.0 * i.time)).abs() <= 1e-6 * MASS * G,
+            "t = {}: {n}",
+            i.time
+        );
+        assert!(contact.coordinate(s).abs() <= GAP_TOLERANCE);
+    }
+    // gap(0.7) = g (0.2)³/3 within the integration's error (1e-3
+    // relative, error_tolerance left at its default)
+    let s = &rec.steps.last().unwrap().1;
+    let gap = G * 0.2f64.powi(3) / 3.0;
+    eprintln!("gap(0.7) = {} (closed form {gap})", contact.coordinate(s));
+    assert!((contact.coordinate(s) - gap).abs() <= 1e-3 * gap);
+}
+
+/// Two spheres on free nodes (rigid bodies, no gravity): A (radius 0.2,
+/// mass m_a) at the origin moving at v_a along x, B (radius 0.3, mass m_b)
+/// at x = 1 moving at v_b, extra tables `extra`.
+fn spheres(end_time: f64, m: [f64; 2], v: [f64; 2], e: f64, extra: &str) -> String {
+    format!(
+        r#"
+[analysis]
+type = "dynamic"
+end_time = {end_time}
+time_step = 0.01
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 2
+x = [1.0, 0.0, 0.0]
+
+[[rigid_bodies]]
+id = 1
+node = 1
+mass = {}
+inertia = [0.01, 0.01, 0.01]
+
+[[rigid_bodies]]
+id = 2
+node = 2
+mass = {}
+inertia = [0.02, 0.02, 0.02]
+
+[[contacts]]
+id = 40
+type = "spheres"
+nodes = [1, 2]
+radii = [0.2, 0.3]
+restitution = {e}
+
+[[initial_motion]]
+nodes = [1]
+velocity = [{}, 0.0, 0.0]
+
+[[initial_motion]]
+nodes = [2]
+velocity = [{}, 0.0, 0.0]
+{extra}
+"#,
+        m[0], m[1], v[0], v[1]
+    )
+}
+
+/// Head-on collision: the gap 0.5 closes at 1.5 m/s, so the spheres meet
+/// at t = 1/3; the impact reverses the relative rate times e, conserves
+/// momentum, v_a⁺ = v_a − (1 + e) m_b/(m_a + m_b) (v_a − v_b) (and
+/// symmetrically for B), and dissipates (1 − e²) ½ μ (v_a − v_b)²,
+/// μ = m_a m_b/(m_a + m_b), with the impulse μ (1 + e)(v_a − v_b).
+#[test]
+fn two_spheres_collide_head_on() {
+    let (m, v, e) = ([1.0, 3.0], [1.0, -0.5], 0.8);
+    let (model, _, rec) = run(&spheres(0.8, m, v, e, ""));
+    assert_eq!(rec.contacts.len(), 1, "{:?}", rec.contacts);
+    let c = &rec.contacts[0];
+    eprintln!("{c:?}");
+    assert_eq!(c.kind, ContactKind::Impact);
+    assert_eq!((c.stop, c.joint), (40, None));
+    let closing = v[0] - v[1];
+    // time: within the event tolerance over the speed (1e-8 m / 1.5 m/s)
+    assert!((c.time - 0.5 / closing).abs() <= 1e-8, "{}", c.time);
+    assert!(c.coordinate.abs() <= GAP_TOLERANCE);
+    // the relative rate, exact in free flight (1e-10), reversed times e
+    // (1e-10: the impact is linear algebra)
+    assert!((c.rate_before + closing).abs() <= 1e-10 * closing);
+    assert!((c.rate_after + e * c.rate_before).abs() <= 1e-10 * closing);
+    let mu = m[0] * m[1] / (m[0] + m[1]);
+    let loss = (1.0 - e * e) * 0.5 * mu * closing * closing;
+    assert!(
+        (c.energy_lost - loss).abs() <= 1e-10 * loss,
+        "{}",
+        c.energy_lost
+    );
+    let impulse = mu * (1.0 + e) * closing;
+    assert!((c.impulse - impulse).abs() <= 1e-10 * impulse);
+    // momentum at every accepted state: 1e-10 of Σ m|v|
+    let p0 = m[0] * v[0] + m[1] * v[1];
+    let scale = m[0] * v[0].abs() + m[1] * v[1].abs();
+    for (i, s) in &rec.steps {
+        let p = m[0] * s.velocity[0][0] + m[1] * s.velocity[1][0];
+        assert!((p - p0).abs() <= 1e-10 * scale, "t = {}: {p}", i.time);
+        for node in 0..2 {
+            for k in 1..6 {
+                assert!(s.velocity[node][k].abs() <= 1e-12, "t = {}", i.time);
+            }
+        }
+    }
+    // the velocities after (1e-10 relative)
+    let s = &rec.steps.last().unwrap().1;
+    let va = v[0] - (1.0 + e) * m[1] / (m[0] + m[1]) * closing;
+    let vb = v[1] + (1.0 + e) * m[0] / (m[0] + m[1]) * closing;
+    eprintln!(
+        "v_a⁺ = {} ({va}), v_b⁺ = {} ({vb})",
+        s.velocity[0][0], s.velocity[1][0]
+    );
+    assert!((s.velocity[0][0] - va).abs() <= 1e-10 * closing);
+    assert!((s.velocity[1][0] - vb).abs() <= 1e-10 * closing);
+    // they part: the gap grows at e × 1.5 m/s after the impact
+    let gap = contact(&model).coordinate(s);
+    let expected = (0.8 - c.time) * e * closing;
+    assert!((gap - expected).abs() <= 1e-8, "{gap} {expected}");
+}
+
+/// A plastic collision (e = 0) with A pushed towards B by a force F: the
+/// contact closes and stays closed, both move together with the common
+/// velocity v_c of the impact (momentum) and the acceleration
+/// F/(m_a + m_b), and the contact carries N = m_b F/(m_a + m_b)
+/// (persistent contact between two nodes).
+#[test]
+fn two_spheres_stay_in_contact_when_pushed_together() {
+    let (m, v, f) = ([1.0, 3.0], [1.0, -0.5], 2.0);
+    let (model, _, rec) = run(&spheres(
+        0.8,
+        m,
+        v,
+        0.0,
+        &format!("\n[[loads]]\nnode = 1\nforce = [{f}, 0.0, 0.0]\ncurve = \"constant\"\n"),
+    ));
+    assert_eq!(rec.contacts.len(), 1, "{:?}", rec.contacts);
+    let c = &rec.contacts[0];
+    assert_eq!(c.kind, ContactKind::Close);
+    // the relative rate stopped (round-off of the impact solve)
+    assert!(c.rate_after.abs() <= 1e-10 * c.rate_before.abs(), "{c:?}");
+    let contact = contact(&model);
+    let (i_c, s_c) = rec
+        .steps
+        .iter()
+        .find(|(i, _)| i.time == c.time)
+        .expect("the impact's step");
+    // the common velocity after the plastic impact: momentum (1e-10)
+    let v_c = (m[0] * s_c.velocity[0][0] + m[1] * s_c.velocity[1][0]) / (m[0] + m[1]);
+    assert!((s_c.velocity[0][0] - v_c).abs() <= 1e-10);
+    assert!((s_c.velocity[1][0] - v_c).abs() <= 1e-10);
+    let a = f / (m[0] + m[1]);
+    let expected = m[1] * f / (m[0] + m[1]);
+    let mut worst = 0.0f64;
+    let after: Vec<_> = rec.steps.iter().filter(|(i, _)| i.time > c.time).collect();
+    assert!(after.len() > 5);
+    for (i, s) in after {
+        // closed, the gap held within the event tolerance
+        assert!(contact.coordinate(s).abs() <= GAP_TOLERANCE);
+        // both move as one: x(t) = x(t_c) + v_c τ + a τ²/2 (1e-9 m: the
+        // relative velocity of index-3 integration, below 6e-6 m/s,
+        // alternates and does not accumulate)
+        let tau = i.time - i_c.time;
+        for node in 0..2 {
+            let x = s_c.x[node].x + v_c * tau + 0.5 * a * tau * tau;
+            assert!(
+                (s.x[node].x - x).abs() <= 1e-9 + 1e-6 * a * tau * tau,
+                "t = {}",
+                i.time
+            );
+        }
+        // N = m_b F/(m_a + m_b): 2e-2 relative (measured: within 7.4e-3,
+        // alternating from step to step: the multiplier of index-3
+        // integration after a contact landed with a step of 1e-6 s)
+        let n = force(&model, s);
+        worst = worst.max((n - expected).abs() / expected);
+        assert!(
+            (n - expected).abs() <= 2e-2 * expected,
+            "t = {}: {n}",
+            i.time
+        );
+    }
+    eprintln!("contact force within {worst:.2e} of m_b F/(m_a + m_b)");
+}

@@ -574,3 +574,226 @@ fn two_spheres_stay_in_contact_when_pushed_together() {
     }
     eprintln!("contact force within {worst:.2e} of m_b F/(m_a + m_b)");
 }
+
+fn error_of(text: &str) -> String {
+    let input: ModelInput = toml::from_str(text).expect("valid toml");
+    match Model::from_input(&input) {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// Input errors name the file, the contact and what is wrong; `unfold
+/// check` refuses them with exit code 2.
+#[test]
+fn contact_input_errors_name_the_contact() {
+    let plane = |keys: &str, z: f64| ball(1.0, [0.0, 0.0, z], keys, "");
+    let cases = [
+        (
+            plane("type = \"plane\"\nnode = 7\nnormal = [0.0, 0.0, 1.0]", 1.0),
+            "node 7 does not exist",
+        ),
+        (
+            plane("type = \"plane\"\nnode = 1\nnormal = [0.0, 0.0, 0.0]", 1.0),
+            "normal must be a non-zero finite vector",
+        ),
+        (
+            plane("type = \"plane\"\nnode = 1", 1.0),
+            "a contact with a plane needs `normal`",
+        ),
+        (
+            plane(
+                "type = \"plane\"\nnode = 1\nnormal = [0.0, 0.0, 1.0]\nradius = -0.1",
+                1.0,
+            ),
+            "radius must be zero or positive and finite, got -0.1",
+        ),
+        (
+            plane(
+                "type = \"plane\"\nnode = 1\nnormal = [0.0, 0.0, 1.0]\nrestitution = 1.5",
+                1.0,
+            ),
+            "restitution must be in [0, 1], got 1.5",
+        ),
+        (
+            plane(
+                "type = \"plane\"\nnode = 1\nnormal = [0.0, 0.0, 1.0]\nrestitution = -0.2",
+                1.0,
+            ),
+            "restitution must be in [0, 1], got -0.2",
+        ),
+        (
+            plane(
+                "type = \"plane\"\nnode = 1\nnormal = [0.0, 0.0, 1.0]\nradius = 0.1",
+                0.05,
+            ),
+            "the sphere on node 1 penetrates the plane in the reference configuration: its gap n·(x − p) − r is -5.000e-2 m",
+        ),
+        (
+            plane(
+                "type = \"plane\"\nnode = 1\nnormal = [0.0, 0.0, 1.0]\nradii = [0.1, 0.1]",
+                1.0,
+            ),
+            "`radii` belong to type = \"spheres\"",
+        ),
+        (
+            spheres(1.0, [1.0, 1.0], [0.0, 0.0], 0.5, "")
+                .replace("radii = [0.2, 0.3]", "radii = [0.6, 0.5]"),
+            "the spheres on nodes 1 and 2 penetrate each other in the reference configuration: their gap |x_b − x_a| − r_a − r_b is -1.000e-1 m",
+        ),
+        (
+            spheres(1.0, [1.0, 1.0], [0.0, 0.0], 0.5, "")
+                .replace("nodes = [1, 2]\nradii", "nodes = [1, 1]\nradii"),
+            "the two spheres are on the same node 1",
+        ),
+        (
+            spheres(1.0, [1.0, 1.0], [0.0, 0.0], 0.5, "")
+                .replace("nodes = [1, 2]\nradii", "nodes = [1, 9]\nradii"),
+            "node 9 does not exist",
+        ),
+        (
+            spheres(1.0, [1.0, 1.0], [0.0, 0.0], 0.5, "")
+                .replace("radii = [0.2, 0.3]", "radii = [0.2, -0.3]"),
+            "radii[2] must be zero or positive and finite, got -0.3",
+        ),
+        (
+            spheres(1.0, [1.0, 1.0], [0.0, 0.0], 0.5, "")
+                .replace("nodes = [1, 2]\nradii", "nodes = [1, 2, 3]\nradii"),
+            "nodes must be two node ids, got 3 of them",
+        ),
+    ];
+    let dir = std::env::temp_dir().join(format!("unfold-contacts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (k, (text, expected)) in cases.iter().enumerate() {
+        let message = error_of(text);
+        assert!(message.contains("contact "), "{message}");
+        assert!(message.contains(expected), "{message}");
+        let file = dir.join(format!("case{k}.toml"));
+        std::fs::write(&file, text).unwrap();
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_unfold"))
+            .arg("check")
+            .arg(&file)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{stderr}");
+        // the file, the entity and the problem
+        assert!(stderr.contains(&format!("case{k}.toml")), "{stderr}");
+        assert!(
+            stderr.contains("contact 30") || stderr.contains("contact 40"),
+            "{stderr}"
+        );
+        assert!(stderr.contains(expected), "{stderr}");
+    }
+    // an unknown type is refused by the reader (exit code 2)
+    let file = dir.join("type.toml");
+    std::fs::write(
+        &file,
+        plane("type = \"cone\"\nnode = 1\nnormal = [0.0, 0.0, 1.0]", 1.0),
+    )
+    .unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .arg("check")
+        .arg(&file)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("cone") && stderr.contains("plane"),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A run of the ball writes its contact's results to `contacts.csv` and
+/// its events to `events.csv`, the contact as the element and the joint
+/// column empty.
+#[test]
+fn a_run_writes_contacts_and_events() {
+    let dir = std::env::temp_dir().join(format!("unfold-contacts-run-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("ball.toml");
+    std::fs::write(
+        &file,
+        ball(
+            0.6,
+            [0.0, 0.0, 1.0 + RADIUS],
+            &format!(
+                "type = \"plane\"\nnode = 1\nnormal = [0.0, 0.0, 1.0]\nradius = {RADIUS}\nrestitution = 0.5"
+            ),
+            "",
+        ),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args(["run", "--quiet"])
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let contacts = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
+    let mut lines = contacts.lines();
+    assert_eq!(lines.next(), Some("step,time,contact,gap,closed,force"));
+    assert!(lines.all(|l| l.split(',').nth(2) == Some("30")));
+    let events = std::fs::read_to_string(out.join("events.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = events
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    eprintln!("{events}");
+    // one impact at t = √(2/g) = 0.4515 (the next at 0.903 is past the end)
+    assert_eq!(rows.len(), 1, "{events}");
+    assert_eq!((rows[0][3], rows[0][4], rows[0][5]), ("30", "impact", ""));
+    let t: f64 = rows[0][2].parse().unwrap();
+    assert!((t - (2.0 / G).sqrt()).abs() <= 1e-6, "{t}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The builder writes `[[contacts]]`; the contact's results in the
+/// reference configuration: open, the gap.
+#[test]
+fn the_builder_writes_the_contact_entries() {
+    use unfold::elements::ElementKind;
+    use unfold::model::builder::*;
+    let mut m = ModelBuilder::new("two balls above a plane");
+    m.analysis(Analysis::dynamic());
+    let a = m.node([0.0, 0.0, 1.0]);
+    let b = m.node([0.0, 0.0, 2.0]);
+    m.add(RigidBody::at(a, 1.0).inertia([0.01, 0.01, 0.01]));
+    m.add(RigidBody::at(b, 1.0).inertia([0.01, 0.01, 0.01]));
+    let floor = m.add(
+        Contact::plane(a, [0.0, 0.0, 0.0], [0.0, 0.0, 2.0])
+            .radius(0.25)
+            .restitution(0.7),
+    );
+    let pair = m.add(Contact::spheres(a, b).radii(0.25, 0.5).restitution(0.2));
+    let model = m.build().unwrap();
+    assert_eq!(model.element(floor).kind(), ElementKind::Contact);
+    let r = model.results(floor, &model.initial_state());
+    assert_eq!(r.get("closed"), Some(0.0));
+    assert_eq!(r.get("force"), Some(0.0));
+    // the normal is made unit: g = 1 − 0.25 (round-off)
+    assert!((r.get("gap").unwrap() - 0.75).abs() < 1e-15);
+    let r = model.results(pair, &model.initial_state());
+    assert!((r.get("gap").unwrap() - 0.25).abs() < 1e-15);
+    let text = m.to_toml().unwrap();
+    assert!(
+        text.contains("[[contacts]]")
+            && text.contains("type = \"spheres\"")
+            && text.contains("restitution = 0.7"),
+        "{text}"
+    );
+    let input: ModelInput = toml::from_str(&text).unwrap();
+    assert_eq!(input.contacts.len(), 2);
+    assert!(Model::from_input(&input).is_ok());
+}

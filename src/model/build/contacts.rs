@@ -136,9 +136,8 @@ impl Builder<'_> {
                 ModelErrorKind::Invalid,
                 entity,
                 format!(
-                    "the sphere on node {} penetrates the plane in the reference configuration: its gap n·(x − p) − r is {} m (the centre must be at least the radius {} from the plane, on the side of the normal)",
+                    "the sphere on node {} penetrates the plane in the reference configuration: its gap n·(x − p) − r is {g:.3e} m (the centre must be at least the radius {} from the plane, on the side of the normal)",
                     self.node_ids[node],
-                    num(g),
                     num(radius)
                 ),
             );
@@ -204,10 +203,9 @@ impl Builder<'_> {
                 ModelErrorKind::Invalid,
                 entity,
                 format!(
-                    "the spheres on nodes {} and {} penetrate each other in the reference configuration: their gap |x_b − x_a| − r_a − r_b is {} m",
+                    "the spheres on nodes {} and {} penetrate each other in the reference configuration: their gap |x_b − x_a| − r_a − r_b is {g:.3e} m",
                     ids[0],
-                    ids[1],
-                    num(g)
+                    ids[1]
                 ),
             );
             return None;

@@ -87,7 +87,10 @@ pub const CONTACT_RESULTS: [&str; 3] = ["gap", "closed", "force"];
 #[derive(Clone, Debug)]
 enum Watched {
     /// A coordinate of joint `joint`.
-    Joint { joint: Id, source: PairCoordinate },
+    Joint {
+        joint: Id,
+        source: Box<PairCoordinate>,
+    },
     /// The gap of a sphere against a fixed plane.
     Plane(Plane),
     /// The gap between two spheres.
@@ -185,7 +188,10 @@ impl Stop {
         let nodes = source.nodes.clone();
         Self {
             id,
-            watched: Watched::Joint { joint, source },
+            watched: Watched::Joint {
+                joint,
+                source: Box::new(source),
+            },
             nodes,
             lower,
             upper,

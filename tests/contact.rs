@@ -658,6 +658,11 @@ fn contact_input_errors_name_the_contact() {
         ),
         (
             spheres(1.0, [1.0, 1.0], [0.0, 0.0], 0.5, "")
+                .replace("radii = [0.2, 0.3]", "radii = [0.0, 0.0]"),
+            "radii are both zero",
+        ),
+        (
+            spheres(1.0, [1.0, 1.0], [0.0, 0.0], 0.5, "")
                 .replace("nodes = [1, 2]\nradii", "nodes = [1, 2, 3]\nradii"),
             "nodes must be two node ids, got 3 of them",
         ),

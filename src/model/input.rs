@@ -469,7 +469,7 @@ pub struct ContactInput {
     /// The two nodes at the spheres' centres (`spheres`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nodes: Option<Vec<Id>>,
-    /// The spheres' radii (m), default `[0, 0]` (`spheres`).
+    /// The spheres' radii (m), not both zero (`spheres`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub radii: Option<Vec<f64>>,
     /// Coefficient of restitution `e ∈ [0, 1]`, default 0 (plastic).

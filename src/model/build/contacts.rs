@@ -169,7 +169,14 @@ impl Builder<'_> {
             );
             return None;
         }
-        let radii = c.radii.clone().unwrap_or(vec![0.0, 0.0]);
+        let Some(radii) = &c.radii else {
+            self.ck.push(
+                ModelErrorKind::Missing,
+                entity,
+                "a contact of spheres needs `radii` (the spheres' radii, [r_a, r_b])",
+            );
+            return None;
+        };
         if radii.len() != 2 {
             self.ck.push(
                 ModelErrorKind::Invalid,
@@ -185,6 +192,14 @@ impl Builder<'_> {
         let (Some(a), Some(b), Some(ra), Some(rb)) = (a, b, ra, rb) else {
             return None;
         };
+        if ra + rb == 0.0 {
+            self.ck.push(
+                ModelErrorKind::Invalid,
+                entity,
+                "radii are both zero: two points touch only where they coincide, where the contact has no normal; give the spheres their radii",
+            );
+            return None;
+        }
         if a == b {
             self.ck.push(
                 ModelErrorKind::Invalid,

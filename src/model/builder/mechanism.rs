@@ -569,8 +569,8 @@ impl Contact {
         }
     }
 
-    /// Points on nodes `a` and `b` (spheres of radius 0 until
-    /// [`Contact::radii`]).
+    /// Spheres centred on nodes `a` and `b`, whose radii
+    /// [`Contact::radii`] gives (required, not both zero).
     pub fn spheres(a: NodeHandle, b: NodeHandle) -> Self {
         Self {
             input: ContactInput {

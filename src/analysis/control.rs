@@ -318,6 +318,15 @@ impl StepController {
         self.size
     }
 
+    /// Sets the size the next step will try (within the bounds), as after
+    /// an impact whose rebound must be seen at its top (docs/theory.md
+    /// §16.4); the error estimate and the events size the steps after it.
+    pub fn set_size(&mut self, size: f64) {
+        if size.is_finite() && size > 0.0 {
+            self.size = size.clamp(self.bounds.min, self.bounds.max);
+        }
+    }
+
     /// The counts so far.
     pub fn counts(&self) -> StepCounts {
         self.counts

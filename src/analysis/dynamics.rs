@@ -310,6 +310,9 @@ struct Run {
     lock_rank_analyses: usize,
     /// The events of the stops so far.
     contacts: Vec<ContactInfo>,
+    /// The size of the step after a rebound from a stop: the time its
+    /// coordinate takes to rise to the top of its flight (§16.4).
+    rebound_step: Option<f64>,
     started: Instant,
     finished: bool,
     error: Option<DynamicError>,
@@ -523,6 +526,7 @@ impl DynamicAnalysis {
             locks: Vec::new(),
             lock_rank_analyses: 0,
             contacts: Vec::new(),
+            rebound_step: None,
             started,
             finished: false,
             error: None,
@@ -644,6 +648,9 @@ impl DynamicAnalysis {
         };
         let result = controller.advance(&mut stepper, observer);
         let run = stepper.run;
+        if let Some(size) = run.rebound_step.take() {
+            controller.set_size(size);
+        }
         run.controller = Some(controller);
         match result {
             Ok(Advance::Accepted(info)) => Step::Increment(info),
@@ -2208,6 +2215,7 @@ impl Dynamics<'_> {
         run.a_before.clear();
         run.a_before_coordinates.clear();
         run.balance.impact(i.energy_lost, i.work);
+        run.rebound_step = i.rebound_step;
         Ok(i.events)
     }
 }

@@ -517,8 +517,9 @@ pub struct ContactInfo {
     pub time: f64,
     /// The stop.
     pub stop: Id,
-    /// The joint whose coordinate it limits.
-    pub joint: Id,
+    /// The joint whose coordinate it limits (`None` for a contact with a
+    /// plane).
+    pub joint: Option<Id>,
     /// What happened.
     pub kind: ContactKind,
     /// The coordinate at the event.
@@ -595,10 +596,10 @@ impl EventFunction for StopEvent {
 pub fn stop_events(model: &Model) -> Vec<Box<dyn EventFunction>> {
     let mut events: Vec<Box<dyn EventFunction>> = Vec::new();
     for (element, e) in model.elements.iter().enumerate() {
-        if e.as_stop().is_some() {
+        if let Some(s) = e.as_stop() {
             events.push(Box::new(StopEvent {
                 element,
-                name: format!("stop {}", e.id()),
+                name: format!("{} {}", s.noun(), e.id()),
             }));
         }
     }
@@ -615,18 +616,24 @@ pub struct ContactImpact {
     pub energy_lost: f64,
     /// Work of the impulses through drivers and prescribed motions.
     pub work: f64,
+    /// The time to the top of the shortest rebound (`e|ċ⁻|/|c̈|`), the
+    /// size of the next step, so that the step lands where the coordinate
+    /// is out of the event band (none without a rebound under an
+    /// acceleration).
+    pub rebound_step: Option<f64>,
 }
 
 /// The error of an impact at stops.
 fn stop_failure(model: &Model, stops: &[&Stop], time: f64, why: Singular) -> DynamicError {
     let latches = stops
         .iter()
-        .map(|s| format!("stop {}", s.id()))
+        .map(|s| format!("{} {}", s.noun(), s.id()))
         .collect::<Vec<_>>()
         .join(", ");
     let reason = match why {
         Singular::Massless(node, c) => format!(
-            "the impulse of the stop acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies the joint joins their mass",
+            "the impulse of the {} acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies it acts on their mass (rigid bodies, point masses or beams at its nodes)",
+            stops[0].noun(),
             model.node_ids[node],
             crate::model::COMPONENT_NAMES[c]
         ),
@@ -697,10 +704,13 @@ pub fn stop_events_at(
         .iter()
         .copied()
         .filter(|s| {
+            let (w0, w1) = (stop_watch(model, s, before), stop_watch(model, s, state));
+            // reached from above the event band; or found beyond it
+            // having never left it since a rebound (a flight out of the
+            // band and back within one step: struck where it is found)
             s.contact(state) == Contact::Open
                 && s.contact(before) == Contact::Open
-                && stop_watch(model, s, before) > 1.0
-                && stop_watch(model, s, state) <= 1.0
+                && ((w0 > 1.0 && w1 <= 1.0) || (w0 <= 1.0 && w1 < -1.0))
         })
         .collect();
     if reached.is_empty() {
@@ -716,6 +726,7 @@ pub fn stop_events_at(
             redundant: rank.redundant.len(),
             energy_lost: 0.0,
             work: 0.0,
+            rebound_step: None,
         }));
     }
     let failed = |why| stop_failure(model, &reached, time, why);
@@ -748,6 +759,8 @@ pub fn stop_events_at(
         /// The restitution applied: `e`, or 0 when the stop closes.
         e: f64,
         approaching: bool,
+        /// The time to the top of the rebound, `e|ċ⁻|/|c̈|`.
+        rise_time: f64,
     }
     let struck: Vec<Struck> = reached
         .iter()
@@ -757,8 +770,14 @@ pub fn stop_events_at(
             let (rate, grad) = s.rate(state);
             // the rate towards the limit
             let approach = -side.side() * rate;
-            let v_min = (2.0 * gap_tolerance(model, s) * a).sqrt();
-            let e = if s.restitution() * approach > v_min {
+            let tol = gap_tolerance(model, s);
+            let v_min = (2.0 * tol * a).sqrt();
+            // the top of the rebound's flight under the acceleration `a`,
+            // from the gap where the step landed (within ±tol): it must
+            // leave the event band
+            let rebound = s.restitution() * approach;
+            let top = s.gap(state).0 + rebound * rebound / (2.0 * a);
+            let e = if rebound > v_min && top > tol {
                 s.restitution()
             } else {
                 0.0
@@ -770,6 +789,7 @@ pub fn stop_events_at(
                 grad,
                 e,
                 approaching: approach > 0.0,
+                rise_time: e * approach / a,
             }
         })
         .collect();
@@ -859,11 +879,17 @@ pub fn stop_events_at(
             kinetic_energy_drop: kinetic_consistent - kinetic_after,
         });
     }
+    let rebound_step = struck
+        .iter()
+        .filter(|k| k.e > 0.0 && k.approaching && k.rise_time.is_finite())
+        .map(|k| k.rise_time)
+        .reduce(f64::min);
     Ok(Some(ContactImpact {
         events,
         redundant,
         energy_lost,
         work: kinetic_after - kinetic_consistent + energy_lost,
+        rebound_step,
     }))
 }
 

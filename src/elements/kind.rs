@@ -33,7 +33,9 @@ pub enum ElementKind {
     Latch,
     /// Unilateral stop of a joint coordinate (joint limits with impact).
     Stop,
-
+    /// Unilateral contact of a sphere on a node with a fixed plane or with
+    /// a sphere on another node.
+    Contact,
     /// Disc rolling without slipping on a plane.
     RollingDisc,
 }
@@ -63,7 +65,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 13] = [
+    pub const ALL: [ElementKind; 14] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -76,6 +78,7 @@ impl ElementKind {
         Self::Driver,
         Self::Latch,
         Self::Stop,
+        Self::Contact,
         Self::RollingDisc,
     ];
 
@@ -94,7 +97,7 @@ impl ElementKind {
             Self::Driver => "driver",
             Self::Latch => "latch",
             Self::Stop => "stop",
-
+            Self::Contact => "contact",
             Self::RollingDisc => "rolling disc",
         }
     }
@@ -114,7 +117,7 @@ impl ElementKind {
             Self::HingeLaw => 10,
             Self::Latch => 11,
             Self::Stop => 12,
-
+            Self::Contact => 14,
             Self::RollingDisc => 13,
         }
     }
@@ -132,7 +135,7 @@ impl ElementKind {
             Self::HingeLaw => Some("hinge_laws.csv"),
             Self::Latch => Some("latches.csv"),
             Self::Stop => Some("stops.csv"),
-
+            Self::Contact => Some("contacts.csv"),
             Self::RollingDisc => Some("rolling.csv"),
             Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
@@ -145,7 +148,7 @@ impl ElementKind {
             Self::Driver => "driver",
             Self::Latch => "latch",
             Self::Stop => "stop",
-
+            Self::Contact => "contact",
             Self::RollingDisc => "joint",
             _ => "element",
         }

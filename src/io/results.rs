@@ -703,8 +703,9 @@ pub struct EventRow<'a> {
     pub element: crate::model::Id,
     /// `lock`, `impact`, `contact` or `release`.
     pub kind: &'a str,
-    /// The joint whose coordinate it watches.
-    pub joint: crate::model::Id,
+    /// The joint whose coordinate it watches (none for a contact with a
+    /// plane: the column is left empty).
+    pub joint: Option<crate::model::Id>,
     /// The coordinate at the event.
     pub coordinate: f64,
     /// The coordinate's rate before and after.
@@ -993,7 +994,7 @@ impl ResultWriter {
             row.time,
             row.element,
             row.kind,
-            row.joint,
+            row.joint.map_or(String::new(), |j| j.to_string()),
             row.coordinate,
             row.rate_before,
             row.rate_after,

@@ -929,18 +929,22 @@ impl Recorder {
     /// Appends `row` to `events.csv`; a write error fails the run at its
     /// end (the analysis goes on: its other results are being written).
     fn write_event(&mut self, row: &EventRow) {
-        let (element, what) = match row.kind {
-            "lock" => ("latch", "locks joint"),
-            "impact" => ("stop", "impact of joint"),
-            "contact" => ("stop", "contact closed on joint"),
-            _ => ("stop", "contact released on joint"),
+        // a contact between bodies watches no joint
+        let (element, on_joint, bare) = match row.kind {
+            "lock" => ("latch", "locks joint", "locks"),
+            "impact" => ("stop", "impact of joint", "impact"),
+            "contact" => ("stop", "contact closed on joint", "contact closed"),
+            _ => ("stop", "contact released on joint", "contact released"),
+        };
+        let (element, what) = match row.joint {
+            Some(j) => (element, format!("{on_joint} {j}")),
+            None => ("contact", bare.to_string()),
         };
         self.line(&format!(
-            "step {:4}  t = {:.6}: {element} {}: {what} {} at c = {:.6}: rate {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}",
+            "step {:4}  t = {:.6}: {element} {}: {what} at c = {:.6}: rate {:.6e} -> {:.6e}, impulse {:.6e}, energy lost {:.6e}",
             row.increment,
             row.time,
             row.element,
-            row.joint,
             row.coordinate,
             row.rate_before,
             row.rate_after,
@@ -1246,7 +1250,7 @@ impl Observer for Recorder {
             time: info.time,
             element: info.latch,
             kind: "lock",
-            joint: info.joint,
+            joint: Some(info.joint),
             coordinate: info.coordinate,
             rate_before: info.rate_before,
             rate_after: 0.0,

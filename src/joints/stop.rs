@@ -1,6 +1,9 @@
 //! Unilateral stops: limits on a joint coordinate `c_min ≤ c ≤ c_max`
 //! (the joint limits of the reference paper, eq. 16; docs/joints.md §6.3,
-//! docs/theory.md §16.4).
+//! docs/theory.md §16.4), and unilateral contacts, whose "coordinate" is
+//! the gap of a sphere on a node against a fixed plane or of two spheres
+//! on two nodes, limited below by 0 (docs/joints.md §6.4, docs/theory.md
+//! §16.5).
 //!
 //! The gaps `g_min = c − c_min` and `g_max = c_max − c` are non-negative
 //! while the stop is open. Open, a stop applies nothing: its one
@@ -29,6 +32,7 @@ use crate::elements::{
     CellShape, ConstraintKind, Element, ElementKind, ElementOutput, EvalContext, Offsets,
 };
 use crate::model::Id;
+use crate::so3::{Mat3, Vec3};
 use crate::state::State;
 
 /// Names of stop results: the coordinate, the contact (`−1` closed at the
@@ -75,13 +79,31 @@ impl Contact {
     }
 }
 
-/// A unilateral stop on a joint coordinate (see the module documentation).
+/// Names of contact results: the gap `g`, `1` closed (`0` open), and the
+/// normal contact force `N ≥ 0` (zero while open).
+pub const CONTACT_RESULTS: [&str; 3] = ["gap", "closed", "force"];
+
+/// What a stop watches.
+#[derive(Clone, Debug)]
+enum Watched {
+    /// A coordinate of joint `joint`.
+    Joint {
+        joint: Id,
+        source: Box<PairCoordinate>,
+    },
+    /// The gap of a sphere against a fixed plane.
+    Plane(Plane),
+    /// The gap between two spheres.
+    Spheres(Spheres),
+}
+
+/// A unilateral stop on a joint coordinate, or a unilateral contact (see
+/// the module documentation).
 #[derive(Clone, Debug)]
 pub struct Stop {
     id: Id,
-    /// The joint whose coordinate it limits.
-    joint: Id,
-    source: PairCoordinate,
+    watched: Watched,
+    nodes: Vec<usize>,
     /// `c_min`, `c_max` (`±∞` when absent).
     lower: f64,
     upper: f64,
@@ -89,6 +111,59 @@ pub struct Stop {
     restitution: f64,
     active: Vec<usize>,
     offsets: Offsets,
+}
+
+/// A sphere of radius `r` centred on a node against a fixed plane through
+/// `p` with unit normal `n` (pointing to the sphere's side): the
+/// "coordinate" of the contact is the gap `g = n·(x − p) − r` (reference
+/// paper, eq. 16), limited below by 0.
+#[derive(Clone, Copy, Debug)]
+pub struct Plane {
+    /// The node.
+    pub node: usize,
+    /// `n`, unit.
+    pub normal: Vec3,
+    /// `p`.
+    pub point: Vec3,
+    /// `r ≥ 0`.
+    pub radius: f64,
+}
+
+impl Plane {
+    /// `g = n·(x − p) − r` with the node at `x`.
+    pub fn gap(&self, x: &Vec3) -> f64 {
+        self.normal.dot(&(x - self.point)) - self.radius
+    }
+}
+
+/// Two spheres of radii `r_a`, `r_b` centred on nodes `a` and `b`: the
+/// "coordinate" of the contact is the gap `g = |x_b − x_a| − r_a − r_b`
+/// (reference paper, eq. 16), limited below by 0.
+#[derive(Clone, Copy, Debug)]
+pub struct Spheres {
+    /// The nodes `a`, `b` (distinct).
+    pub nodes: [usize; 2],
+    /// `r_a`, `r_b ≥ 0`.
+    pub radii: [f64; 2],
+}
+
+impl Spheres {
+    /// `g = |x_b − x_a| − r_a − r_b`.
+    pub fn gap(&self, xa: &Vec3, xb: &Vec3) -> f64 {
+        (xb - xa).norm() - self.radii[0] - self.radii[1]
+    }
+
+    /// `d = |x_b − x_a|` and `u = (x_b − x_a)/d` (zero when the centres
+    /// coincide, where the direction is not defined).
+    fn direction(state: &State, nodes: [usize; 2]) -> (f64, Vec3) {
+        let r = state.x[nodes[1]] - state.x[nodes[0]];
+        let d = r.norm();
+        if d > 0.0 {
+            (d, r / d)
+        } else {
+            (0.0, Vec3::zeros())
+        }
+    }
 }
 
 /// Internal variables after the unwrapped angle (angles only).
@@ -110,10 +185,14 @@ impl Stop {
         restitution: f64,
     ) -> Self {
         let active = source.active();
+        let nodes = source.nodes.clone();
         Self {
             id,
-            joint,
-            source,
+            watched: Watched::Joint {
+                joint,
+                source: Box::new(source),
+            },
+            nodes,
             lower,
             upper,
             restitution,
@@ -122,9 +201,59 @@ impl Stop {
         }
     }
 
-    /// The joint whose coordinate it limits.
-    pub fn joint(&self) -> Id {
-        self.joint
+    /// A contact between a sphere on a node and a fixed plane
+    /// (`plane.normal` unit), with restitution `restitution`: the stop of
+    /// the gap `g = n·(x − p) − r ≥ 0`.
+    pub fn on_plane(id: Id, plane: Plane, restitution: f64) -> Self {
+        Self {
+            id,
+            watched: Watched::Plane(plane),
+            nodes: vec![plane.node],
+            lower: 0.0,
+            upper: f64::INFINITY,
+            restitution,
+            active: vec![0, 1, 2],
+            offsets: Offsets::default(),
+        }
+    }
+
+    /// A contact between two spheres on two distinct nodes, with
+    /// restitution `restitution`: the stop of the gap
+    /// `g = |x_b − x_a| − r_a − r_b ≥ 0`.
+    pub fn between_spheres(id: Id, spheres: Spheres, restitution: f64) -> Self {
+        Self {
+            id,
+            watched: Watched::Spheres(spheres),
+            nodes: spheres.nodes.to_vec(),
+            lower: 0.0,
+            upper: f64::INFINITY,
+            restitution,
+            active: vec![0, 1, 2, 6, 7, 8],
+            offsets: Offsets::default(),
+        }
+    }
+
+    /// The joint whose coordinate it limits (`None` for a contact).
+    pub fn joint(&self) -> Option<Id> {
+        match &self.watched {
+            Watched::Joint { joint, .. } => Some(*joint),
+            _ => None,
+        }
+    }
+
+    /// Whether it is a contact (of a sphere with a plane or of two
+    /// spheres) rather than a stop on a joint coordinate.
+    pub fn is_contact(&self) -> bool {
+        self.joint().is_none()
+    }
+
+    /// `"stop"` or `"contact"`, for messages.
+    pub fn noun(&self) -> &'static str {
+        if self.is_contact() {
+            "contact"
+        } else {
+            "stop"
+        }
     }
 
     /// `(c_min, c_max)`.
@@ -139,16 +268,19 @@ impl Stop {
 
     /// Whether the coordinate is an angle.
     pub fn is_angle(&self) -> bool {
-        self.source.is_angle()
+        match &self.watched {
+            Watched::Joint { source, .. } => source.is_angle(),
+            _ => false,
+        }
     }
 
     /// The nodes of its pair.
     pub fn pair_nodes(&self) -> &[usize] {
-        &self.source.nodes
+        &self.nodes
     }
 
     fn slot(&self, k: usize) -> usize {
-        self.offsets.internal + usize::from(self.source.is_angle()) + k
+        self.offsets.internal + usize::from(self.is_angle()) + k
     }
 
     /// Index of its multiplier among the state's multipliers.
@@ -214,7 +346,7 @@ impl Stop {
     }
 
     fn reference(&self, state: &State) -> f64 {
-        if self.source.is_angle() {
+        if self.is_angle() {
             state.internal[self.offsets.internal]
         } else {
             0.0
@@ -224,7 +356,11 @@ impl Stop {
     /// The coordinate `c` at `state` (an angle on the branch of the last
     /// converged state).
     pub fn coordinate(&self, state: &State) -> f64 {
-        self.source.value(state, self.reference(state))
+        match &self.watched {
+            Watched::Joint { source, .. } => source.value(state, self.reference(state)),
+            Watched::Plane(p) => p.gap(&state.x[p.node]),
+            Watched::Spheres(s) => s.gap(&state.x[s.nodes[0]], &state.x[s.nodes[1]]),
+        }
     }
 
     /// The smaller gap, `min(c − c_min, c_max − c)`, and the limit it is
@@ -272,16 +408,38 @@ impl Stop {
     /// `ċ = B v`: the rate of the coordinate at the state's velocities,
     /// and its gradient `B` over the pair's local unknowns (6 per node).
     pub fn rate(&self, state: &State) -> (f64, Vec<f64>) {
-        let n = 6 * self.source.nodes.len();
+        let source = match &self.watched {
+            Watched::Plane(p) => {
+                // B = [nᵀ 0]: ġ = n·ẋ
+                let v = state.velocity[p.node];
+                let n = p.normal;
+                let grad = vec![n.x, n.y, n.z, 0.0, 0.0, 0.0];
+                return (n.dot(&Vec3::new(v[0], v[1], v[2])), grad);
+            }
+            Watched::Spheres(s) => {
+                // B = [−uᵀ 0 uᵀ 0]: ġ = u·(ẋ_b − ẋ_a)
+                let (_, u) = Spheres::direction(state, s.nodes);
+                let mut grad = vec![0.0; 12];
+                let mut rate = 0.0;
+                for c in 0..3 {
+                    grad[c] = -u[c];
+                    grad[6 + c] = u[c];
+                    rate += u[c] * (state.velocity[s.nodes[1]][c] - state.velocity[s.nodes[0]][c]);
+                }
+                return (rate, grad);
+            }
+            Watched::Joint { source, .. } => source,
+        };
+        let n = 6 * source.nodes.len();
         let mut grad = vec![0.0; n];
         with_scratch(|sc| {
-            sc.local.gather(state, &self.source.nodes, 0..0);
+            sc.local.gather(state, &source.nodes, 0..0);
             let mut v = [0.0];
-            let f = self.source.function(self.reference(state));
+            let f = source.function(self.reference(state));
             sc.local.gradient(1, &self.active, &f, &mut v, &mut grad);
         });
         let mut rate = 0.0;
-        for (k, &node) in self.source.nodes.iter().enumerate() {
+        for (k, &node) in source.nodes.iter().enumerate() {
             for c in 0..6 {
                 rate += grad[6 * k + c] * state.velocity[node][c];
             }
@@ -289,8 +447,54 @@ impl Stop {
         (rate, grad)
     }
 
+    /// Adds the closed gap constraint `Φ = g(x) − g_c` of a contact, with
+    /// its gradient `B` given by blocks `(first local unknown, ∂g/∂x)` on
+    /// the nodes' translations and its curvature `H` (`∂²g/∂x²`, the same
+    /// block on each node, `−H` between them): the residual `Bᵀ(pΦ − kλ)`
+    /// and `−kΦ` on the multiplier row, the tangent `p BᵀB + (pΦ − kλ) H`
+    /// and `−kB` (the augmented Lagrangian of the reference paper, eq. 18).
+    fn add_gap_constraint(
+        &self,
+        ctx: &EvalContext,
+        state: &State,
+        gradient: &[(usize, Vec3)],
+        curvature: Option<Mat3>,
+        out: &mut ElementOutput,
+    ) {
+        let nq = 6 * self.nodes.len();
+        let (k, pen) = self.scaling(ctx);
+        let phi = self.coordinate(state) - self.held_value(state);
+        let lambda = state.multipliers[self.offsets.multipliers];
+        let w = pen * phi - k * lambda;
+        for &(i, b) in gradient {
+            for c in 0..3 {
+                out.residual[i + c] += b[c] * w;
+            }
+        }
+        out.residual[nq] += -k * phi;
+        let Some(t) = out.stiffness.as_deref_mut() else {
+            return;
+        };
+        let size = nq + 1;
+        for (a, &(i, bi)) in gradient.iter().enumerate() {
+            for r in 0..3 {
+                t[(i + r) * size + nq] += -k * bi[r];
+                t[nq * size + i + r] += -k * bi[r];
+            }
+            for (b, &(j, bj)) in gradient.iter().enumerate() {
+                let sign = if a == b { 1.0 } else { -1.0 };
+                for r in 0..3 {
+                    for c in 0..3 {
+                        let h = curvature.map_or(0.0, |h| sign * h[(r, c)]);
+                        t[(j + c) * size + i + r] += pen * bi[r] * bj[c] + w * h;
+                    }
+                }
+            }
+        }
+    }
+
     fn kind_of_equation(&self) -> Equation {
-        if self.source.is_angle() {
+        if self.is_angle() {
             Equation::Moment
         } else {
             Equation::Force
@@ -305,13 +509,17 @@ impl Stop {
 
 impl Element for Stop {
     fn kind(&self) -> ElementKind {
-        ElementKind::Stop
+        if self.is_contact() {
+            ElementKind::Contact
+        } else {
+            ElementKind::Stop
+        }
     }
     fn id(&self) -> Id {
         self.id
     }
     fn nodes(&self) -> &[usize] {
-        &self.source.nodes
+        &self.nodes
     }
     fn n_multipliers(&self) -> usize {
         1
@@ -320,7 +528,7 @@ impl Element for Stop {
     /// number of events, the largest load carried, the coordinate where
     /// it closed.
     fn n_internal(&self) -> usize {
-        usize::from(self.source.is_angle()) + 4
+        usize::from(self.is_angle()) + 4
     }
     fn set_offsets(&mut self, offsets: Offsets) {
         self.offsets = offsets;
@@ -335,7 +543,7 @@ impl Element for Stop {
         Some(self)
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
-        let nq = 6 * self.source.nodes.len();
+        let nq = 6 * self.nodes.len();
         let contact = self.contact(state);
         if contact == Contact::Open {
             // open: k λ = 0
@@ -346,8 +554,26 @@ impl Element for Stop {
             }
             return;
         }
+        let source = match &self.watched {
+            Watched::Joint { source, .. } => source,
+            Watched::Plane(p) => {
+                // closed: Φ = n·(x − p) − r − g_c, linear in x (no
+                // curvature term)
+                let n = p.normal;
+                self.add_gap_constraint(ctx, state, &[(0, n)], None, out);
+                return;
+            }
+            Watched::Spheres(s) => {
+                // closed: Φ = |x_b − x_a| − r_a − r_b − g_c, B = [−uᵀ uᵀ],
+                // ∂²Φ/∂x_b² = ∂²Φ/∂x_a² = −∂²Φ/∂x_a∂x_b = (I − u uᵀ)/d
+                let (d, u) = Spheres::direction(state, s.nodes);
+                let curvature = (d > 0.0).then(|| (Mat3::identity() - u * u.transpose()) / d);
+                self.add_gap_constraint(ctx, state, &[(0, -u), (6, u)], curvature, out);
+                return;
+            }
+        };
         // closed: Φ = c(q) − c_c
-        let c = self.source.function(self.reference(state));
+        let c = source.function(self.reference(state));
         let value = self.held_value(state);
         let phi = |conf: &Conf, o: &mut [HyperDual]| {
             c(conf, o);
@@ -356,7 +582,7 @@ impl Element for Stop {
         let m = self.offsets.multipliers;
         let lambda = &state.multipliers[m..m + 1];
         with_scratch(|sc| {
-            sc.local.gather(state, &self.source.nodes, 0..0);
+            sc.local.gather(state, &source.nodes, 0..0);
             add_constraints(
                 ctx,
                 &mut sc.local,
@@ -372,9 +598,11 @@ impl Element for Stop {
     }
     fn update_internal(&self, ctx: &EvalContext, state: &State, internal: &mut [f64]) {
         // the contact and the events are set by the analysis
-        let first = usize::from(self.source.is_angle());
-        if self.source.is_angle() {
-            internal[0] = self.source.value(state, internal[0]);
+        let first = usize::from(self.is_angle());
+        if self.is_angle() {
+            if let Watched::Joint { source, .. } = &self.watched {
+                internal[0] = source.value(state, internal[0]);
+            }
         }
         if self.contact(state) != Contact::Open {
             let n = self.load(ctx, state).abs();
@@ -382,10 +610,22 @@ impl Element for Stop {
         }
     }
     fn result_names(&self) -> &'static [&'static str] {
-        &STOP_RESULTS
+        if self.is_contact() {
+            &CONTACT_RESULTS
+        } else {
+            &STOP_RESULTS
+        }
     }
-    /// Fills the first `out.len()` values of [`STOP_RESULTS`].
+    /// Fills the first `out.len()` values of [`STOP_RESULTS`] (of
+    /// [`CONTACT_RESULTS`] for a contact).
     fn results(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
+        if self.is_contact() {
+            let closed = f64::from(u8::from(self.contact(state) != Contact::Open));
+            let all = [self.coordinate(state), closed, self.load(ctx, state)];
+            let n = out.len().min(all.len());
+            out[..n].copy_from_slice(&all[..n]);
+            return;
+        }
         let contact = match self.contact(state) {
             Contact::Open => 0.0,
             Contact::Lower => -1.0,

@@ -307,3 +307,94 @@ fn node_driver_coordinate_is_the_displacement_along_its_direction() {
     let _ = eval;
     let _ = SliderCurve { spline: true };
 }
+
+/// The gap `g`, its gradient `B` against central differences, and the
+/// tangent of a stop or contact, open (`kλ = 0`) and closed
+/// (`Φ = g − g_c`), against central differences of its residual (h = 1e-6;
+/// 1e-6 of the largest entry, as above). Returns the worst error.
+fn check_stop(rng: &mut Lcg, stop: &Stop, s: &mut State, what: &str) -> f64 {
+    let mut worst = 0.0f64;
+    // internal variables after the unwrapped angle: contact, events, load
+    // scale, the value held
+    let first = usize::from(stop.is_angle());
+    s.internal[first + 3] = stop.coordinate(s) + 0.1 * rng.next();
+    for contact in [0.0, 1.0, 2.0] {
+        s.internal[first] = contact;
+        let err = tangent_error(stop, &ctx(), s, 1e-6);
+        assert!(err < 1e-6, "{what} ({contact}): tangent error {err:.3e}");
+        worst = worst.max(err);
+    }
+    let (rate, grad) = stop.rate(s);
+    let h = 1e-6;
+    let largest = grad.iter().fold(1e-300f64, |a, g| a.max(g.abs()));
+    let mut from_grad = 0.0;
+    for (k, g) in grad.iter().enumerate() {
+        let cp = stop.coordinate(&crate::elements::testing::moved(s, stop, k, h));
+        let cm = stop.coordinate(&crate::elements::testing::moved(s, stop, k, -h));
+        let fd = (cp - cm) / (2.0 * h);
+        assert!(
+            (fd - g).abs() < 1e-6 * largest,
+            "{what}: ∂g/∂q{k} {g} vs {fd}"
+        );
+        worst = worst.max((fd - g).abs() / largest);
+        from_grad += g * s.velocity[stop.pair_nodes()[k / 6]][k % 6];
+    }
+    // ġ = B v (round-off)
+    assert!(
+        (rate - from_grad).abs() <= 1e-12 * (1.0 + rate.abs()),
+        "{what}"
+    );
+    worst
+}
+
+/// Stops on joint coordinates, and contacts of a sphere with a plane and
+/// of two spheres (docs/theory.md §16.5): tangents and gradients against
+/// central differences, and the gaps against their definitions.
+#[test]
+fn stop_and_contact_tangents_match_finite_differences() {
+    use super::stop::{Plane, Spheres};
+    let mut rng = Lcg(17);
+    let mut worst = 0.0f64;
+    for c in [Coordinate::Angle, Coordinate::Slide1] {
+        for grounded in [false, true] {
+            for _ in 0..4 {
+                let (src, x, q) = revolute_coordinate(&mut rng, grounded, c);
+                let nn = src.nodes.len();
+                let stop = Stop::new(5, 1, src, -0.4, 0.3, 0.5);
+                let mut s = moved(&mut rng, &x[..nn], &q[..nn], &stop);
+                let what = format!("stop on {}", c.name());
+                worst = worst.max(check_stop(&mut rng, &stop, &mut s, &what));
+            }
+        }
+    }
+    for _ in 0..8 {
+        let (x, q, _, p) = reference(&mut rng);
+        let normal = rng.vec(1.0).normalize();
+        let plane = Plane {
+            node: 0,
+            normal,
+            point: p,
+            radius: 0.3 * rng.next().abs(),
+        };
+        let stop = Stop::on_plane(6, plane, 0.5);
+        let mut s = moved(&mut rng, &x[..1], &q[..1], &stop);
+        s.velocity[0] = [rng.next(), rng.next(), rng.next(), 0.0, 0.0, 0.0];
+        let g = normal.dot(&(s.x[0] - p)) - plane.radius;
+        assert!((stop.coordinate(&s) - g).abs() < 1e-15);
+        worst = worst.max(check_stop(&mut rng, &stop, &mut s, "plane"));
+
+        let spheres = Spheres {
+            nodes: [0, 1],
+            radii: [0.1 * rng.next().abs(), 0.2 * rng.next().abs()],
+        };
+        let stop = Stop::between_spheres(7, spheres, 0.5);
+        let mut s = moved(&mut rng, &x, &q, &stop);
+        for v in s.velocity.iter_mut() {
+            *v = [rng.next(), rng.next(), rng.next(), rng.next(), 0.0, 0.0];
+        }
+        let g = (s.x[1] - s.x[0]).norm() - spheres.radii[0] - spheres.radii[1];
+        assert!((stop.coordinate(&s) - g).abs() < 1e-15);
+        worst = worst.max(check_stop(&mut rng, &stop, &mut s, "spheres"));
+    }
+    println!("worst stop and contact tangent and gradient error {worst:.2e}");
+}

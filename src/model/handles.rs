@@ -126,6 +126,11 @@ element_handle!(
     ElementKind::Stop
 );
 element_handle!(
+    /// A unilateral contact.
+    ContactHandle,
+    ElementKind::Contact
+);
+element_handle!(
     /// A rolling disc.
     RollingDiscHandle,
     ElementKind::RollingDisc

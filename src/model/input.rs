@@ -44,7 +44,7 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 23] = [
+pub const TOP_LEVEL_KEYS: [&str; 24] = [
     "title",
     "analysis",
     "nodes",
@@ -65,6 +65,7 @@ pub const TOP_LEVEL_KEYS: [&str; 23] = [
     "drivers",
     "latches",
     "stops",
+    "contacts",
     "rolling_discs",
     "initial_motion",
     "output",
@@ -136,6 +137,10 @@ pub struct ModelInput {
     /// Unilateral stops of joint coordinates (joint limits).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stops: Vec<StopInput>,
+    /// Unilateral contacts of spheres on nodes with fixed planes or with
+    /// each other.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactInput>,
     /// Discs rolling without slipping on fixed planes (docs/joints.md
     /// §3.8).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -409,6 +414,64 @@ pub struct StopInput {
     /// Unit of the limits for an angle coordinate.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unit: Option<AngleUnit>,
+    /// Coefficient of restitution `e ∈ [0, 1]`, default 0 (plastic).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+}
+
+/// What a contact is between.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ContactType {
+    /// A sphere on a node and a fixed plane.
+    #[default]
+    Plane,
+    /// Spheres on two nodes.
+    Spheres,
+}
+
+impl ContactType {
+    /// Name used in files and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Plane => "plane",
+            Self::Spheres => "spheres",
+        }
+    }
+}
+
+/// A unilateral contact (docs/joints.md §6.4): a sphere centred on a node
+/// against a fixed plane (`type = "plane"`: `node`, `point`, `normal`,
+/// `radius`), or two spheres centred on two nodes (`type = "spheres"`:
+/// `nodes`, `radii`). The gap stays non-negative, with impacts of
+/// restitution `restitution` and persistent contact.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactInput {
+    /// Element id.
+    pub id: Id,
+    /// `plane` or `spheres`.
+    #[serde(rename = "type")]
+    pub kind: ContactType,
+    /// The node at the sphere's centre (`plane`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub node: Option<Id>,
+    /// A point of the plane (global), default the origin (`plane`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 3]>,
+    /// The plane's normal (global), pointing to the sphere's side
+    /// (`plane`); any length but zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// The sphere's radius (m), default 0 (`plane`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// The two nodes at the spheres' centres (`spheres`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nodes: Option<Vec<Id>>,
+    /// The spheres' radii (m), not both zero (`spheres`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radii: Option<Vec<f64>>,
     /// Coefficient of restitution `e ∈ [0, 1]`, default 0 (plastic).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub restitution: Option<f64>,

@@ -32,9 +32,9 @@ pub use build::{
 };
 pub use builder::ModelBuilder;
 pub use handles::{
-    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
-    JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
-    RigidBodyHandle, RollingDiscHandle, SpringHandle, StopHandle,
+    BeamHandle, BeamLineHandle, ContactHandle, DriverHandle, ElementRef, ElementResults,
+    HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle,
+    PointMassHandle, RigidBodyHandle, RollingDiscHandle, SpringHandle, StopHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.

@@ -11,6 +11,7 @@ use std::collections::{HashMap, HashSet};
 
 mod beams;
 mod checks;
+mod contacts;
 mod curves;
 mod drivers;
 mod hinge_laws;
@@ -210,6 +211,23 @@ fn num(v: f64) -> String {
     }
 }
 
+/// The model's size: the diagonal of the box around the nodes at `x`, 1
+/// for a model of one point ([`Model::length_scale`]).
+fn length_scale<'a>(x: impl Iterator<Item = &'a Vec3>) -> f64 {
+    let mut lo = Vec3::repeat(f64::INFINITY);
+    let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+    for x in x {
+        lo = lo.inf(x);
+        hi = hi.sup(x);
+    }
+    let d = (hi - lo).norm();
+    if d > 0.0 && d.is_finite() {
+        d
+    } else {
+        1.0
+    }
+}
+
 /// A node being built: reference position and orientation.
 struct NodeData {
     x: Vec3,
@@ -320,6 +338,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.drivers.len(),
         input.latches.len(),
         input.stops.len(),
+        input.contacts.len(),
         input.rolling_discs.len(),
         generated,
     ]
@@ -372,6 +391,7 @@ impl Model {
         b.springs();
         b.loads();
         joints::build(&mut b);
+        b.contacts();
         b.rolling_discs();
         let gravity = b.gravity();
         b.supports();
@@ -405,20 +425,7 @@ impl Model {
             return Err(ModelErrors(ck.errors));
         }
 
-        let length_scale = {
-            let mut lo = Vec3::repeat(f64::INFINITY);
-            let mut hi = Vec3::repeat(f64::NEG_INFINITY);
-            for n in &nodes {
-                lo = lo.inf(&n.x);
-                hi = hi.sup(&n.x);
-            }
-            let d = (hi - lo).norm();
-            if d > 0.0 && d.is_finite() {
-                d
-            } else {
-                1.0
-            }
-        };
+        let length_scale = length_scale(nodes.iter().map(|n| &n.x));
         let mut model = Model {
             title: input.title.clone().unwrap_or_default(),
             node_ids,

@@ -1,14 +1,15 @@
-//! Joints, joint springs and dampers, drivers, latches (docs/joints.md).
+//! Joints, joint springs and dampers, drivers, latches, stops and contacts
+//! (docs/joints.md).
 
 use super::{Body, CurveHandle, Entity, ModelBuilder};
 use crate::joints::{Coordinate, JointType};
 use crate::model::handles::{
-    DriverHandle, HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, NodeHandle,
-    RollingDiscHandle, StopHandle,
+    ContactHandle, DriverHandle, HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle,
+    NodeHandle, RollingDiscHandle, StopHandle,
 };
 use crate::model::input::{
-    AngleUnit, Approach, DriverInput, HingeLawInput, JointInput, JointSpringInput, LatchInput,
-    RollingDiscInput, StartBranch, StopInput, TapeSpringInput,
+    AngleUnit, Approach, ContactInput, ContactType, DriverInput, HingeLawInput, JointInput,
+    JointSpringInput, LatchInput, RollingDiscInput, StartBranch, StopInput, TapeSpringInput,
 };
 use crate::model::Id;
 
@@ -538,6 +539,80 @@ impl Entity for Stop {
         self.input.id = m.element_id(self.id, 1);
         let handle = StopHandle(self.input.id);
         m.input.stops.push(self.input);
+        handle
+    }
+}
+
+/// A unilateral contact (docs/joints.md §6.4): a sphere centred on a node
+/// against a fixed plane, or two spheres centred on two nodes; impacts of
+/// restitution `e` and persistent contact (in dynamic analyses).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Contact {
+    input: ContactInput,
+    id: Option<Id>,
+}
+
+impl Contact {
+    /// A point on `node` (a sphere of radius 0 until [`Contact::radius`])
+    /// against the fixed plane through `point` with normal `normal`
+    /// (global, pointing to the node's side; any length but zero).
+    pub fn plane(node: NodeHandle, point: [f64; 3], normal: [f64; 3]) -> Self {
+        Self {
+            input: ContactInput {
+                kind: ContactType::Plane,
+                node: Some(node.0),
+                point: Some(point),
+                normal: Some(normal),
+                ..ContactInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// Spheres centred on nodes `a` and `b`, whose radii
+    /// [`Contact::radii`] gives (required, not both zero).
+    pub fn spheres(a: NodeHandle, b: NodeHandle) -> Self {
+        Self {
+            input: ContactInput {
+                kind: ContactType::Spheres,
+                nodes: Some(vec![a.0, b.0]),
+                ..ContactInput::default()
+            },
+            id: None,
+        }
+    }
+
+    /// The radius of the sphere of a contact with a plane (m).
+    pub fn radius(mut self, r: f64) -> Self {
+        self.input.radius = Some(r);
+        self
+    }
+
+    /// The radii of the spheres of a contact of spheres (m).
+    pub fn radii(mut self, ra: f64, rb: f64) -> Self {
+        self.input.radii = Some(vec![ra, rb]);
+        self
+    }
+
+    /// The coefficient of restitution `e ∈ [0, 1]` (default 0).
+    pub fn restitution(mut self, e: f64) -> Self {
+        self.input.restitution = Some(e);
+        self
+    }
+
+    /// Its id (default: the next free element id).
+    pub fn id(mut self, id: Id) -> Self {
+        self.id = Some(id);
+        self
+    }
+}
+
+impl Entity for Contact {
+    type Handle = ContactHandle;
+    fn add_to(mut self, m: &mut ModelBuilder) -> ContactHandle {
+        self.input.id = m.element_id(self.id, 1);
+        let handle = ContactHandle(self.input.id);
+        m.input.contacts.push(self.input);
         handle
     }
 }

@@ -43,13 +43,13 @@ mod structure;
 pub use loading::{
     Analysis, Component, CurveHandle, Dofs, Gravity, Load, LoadCurve, PrescribedMotion,
 };
-pub use mechanism::{Driver, HingeLaw, Joint, JointSpring, Latch, RollingDisc, Stop};
+pub use mechanism::{Contact, Driver, HingeLaw, Joint, JointSpring, Latch, RollingDisc, Stop};
 pub use structure::{Beam, BeamLine, Node, PointMass, RigidBody, Section, SectionHandle, Spring};
 
 pub use super::handles::{
-    BeamHandle, BeamLineHandle, DriverHandle, ElementRef, ElementResults, HingeLawHandle,
-    JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle, PointMassHandle,
-    RigidBodyHandle, RollingDiscHandle, SpringHandle, StopHandle,
+    BeamHandle, BeamLineHandle, ContactHandle, DriverHandle, ElementRef, ElementResults,
+    HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle,
+    PointMassHandle, RigidBodyHandle, RollingDiscHandle, SpringHandle, StopHandle,
 };
 pub use super::input::{AngleUnit, Approach, StartBranch, TapeSpringInput as TapeSpring};
 pub use super::{Id, Model, ModelErrors};

@@ -975,11 +975,11 @@ impl Observer for Recorder {
             increment: info.increment + self.increment_offset,
             time: info.time,
             element: info.latch,
-            kind: "lock",
+            kind: info.kind.name(),
             joint: info.joint,
             coordinate: info.coordinate,
             rate_before: info.rate_before,
-            rate_after: 0.0,
+            rate_after: info.rate_after,
             impulse: info.impulse,
             energy_lost: info.energy_lost,
         });

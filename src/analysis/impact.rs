@@ -568,7 +568,7 @@ pub fn spring_latch_events_at(
                     LatchEventKind::Lock
                 }
                 SpringEvent::Unlatch => {
-                    out.restart = true;
+                    out.restart |= spring.damping * held.1 != 0.0;
                     out.released += energy;
                     LatchEventKind::Unlatch
                 }

@@ -277,7 +277,11 @@ stiffness = {K_LATCH}
         let r = latch_results(&model, s);
         assert_eq!(r[1], 1.0);
         let spring = -K_LATCH * (angle(s) - THETA_L);
-        assert!((r[3] - spring).abs() <= 1e-9 * K_LATCH, "{} vs {spring}", r[3]);
+        assert!(
+            (r[3] - spring).abs() <= 1e-9 * K_LATCH,
+            "{} vs {spring}",
+            r[3]
+        );
     }
     // the energy balance with ρ∞ = 1: T + V conserved, the latch's spring
     // energy in V; within 1e-4 of the energy, ½ k_s θ_f²
@@ -522,7 +526,11 @@ unlatch_load = {UNLATCH}
     // (1e-6 F_u, src/joints/latch.rs UNLATCH_TOLERANCE) and is k δθ off the
     // exact load: t within (1e-6 F_u + k δθ)/Ḟ of t_u
     let dt = (1e-6 * UNLATCH + K_HOLD * err) / load_rate;
-    assert!((release.time - t_u).abs() <= dt, "{} vs {t_u} (±{dt:.2e})", release.time);
+    assert!(
+        (release.time - t_u).abs() <= dt,
+        "{} vs {t_u} (±{dt:.2e})",
+        release.time
+    );
     // the energy its spring held, ½ F_u²/k, leaves with it (1e-5: the
     // load within its tolerance)
     let held_energy = 0.5 * UNLATCH * UNLATCH / K_HOLD;
@@ -561,6 +569,119 @@ unlatch_load = {UNLATCH}
     assert!(out.energies.balance_error.abs() <= 1e-5 * out.energies.external_work);
 }
 
+// ---------- the dashpot ----------
+
+/// Spinning at ω₀ = 2 rad/s into a spring latch at θ_L = 0.5 rad without
+/// backlash, with a dashpot `d` of damping ratio `ζ = d/(2√(kJ)) = 0.02`:
+/// after the lock `J ẍ + d ẋ + k x = 0` from `x = 0`, `ẋ = ω₀`, so
+/// `x = (ω₀/ω_d) e^{−ζωτ} sin ω_d τ`, `ω_d = ω√(1 − ζ²)`, `τ = t − t_L`.
+/// ρ∞ = 1 and fixed steps of 5e-4 s (ωh = 0.015: a phase error of
+/// (ωh)²/12 = 2e-5 per radian, 6e-4 over the 30 rad of the run).
+#[test]
+fn a_spring_latch_with_a_dashpot_rings_down_as_a_damped_oscillator() {
+    let zeta = 0.02;
+    let omega = (K_RATTLE / J).sqrt();
+    let d = 2.0 * zeta * (K_RATTLE * J).sqrt();
+    let text = panel(
+        "end_time = 1.25\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
+        &format!(
+            r#"
+[[initial_motion]]
+nodes = [2]
+angular_velocity = [0.0, 0.0, {OMEGA_0}]
+
+[[latches]]
+id = 20
+joint = 10
+value = {THETA_R}
+mode = "spring"
+stiffness = {K_RATTLE}
+damping = {d}
+"#
+        ),
+    );
+    let (model, out, rec) = run(&text);
+    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
+    let lock = &rec.events[0];
+    let (t_l, v) = (lock.time, lock.rate_before);
+    let omega_d = omega * (1.0 - zeta * zeta).sqrt();
+    let amplitude = v / omega_d;
+    let mut worst = 0.0f64;
+    for (i, s) in rec.steps.iter().filter(|(i, _)| i.time >= t_l) {
+        let tau = i.time - t_l;
+        let exact = amplitude * (-zeta * omega * tau).exp() * (omega_d * tau).sin();
+        worst = worst.max((angle(s) - THETA_R - exact).abs());
+        // the load is the spring's and the dashpot's, −(k x + d ẋ)
+        let r = latch_results(&model, s);
+        let f = K_RATTLE * (angle(s) - THETA_R) + d * s.velocity[1][5];
+        assert!((r[3] + f).abs() <= 1e-9 * K_RATTLE);
+    }
+    eprintln!(
+        "largest error against the damped oscillation {worst:.3e} rad (amplitude {amplitude}); energies at the end {:?}",
+        out.energies
+    );
+    // within 2e-3 of the amplitude (the phase error above, with margin)
+    assert!(worst <= 2e-3 * amplitude, "{worst:.3e}");
+    // the dashpot's work counted as dissipated: the energy lost by the
+    // closed-form motion by the end, ½ J ω₀² − (½ J ẋ² + ½ k x²), within
+    // 1e-3 of it (the dissipation integrated by the trapezoidal rule over
+    // the steps); the balance within 1e-4 of the energy
+    let e0 = 0.5 * J * OMEGA_0 * OMEGA_0;
+    let tau = out.time - t_l;
+    let decay = (-zeta * omega * tau).exp();
+    let x = amplitude * decay * (omega_d * tau).sin();
+    let xdot = amplitude
+        * decay
+        * (omega_d * (omega_d * tau).cos() - zeta * omega * (omega_d * tau).sin());
+    let lost = e0 - 0.5 * J * xdot * xdot - 0.5 * K_RATTLE * x * x;
+    eprintln!(
+        "dissipated {} (closed form {lost})",
+        out.energies.dissipated
+    );
+    assert!((out.energies.dissipated / lost - 1.0).abs() <= 1e-3);
+    assert!(out.energies.balance_error.abs() <= 1e-4 * e0);
+}
+
+/// A spring latch on an angle given in degrees (`unit = "deg"`: the
+/// locking value and the backlash in degrees, the stiffness per degree,
+/// the dashpot per degree per second) is the same latch as the one in
+/// radians (1e-12 relative).
+#[test]
+fn spring_latch_keys_in_degrees_are_converted_to_radians() {
+    let deg = std::f64::consts::PI / 180.0;
+    let latch = |keys: &str| {
+        let text = panel(
+            "end_time = 0.1",
+            &format!("[[latches]]\nid = 20\njoint = 10\nmode = \"spring\"\n{keys}\n"),
+        );
+        let input: ModelInput = toml::from_str(&text).unwrap();
+        let model = Model::from_input(&input).unwrap();
+        let l = model
+            .elements
+            .iter()
+            .find_map(|e| e.as_latch())
+            .unwrap()
+            .clone();
+        (l.value(), *l.spring().unwrap())
+    };
+    let (v_deg, s_deg) = latch(
+        "value = 90.0\nunit = \"deg\"\nstiffness = 10.0\nbacklash = 2.0\ndamping = 0.5\nunlatch_load = 3.0",
+    );
+    let (v_rad, s_rad) = latch(&format!(
+        "value = {}\nstiffness = {}\nbacklash = {}\ndamping = {}\nunlatch_load = 3.0",
+        90.0 * deg,
+        10.0 / deg,
+        2.0 * deg,
+        0.5 / deg
+    ));
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+    assert!(close(v_deg, v_rad));
+    assert!(close(s_deg.stiffness, s_rad.stiffness));
+    assert!(close(s_deg.backlash, s_rad.backlash));
+    assert!(close(s_deg.damping, s_rad.damping));
+    assert_eq!(s_deg.unlatch_load, Some(3.0));
+}
+
 // ---------- (4) input errors through the command line ----------
 
 /// A fresh scratch directory for one test.
@@ -597,7 +718,7 @@ fn bad_spring_latch_keys_are_input_errors() {
         ),
         (
             "stiffness = 100.0\nbacklash = 0.1",
-            "latch 20: `stiffness`, `backlash` applies to spring latches: add mode = \"spring\"",
+            "latch 20: `stiffness`, `backlash` apply to spring latches: add mode = \"spring\"",
         ),
         (
             "mode = \"rigid\"\ndamping = 2.0",

@@ -553,9 +553,8 @@ pub fn spring_latch_events_at(
             continue;
         }
         for _ in 0..3 {
-            let held = l.spring_state(state);
             let energy = if l.is_locked(state) {
-                spring.energy(held.0)
+                spring.energy(l.spring_state(state).0)
             } else {
                 0.0
             };
@@ -564,16 +563,19 @@ pub fn spring_latch_events_at(
             };
             let kind = match event {
                 SpringEvent::Lock => {
-                    out.restart |= spring.damping * held.1 != 0.0;
+                    // the dashpot's load d ċ appears at once
+                    out.restart |= spring.damping * l.rate(state).0 != 0.0;
                     LatchEventKind::Lock
                 }
                 SpringEvent::Unlatch => {
-                    out.restart |= spring.damping * held.1 != 0.0;
+                    // the dashpot's load d ċ appears at once
+                    out.restart |= spring.damping * l.rate(state).0 != 0.0;
                     out.released += energy;
                     LatchEventKind::Unlatch
                 }
                 SpringEvent::Rearm | SpringEvent::Band => break,
             };
+            // the velocities do not jump
             let rate = l.rate(state).0;
             out.events.push(LockInfo {
                 kind,

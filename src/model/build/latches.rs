@@ -60,8 +60,9 @@ pub(super) fn latch(
                     ModelErrorKind::Invalid,
                     entity,
                     format!(
-                        "`{}` applies to spring latches: add mode = \"spring\" (a rigid latch holds its coordinate as a constraint)",
-                        given.join("`, `")
+                        "`{}` {} to spring latches: add mode = \"spring\" (a rigid latch holds its coordinate as a constraint)",
+                        given.join("`, `"),
+                        if given.len() == 1 { "applies" } else { "apply" }
                     ),
                 );
                 return None;

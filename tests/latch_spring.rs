@@ -134,30 +134,28 @@ fn fit_harmonic(points: &[(f64, f64)], omega: f64) -> [f64; 3] {
     let mut r = [0.0; 3];
     for &(t, y) in points {
         let phi = [1.0, (omega * t).cos(), (omega * t).sin()];
-        for i in 0..3 {
-            for j in 0..3 {
-                n[i][j] += phi[i] * phi[j];
+        for ((row, ri), pi) in n.iter_mut().zip(r.iter_mut()).zip(phi) {
+            for (v, pj) in row.iter_mut().zip(phi) {
+                *v += pi * pj;
             }
-            r[i] += phi[i] * y;
+            *ri += pi * y;
         }
     }
-    // Gaussian elimination of the 3×3 normal equations (well conditioned:
-    // many periods)
-    for k in 0..3 {
-        for i in k + 1..3 {
-            let f = n[i][k] / n[k][k];
-            for j in k..3 {
-                n[i][j] -= f * n[k][j];
-            }
-            r[i] -= f * r[k];
+    // Cramer's rule on the 3×3 normal equations (well conditioned: many
+    // periods)
+    let det = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(&n);
+    std::array::from_fn(|c| {
+        let mut m = n;
+        for (row, v) in m.iter_mut().zip(r) {
+            row[c] = v;
         }
-    }
-    let mut x = [0.0; 3];
-    for i in (0..3).rev() {
-        let s: f64 = (i + 1..3).map(|j| n[i][j] * x[j]).sum();
-        x[i] = (r[i] - s) / n[i][i];
-    }
-    x
+        det(&m) / d
+    })
 }
 
 // ---------- (1) no backlash: oscillation about the locking value ----------

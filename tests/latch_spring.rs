@@ -680,6 +680,94 @@ fn spring_latch_keys_in_degrees_are_converted_to_radians() {
     assert_eq!(s_deg.unlatch_load, Some(3.0));
 }
 
+/// The release through the command line: `events.csv` has one `unlatch`
+/// row (the latch, its joint, the coordinate at `F_u/k` within the event
+/// tolerance of the load, the energy released ½F_u²/k), `log.txt` a line
+/// for it, and `latches.csv` the latch locked (1) up to the release and
+/// open (0) after it, with its `contact` column.
+#[test]
+fn the_release_is_an_event_in_the_result_files() {
+    let dir = scratch("release");
+    let text = panel(
+        "end_time = 0.6\ntime_step = 0.001\nerror_tolerance = 1e-6",
+        &format!(
+            r#"
+[[loads]]
+node = 2
+moment = [0.0, 0.0, {RAMP}]
+curve = "ramp"
+
+[[latches]]
+id = 20
+joint = 10
+value = 0.0
+approach = "increasing"
+mode = "spring"
+stiffness = {K_HOLD}
+unlatch_load = {UNLATCH}
+"#
+        ),
+    );
+    let model = dir.join("model.toml");
+    std::fs::write(&model, text).unwrap();
+    let out = dir.join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args([
+            "run",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(0), "{run:?}");
+    let table = |name: &str| -> (Vec<String>, Vec<Vec<String>>) {
+        let text = std::fs::read_to_string(out.join(name)).unwrap();
+        let mut lines = text.lines();
+        let header = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows = lines
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect();
+        (header, rows)
+    };
+    let (header, rows) = table("events.csv");
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    let row = &rows[0];
+    assert_eq!(row[col("kind")], "unlatch");
+    assert_eq!(
+        (row[col("element")].as_str(), row[col("joint")].as_str()),
+        ("20", "10")
+    );
+    let c: f64 = row[col("coordinate")].parse().unwrap();
+    let lost: f64 = row[col("energy_lost")].parse().unwrap();
+    // θ at the release: F_u/k within the load's event tolerance (1e-6)
+    assert!((c * K_HOLD / UNLATCH - 1.0).abs() <= 1e-5, "{c}");
+    assert!((lost / (0.5 * UNLATCH * UNLATCH / K_HOLD) - 1.0).abs() <= 1e-5);
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    assert!(log.contains("unlatch at element 20 (joint 10)"), "{log}");
+    let (header, rows) = table("latches.csv");
+    assert_eq!(
+        header,
+        [
+            "step",
+            "time",
+            "latch",
+            "coordinate",
+            "locked",
+            "gap",
+            "load",
+            "contact"
+        ]
+    );
+    let locked: Vec<f64> = rows.iter().map(|r| r[4].parse().unwrap()).collect();
+    let first_open = locked.iter().position(|&l| l == 0.0).unwrap();
+    assert!(first_open > 10, "{locked:?}");
+    assert!(locked[..first_open].iter().all(|&l| l == 1.0));
+    assert!(locked[first_open..].iter().all(|&l| l == 0.0));
+}
+
 // ---------- (4) input errors through the command line ----------
 
 /// A fresh scratch directory for one test.

@@ -1472,13 +1472,8 @@ impl Dynamics<'_> {
             damping = Some(c);
         }
         let velocity_rows = rows.as_deref().zip(damping.as_ref());
-        let scaled = constrained_mass_system(
-            model,
-            self.solver,
-            state,
-            &mut run.mass_system,
-            velocity_rows,
-        );
+        let scaled =
+            constrained_mass_system(model, self.solver, state, &mut run.mass_system, velocity_rows);
         run.mass_system.damping = damping;
         let (_, s_eq) = scaled?;
         let dofs = &self.solver.dofs;

@@ -558,7 +558,7 @@ pub fn spring_latch_events_at(
             } else {
                 0.0
             };
-            let Some(event) = l.spring_transition(state, tol) else {
+            let Some(event) = l.spring_transition(state) else {
                 break;
             };
             let kind = match event {

@@ -297,7 +297,7 @@ impl Latch {
     /// an edge that turns back stays on its branch). The caller flips the
     /// sign of the event function ([`Self::flip_watch_sign`]). `None` for a
     /// rigid latch.
-    pub fn spring_transition(&self, state: &mut State, tol: f64) -> Option<SpringEvent> {
+    pub fn spring_transition(&self, state: &mut State) -> Option<SpringEvent> {
         let s = self.spring?;
         let slot = self.lock_slot();
         let event = if !self.is_locked(state) {
@@ -310,9 +310,11 @@ impl Latch {
             }
         } else {
             let (x, rate, f) = self.spring_state(state);
-            if s.unlatch_load.is_some_and(|fu| {
-                (fu - f.abs()) / (UNLATCH_TOLERANCE * fu) <= self.watch(state, tol)
-            }) {
+            // the load at its unlatch load releases the latch, whatever
+            // the band (both may land on one step)
+            if s.unlatch_load
+                .is_some_and(|fu| (fu - f.abs()) / (UNLATCH_TOLERANCE * fu) <= 1.0)
+            {
                 state.internal[slot] = 0.0;
                 state.internal[slot + SIDE] = if self.gap(state) > 0.0 { 1.0 } else { 0.0 };
                 SpringEvent::Unlatch

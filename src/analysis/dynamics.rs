@@ -1563,8 +1563,13 @@ impl Dynamics<'_> {
             damping = Some(c);
         }
         let velocity_rows = rows.as_deref().zip(damping.as_ref());
-        let scaled =
-            constrained_mass_system(model, self.solver, state, &mut run.mass_system, velocity_rows);
+        let scaled = constrained_mass_system(
+            model,
+            self.solver,
+            state,
+            &mut run.mass_system,
+            velocity_rows,
+        );
         run.mass_system.damping = damping;
         let (_, s_eq) = scaled?;
         let dofs = &self.solver.dofs;
@@ -2149,6 +2154,23 @@ impl Stepper for Dynamics<'_> {
             }
             None => Vec::new(),
         };
+        // spring latches latching or releasing (docs/theory.md §16.5)
+        let mut locks = locks;
+        let springs =
+            impact::spring_latch_events_at(model, &run.accepted, &mut run.state, info.increment);
+        if springs.restart {
+            initial_accelerations(model, self.solver, run, self.settings.end_time).map_err(
+                |failure| DynamicError::Initial {
+                    time: info.time,
+                    failure,
+                },
+            )?;
+            run.last_step = None;
+            run.a_before.clear();
+            run.a_before_coordinates.clear();
+        }
+        run.balance.impact(springs.released, 0.0);
+        locks.extend(springs.events);
         // stops reached or released: impact, then a restart (§16.4)
         let contacts = self.stop_events(info)?;
         let run = &mut *self.run;

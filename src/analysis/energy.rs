@@ -35,7 +35,7 @@ pub struct Energies {
     pub strain: f64,
     /// Potential of the weight, `−Σ m g·x_c`.
     pub gravity: f64,
-    /// Energy stored in springs and joint springs.
+    /// Energy stored in springs, joint springs and spring latches.
     pub spring: f64,
     /// Work done on the model by loads, drivers and prescribed motions
     /// since the start of the motion.
@@ -67,7 +67,9 @@ pub fn energies(model: &Model, state: &State) -> Energies {
         e.gravity += el.weight_potential(&ctx, state);
         let stored = el.strain_energy(&ctx, state);
         match el.kind() {
-            ElementKind::Spring | ElementKind::JointSpring => e.spring += stored,
+            ElementKind::Spring | ElementKind::JointSpring | ElementKind::Latch => {
+                e.spring += stored
+            }
             _ => e.strain += stored,
         }
     }

@@ -30,7 +30,7 @@ use super::energy;
 use super::newton::{NewtonSolver, SINGULAR_PIVOT};
 use crate::dofs::{DofKind, NO_EQUATION};
 use crate::elements::{ConstraintKind, Element, EvalContext, Need};
-use crate::joints::latch::EVENT_TOLERANCE;
+use crate::joints::latch::{SpringEvent, EVENT_TOLERANCE};
 use crate::joints::stop::Contact;
 use crate::joints::{Latch, Stop};
 use crate::linalg::{smallest_relative_pivot, SparseLu};
@@ -45,9 +45,33 @@ const MASSLESS: f64 = 1e-12;
 /// do not load an unknown.
 const NEGLIGIBLE_GRADIENT: f64 = 1e-12;
 
-/// A latch that locked during a dynamic analysis ([`super::Observer::lock`]).
+/// What happened at a latch ([`LockInfo::kind`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LatchEventKind {
+    /// The latch locked: a rigid latch's plastic impact, or a spring
+    /// latch latching (no impact).
+    #[default]
+    Lock,
+    /// A spring latch's load reached its unlatch load: it released.
+    Unlatch,
+}
+
+impl LatchEventKind {
+    /// The name written in `events.csv`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Lock => "lock",
+            Self::Unlatch => "unlatch",
+        }
+    }
+}
+
+/// A latch that locked (or a spring latch that released) during a dynamic
+/// analysis ([`super::Observer::lock`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LockInfo {
+    /// What happened.
+    pub kind: LatchEventKind,
     /// The step that landed on the lock.
     pub increment: usize,
     /// Time of the lock.
@@ -61,11 +85,17 @@ pub struct LockInfo {
     /// `ċ⁻`: the coordinate's rate just before the lock (with the
     /// velocities consistent with the other constraints).
     pub rate_before: f64,
+    /// `ċ⁺`: its rate just after (0 after a rigid lock; unchanged by a
+    /// spring latch's events).
+    pub rate_after: f64,
     /// `kπ`: the impulse of the lock along the coordinate (N·m·s for an
-    /// angle, N·s for a length), opposed to the approach.
+    /// angle, N·s for a length), opposed to the approach (0 for a spring
+    /// latch).
     pub impulse: f64,
     /// `½ Δvᵀ M Δv`: the energy the impact dissipates. Latches that lock
-    /// in the same step share one impact and report its whole loss.
+    /// in the same step share one impact and report its whole loss. For a
+    /// spring latch that releases, the energy its spring held (it leaves
+    /// the model with the latch); 0 when a spring latch latches.
     pub energy_lost: f64,
     /// `T⁻ − T⁺`, the drop of the kinetic energy: the energy lost plus
     /// [`Self::velocity_correction`] (when no constraint depends on time),
@@ -87,8 +117,9 @@ pub fn event_tolerance(model: &Model, latch: &Latch) -> f64 {
     }
 }
 
-/// The event function of a latch: `g = s (c − c_L)` while it is open, 1
-/// once locked (no more events).
+/// The event function of a latch: for a rigid latch `g = s (c − c_L)`
+/// while it is open, 1 once locked (no more events); for a spring latch
+/// `(−1)ⁿ w` ([`Latch::watch`], [`Latch::watch_sign`]), with the tolerance 1.
 pub struct LatchEvent {
     element: usize,
     name: String,
@@ -101,6 +132,9 @@ impl EventFunction for LatchEvent {
     }
     fn value(&self, model: &Model, state: &State) -> f64 {
         match model.elements[self.element].as_latch() {
+            Some(l) if l.spring().is_some() => {
+                l.watch_sign(state) * l.watch(state, event_tolerance(model, l))
+            }
             Some(l) if !l.is_locked(state) => l.gap(state),
             _ => 1.0,
         }
@@ -118,7 +152,11 @@ pub fn latch_events(model: &Model) -> Vec<Box<dyn EventFunction>> {
             events.push(Box::new(LatchEvent {
                 element,
                 name: format!("latch {}", e.id()),
-                tolerance: event_tolerance(model, l),
+                tolerance: if l.spring().is_some() {
+                    1.0
+                } else {
+                    event_tolerance(model, l)
+                },
             }));
         }
     }
@@ -370,7 +408,10 @@ pub fn lock_latches(
         .filter_map(|e| e.as_latch())
         .filter(|l| {
             let tol = event_tolerance(model, l);
-            !l.is_locked(state) && l.gap(before) < -tol && l.gap(state) >= -tol
+            l.spring().is_none()
+                && !l.is_locked(state)
+                && l.gap(before) < -tol
+                && l.gap(state) >= -tol
         })
         .collect();
     if reached.is_empty() {
@@ -448,12 +489,14 @@ pub fn lock_latches(
         .zip(&rows)
         .zip(&struck)
         .map(|((l, &eq), (rate, _))| LockInfo {
+            kind: LatchEventKind::Lock,
             increment,
             time,
             latch: l.id(),
             joint: l.joint(),
             coordinate: l.coordinate(state),
             rate_before: *rate,
+            rate_after: 0.0,
             impulse: if eq == NO_EQUATION {
                 0.0
             } else {
@@ -470,6 +513,97 @@ pub fn lock_latches(
         // T⁺ − T₁ = W − ½ΔvᵀMΔv
         work: kinetic_after - kinetic_consistent + j.energy,
     }))
+}
+
+// ---------- spring latches (docs/theory.md §16.5) ----------
+
+/// What [`spring_latch_events_at`] did.
+#[derive(Default)]
+pub struct SpringLatching {
+    /// The locks and releases, in the order of the latches.
+    pub events: Vec<LockInfo>,
+    /// The energy the springs of the latches that released held.
+    pub released: f64,
+    /// Whether a load jumped (a release, or a lock with a dashpot moving):
+    /// the accelerations must be made consistent again.
+    pub restart: bool,
+}
+
+/// The events of the spring latches over the accepted step from `before`
+/// to `state`: each whose watched quantity ([`Latch::watch`]) came from
+/// above 1 to at most 1 changes its state ([`Latch::spring_transition`]):
+/// it latches at `c_L` (no impact: its law is a spring about `c_L`),
+/// releases when its load reaches its unlatch load, or follows its
+/// coordinate across an edge of its dead band. A latch that locks with a
+/// load already at its unlatch load (a dashpot moving fast) releases at
+/// once.
+pub fn spring_latch_events_at(
+    model: &Model,
+    before: &State,
+    state: &mut State,
+    increment: usize,
+) -> SpringLatching {
+    let mut out = SpringLatching::default();
+    for l in model.elements.iter().filter_map(|e| e.as_latch()) {
+        let Some(spring) = l.spring() else {
+            continue;
+        };
+        let tol = event_tolerance(model, l);
+        if !(l.watch(before, tol) > 1.0 && l.watch(state, tol) <= 1.0) {
+            continue;
+        }
+        for _ in 0..3 {
+            let energy = if l.is_locked(state) {
+                spring.energy(l.spring_state(state).0)
+            } else {
+                0.0
+            };
+            let Some(event) = l.spring_transition(state) else {
+                break;
+            };
+            let kind = match event {
+                SpringEvent::Lock => {
+                    // the dashpot's load d ċ appears at once
+                    out.restart |= spring.damping * l.rate(state).0 != 0.0;
+                    LatchEventKind::Lock
+                }
+                SpringEvent::Unlatch => {
+                    // the dashpot's load d ċ appears at once
+                    out.restart |= spring.damping * l.rate(state).0 != 0.0;
+                    out.released += energy;
+                    LatchEventKind::Unlatch
+                }
+                SpringEvent::Rearm | SpringEvent::Band => break,
+            };
+            // the velocities do not jump
+            let rate = l.rate(state).0;
+            out.events.push(LockInfo {
+                kind,
+                increment,
+                time: state.time,
+                latch: l.id(),
+                joint: l.joint(),
+                coordinate: l.coordinate(state),
+                rate_before: rate,
+                rate_after: rate,
+                impulse: 0.0,
+                energy_lost: if kind == LatchEventKind::Unlatch {
+                    energy
+                } else {
+                    0.0
+                },
+                kinetic_energy_drop: 0.0,
+                velocity_correction: 0.0,
+            });
+            if kind == LatchEventKind::Unlatch || l.watch(state, tol) > 1.0 {
+                break;
+            }
+        }
+        // one flip of the event function's sign for the step, whatever the
+        // number of changes (the step controller crossed one event)
+        l.flip_watch_sign(state);
+    }
+    out
 }
 
 // ---------- unilateral stops (docs/theory.md §16.4) ----------

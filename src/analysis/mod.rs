@@ -29,7 +29,7 @@ pub mod statics;
 pub use control::EventFunction;
 pub use dynamics::{Continuation, DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
 pub use energy::{Energies, EnergyBalance};
-pub use impact::{ContactInfo, ContactKind, LockInfo};
+pub use impact::{ContactInfo, ContactKind, LatchEventKind, LockInfo};
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
 pub use settings::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
@@ -127,8 +127,9 @@ pub trait Observer {
     /// [`Observer::increment`] first).
     fn event(&mut self, _info: &EventInfo) {}
 
-    /// After the step on which a latch locked (reported to
-    /// [`Observer::increment`], with the post-impact state, first).
+    /// After the step on which a latch locked, or a spring latch released
+    /// ([`LockInfo::kind`]; reported to [`Observer::increment`], with the
+    /// post-event state, first).
     fn lock(&mut self, _info: &LockInfo) {}
 
     /// After the step on which a stop was struck, closed or released

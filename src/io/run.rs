@@ -932,6 +932,7 @@ impl Recorder {
         // a contact between bodies watches no joint
         let (element, on_joint, bare) = match row.kind {
             "lock" => ("latch", "locks joint", "locks"),
+            "unlatch" => ("latch", "releases joint", "releases"),
             "impact" => ("stop", "impact of joint", "impact"),
             "contact" => ("stop", "contact closed on joint", "contact closed"),
             _ => ("stop", "contact released on joint", "contact released"),
@@ -1249,11 +1250,11 @@ impl Observer for Recorder {
             increment: info.increment + self.increment_offset,
             time: info.time,
             element: info.latch,
-            kind: "lock",
+            kind: info.kind.name(),
             joint: Some(info.joint),
             coordinate: info.coordinate,
             rate_before: info.rate_before,
-            rate_after: 0.0,
+            rate_after: info.rate_after,
             impulse: info.impulse,
             energy_lost: info.energy_lost,
         });

@@ -5,6 +5,7 @@
 //! multipliers and scalings. Tolerance 1e-6 of the largest tangent entry
 //! (h = 1e-6: truncation ~1e-12·|third derivative|, round-off ~1e-10).
 
+use super::latch::SpringLatch;
 use super::types::{Coordinate, JointParameters, SliderCurve};
 use super::*;
 use crate::elements::testing::{eval, rate_errors, tangent_error};
@@ -273,6 +274,81 @@ fn latch_tangents_and_gradient_match_finite_differences() {
         }
     }
     println!("worst latch tangent and gradient error {worst:.2e}");
+}
+
+/// A spring latch, latched, on each branch of its law (within its dead
+/// band, beyond either edge; and without backlash), with its dashpot: the
+/// stiffness against central differences of the residual in `q` (with
+/// the dashpot's rate terms in dynamics), `∂r/∂v = d g gᵀ` against
+/// differences in the velocities (h = 1e-6 in q, 1e-3 in v: the residual
+/// is linear in v; 1e-6 of the largest entry, as above). The points stay
+/// 0.05 or more from the corners of the law, beyond the reach of the
+/// differences. Released, it applies nothing.
+#[test]
+fn spring_latch_tangents_match_finite_differences_on_each_branch() {
+    let mut rng = Lcg(17);
+    let coords = [Coordinate::Angle, Coordinate::Slide1, Coordinate::Cardan2];
+    let dynamic = EvalContext {
+        dynamics: true,
+        ..ctx()
+    };
+    let mut worst = 0.0f64;
+    for c in coords {
+        for grounded in [false, true] {
+            for _ in 0..4 {
+                let (src, x, q) = revolute_coordinate(&mut rng, grounded, c);
+                let nn = src.nodes.len();
+                for (backlash, offset, side) in [
+                    (0.2, 0.05, 0.0),
+                    (0.2, 0.35, 1.0),
+                    (0.2, -0.4, -1.0),
+                    (0.0, 0.3, 1.0),
+                    (0.0, -0.2, -1.0),
+                ] {
+                    let spring = SpringLatch {
+                        stiffness: 3.0,
+                        backlash,
+                        damping: 0.7,
+                        unlatch_load: Some(5.0),
+                    };
+                    let probe = Latch::new(5, 1, src.clone(), 0.0, 1.0).with_spring(spring);
+                    let mut s = moved(&mut rng, &x[..nn], &q[..nn], &probe);
+                    s.velocity = (0..nn)
+                        .map(|_| std::array::from_fn(|k| 30.0 * rng.next() + 10.0 * (k as f64)))
+                        .collect();
+                    s.internal.iter_mut().skip(1).for_each(|v| *v = 0.0);
+                    // c_L so that c − c_L = offset
+                    let value = probe.coordinate(&s) - offset;
+                    let latch = Latch::new(5, 1, src.clone(), value, 1.0).with_spring(spring);
+                    assert_eq!(latch.n_multipliers(), 0);
+                    let (_, r) = eval(&latch, &ctx(), &s);
+                    assert!(r.iter().all(|&v| v == 0.0), "released: no stiffness");
+                    latch.lock(&mut s);
+                    let (xc, _, f) = latch.spring_state(&s);
+                    assert!((xc - offset).abs() < 1e-12);
+                    let (fs, _) = spring.spring_force(offset);
+                    assert_eq!(fs == 0.0, side == 0.0);
+                    let mut res = [0.0; 5];
+                    latch.results(&ctx(), &s, &mut res);
+                    assert_eq!((res[1], res[4]), (1.0, side));
+                    assert_eq!(res[3], -f);
+                    for (what, cx) in [("statics", ctx()), ("dynamics", dynamic)] {
+                        let err = tangent_error(&latch, &cx, &s, 1e-6);
+                        assert!(
+                            err < 1e-6,
+                            "spring latch on {} at x = {offset} ({what}): {err:.3e}",
+                            c.name()
+                        );
+                        worst = worst.max(err);
+                    }
+                    let (ev, _) = rate_errors(&latch, &dynamic, &s, 1e-3, 1e-3);
+                    assert!(ev < 1e-6, "spring latch on {}: ∂r/∂v {ev:.3e}", c.name());
+                    worst = worst.max(ev);
+                }
+            }
+        }
+    }
+    println!("worst spring-latch tangent error {worst:.2e}");
 }
 
 /// A node driver measures the node's own motion along a fixed direction.

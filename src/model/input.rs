@@ -363,8 +363,8 @@ pub struct DriverInput {
 }
 
 /// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
-/// when it reaches `value` moving in the direction of approach, and stays
-/// locked.
+/// when it reaches `value` moving in the direction of approach, rigidly
+/// (and stays locked) or through a stiff spring (which may release).
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct LatchInput {
@@ -385,9 +385,25 @@ pub struct LatchInput {
     /// (default: away from the reference configuration, where it is 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub approach: Option<Approach>,
-    /// `rigid` (default): once locked, `c = c_L` is a constraint.
+    /// `rigid` (default): once locked, `c = c_L` is a constraint;
+    /// `spring`: a stiff spring about `c_L`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mode: Option<LatchMode>,
+    /// Spring mode: its stiffness `k > 0` (N·m/rad or N/m; per `unit` on
+    /// an angle).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<f64>,
+    /// Spring mode: the total width `b ≥ 0` of the dead band about `c_L`
+    /// (m, or rad unless `unit` says otherwise), default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backlash: Option<f64>,
+    /// Spring mode: the coefficient `d ≥ 0` of its dashpot (N·m·s/rad or
+    /// N·s/m; per `unit` on an angle), default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
+    /// Spring mode: the load (N·m or N) at which it releases; none: never.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unlatch_load: Option<f64>,
 }
 
 /// A unilateral stop on a joint coordinate (docs/joints.md §6.3): the
@@ -515,6 +531,9 @@ pub enum LatchMode {
     /// `c − c_L = 0` is a constraint with a multiplier.
     #[default]
     Rigid,
+    /// A stiff spring about `c_L`, with backlash, a dashpot and an unlatch
+    /// load.
+    Spring,
 }
 
 /// The analyses of a model: one (`[analysis]`, the default static analysis

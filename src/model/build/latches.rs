@@ -2,8 +2,9 @@
 
 use super::joints::{angle_unit, joint_coordinate, Context, Joints};
 use super::AngleLimit;
+use crate::joints::latch::SpringLatch;
 use crate::joints::Latch;
-use crate::model::input::{Approach, LatchInput};
+use crate::model::input::{Approach, LatchInput, LatchMode};
 use crate::model::ModelErrorKind;
 
 pub(super) fn latch(
@@ -21,7 +22,8 @@ pub(super) fn latch(
         return None;
     }
     let source = joint_coordinate(cx, entity, l.joint, &l.coordinate, joints)?;
-    let value = l.value * angle_unit(cx, entity, l.unit, &source)?;
+    let unit = angle_unit(cx, entity, l.unit, &source)?;
+    let value = l.value * unit;
     let approach = match l.approach {
         Some(Approach::Increasing) => 1.0,
         Some(Approach::Decreasing) => -1.0,
@@ -40,5 +42,106 @@ pub(super) fn latch(
         cx.ck
             .unitless_angle(entity, "locks at", value, AngleLimit::FullTurn);
     }
-    Some(Latch::new(l.id, l.joint, source, value, approach))
+    let latch = Latch::new(l.id, l.joint, source, value, approach);
+    match l.mode.unwrap_or_default() {
+        LatchMode::Rigid => {
+            let given: Vec<&str> = [
+                ("stiffness", l.stiffness),
+                ("backlash", l.backlash),
+                ("damping", l.damping),
+                ("unlatch_load", l.unlatch_load),
+            ]
+            .iter()
+            .filter(|(_, v)| v.is_some())
+            .map(|(k, _)| *k)
+            .collect();
+            if !given.is_empty() {
+                cx.ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!(
+                        "`{}` {} to spring latches: add mode = \"spring\" (a rigid latch holds its coordinate as a constraint)",
+                        given.join("`, `"),
+                        if given.len() == 1 { "applies" } else { "apply" }
+                    ),
+                );
+                return None;
+            }
+            Some(latch)
+        }
+        LatchMode::Spring => {
+            let spring = spring(cx, entity, l, unit, latch.is_angle())?;
+            Some(latch.with_spring(spring))
+        }
+    }
+}
+
+/// The compliant lock of a spring latch, its angles in `unit` (rad per
+/// unit of the entry) converted to radians.
+fn spring(
+    cx: &mut Context,
+    entity: &str,
+    l: &LatchInput,
+    unit: f64,
+    angle: bool,
+) -> Option<SpringLatch> {
+    let mut ok = true;
+    let mut bad = |cx: &mut Context, kind, message: String| {
+        cx.ck.push(kind, entity, message);
+        ok = false;
+    };
+    let stiffness = match l.stiffness {
+        None => {
+            bad(
+                cx,
+                ModelErrorKind::Missing,
+                "a spring latch needs `stiffness` (N·m/rad or N/m, positive)".into(),
+            );
+            0.0
+        }
+        Some(k) if !(k.is_finite() && k > 0.0 && (k / unit).is_finite()) => {
+            bad(
+                cx,
+                ModelErrorKind::NonPositive,
+                format!("stiffness must be positive and finite, got {k}"),
+            );
+            0.0
+        }
+        Some(k) => k / unit,
+    };
+    let backlash = l.backlash.unwrap_or(0.0);
+    if !(backlash.is_finite() && backlash >= 0.0) {
+        bad(
+            cx,
+            ModelErrorKind::Invalid,
+            format!("backlash must be zero or positive and finite, got {backlash}"),
+        );
+    }
+    let damping = l.damping.unwrap_or(0.0);
+    if !(damping.is_finite() && damping >= 0.0 && (damping / unit).is_finite()) {
+        bad(
+            cx,
+            ModelErrorKind::Invalid,
+            format!("damping must be zero or positive and finite, got {damping}"),
+        );
+    }
+    if let Some(f) = l.unlatch_load {
+        if !(f.is_finite() && f > 0.0) {
+            bad(
+                cx,
+                ModelErrorKind::NonPositive,
+                format!("unlatch_load must be positive and finite, got {f}"),
+            );
+        }
+    }
+    if angle && l.unit.is_none() {
+        cx.ck
+            .unitless_angle(entity, "backlash is", backlash, AngleLimit::FullTurn);
+    }
+    ok.then(|| SpringLatch {
+        stiffness,
+        backlash: backlash * unit,
+        damping: damping / unit,
+        unlatch_load: l.unlatch_load,
+    })
 }

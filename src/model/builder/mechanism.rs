@@ -9,7 +9,8 @@ use crate::model::handles::{
 };
 use crate::model::input::{
     AngleUnit, Approach, ContactInput, ContactType, DriverInput, HingeLawInput, JointInput,
-    JointSpringInput, LatchInput, RollingDiscInput, StartBranch, StopInput, TapeSpringInput,
+    JointSpringInput, LatchInput, LatchMode, RollingDiscInput, StartBranch, StopInput,
+    TapeSpringInput,
 };
 use crate::model::Id;
 
@@ -415,7 +416,8 @@ impl Entity for Driver {
 
 /// A latch on a joint coordinate (docs/joints.md §6.2): the coordinate locks
 /// when it reaches its locking value moving in the direction of approach,
-/// and stays locked (in dynamic analyses, with the impact of the lock).
+/// rigidly and for good (in dynamic analyses, with the impact of the lock)
+/// or, with [`Latch::spring`], through a stiff spring.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Latch {
     input: LatchInput,
@@ -453,6 +455,34 @@ impl Latch {
     /// the reference configuration, where it is 0).
     pub fn approach(mut self, approach: Approach) -> Self {
         self.input.approach = Some(approach);
+        self
+    }
+
+    /// A spring latch (docs/joints.md §6.2): once latched, a spring of
+    /// stiffness `stiffness` about the locking value (N·m/rad or N/m; per
+    /// degree with [`Latch::angle`] in degrees) instead of a constraint.
+    pub fn spring(mut self, stiffness: f64) -> Self {
+        self.input.mode = Some(LatchMode::Spring);
+        self.input.stiffness = Some(stiffness);
+        self
+    }
+
+    /// A spring latch's dead band: its total width about the locking
+    /// value, in the unit of the locking value.
+    pub fn backlash(mut self, backlash: f64) -> Self {
+        self.input.backlash = Some(backlash);
+        self
+    }
+
+    /// A spring latch's dashpot, acting while latched.
+    pub fn damping(mut self, damping: f64) -> Self {
+        self.input.damping = Some(damping);
+        self
+    }
+
+    /// The load at which a spring latch releases.
+    pub fn unlatch_load(mut self, load: f64) -> Self {
+        self.input.unlatch_load = Some(load);
         self
     }
 

@@ -2136,14 +2136,16 @@ impl Watch {
     /// largest energy so far is a step that created or lost energy (a
     /// spurious root, a step far too long for the motion).
     fn energy_jump(&mut self, before: &Energies, after: &Energies) -> Option<String> {
-        self.largest = self.largest.max(self.scale(before)).max(self.scale(after));
+        let so_far = self.largest.max(self.scale(before));
+        self.largest = so_far.max(self.scale(after));
         let jump = after.balance_error - before.balance_error;
         (jump.abs() > ENERGY_JUMP * self.largest).then(|| {
             format!(
-                "the energy balance error changed by {jump:.3e} in one step (from {:.3e} to {:.3e}), more than {} % of the largest energy of the motion ({:.3e}): the step created or lost energy; its results are suspect (shorten time_step, or use adaptive steps)",
+                "the energy balance error changed by {jump:.3e} in one step (from {:.3e} to {:.3e}), more than {} % of the largest energy of the motion ({:.3e} before this step, {:.3e} with it): the step created or lost energy; its results are suspect (shorten time_step, or use adaptive steps)",
                 before.balance_error,
                 after.balance_error,
                 ENERGY_JUMP * 100.0,
+                so_far,
                 self.largest
             )
         })

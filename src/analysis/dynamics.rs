@@ -675,6 +675,11 @@ impl DynamicAnalysis {
         let result = controller.advance(&mut stepper, observer);
         let run = stepper.run;
         run.controller = Some(controller);
+        if !matches!(result, Ok(Advance::Accepted(_))) {
+            for w in run.watch.warnings() {
+                observer.warning(&w);
+            }
+        }
         match result {
             Ok(Advance::Accepted(info)) => Step::Increment(info),
             Ok(Advance::Finished) => {
@@ -2023,14 +2028,7 @@ impl Stepper for Dynamics<'_> {
         let residual = self.solver.residual();
         let before = run.energies;
         run.energies = run.balance.record(model, &run.state, Some(residual));
-        if let Some(message) = run.watch.energy_jump(&before, &run.energies) {
-            observer.warning(&WarningInfo {
-                increment: info.increment,
-                from: info.time - info.step,
-                time: info.time,
-                message,
-            });
-        }
+        run.watch.energy_jump(info, &before, &run.energies);
         observer.energies(&run.energies);
         observer.increment(info, model, &run.state, residual)?;
         for l in &locks {
@@ -2107,6 +2105,11 @@ struct Watch {
     /// residual above the residual tolerance: the relative residual and
     /// the last corrections (translation, rotation).
     round_off: Option<(f64, f64, f64)>,
+    /// The steps whose change of `E` was above [`ENERGY_JUMP`] of the
+    /// largest energy when they were taken: the step, `E` before and
+    /// after. Reported at the end of the analysis against the largest
+    /// energy of the whole motion ([`Watch::warnings`]).
+    jumps: Vec<(IncrementInfo, f64, f64)>,
     /// Notes given once per analysis: a step accepted at its round-off
     /// plateau, a fixed step with a large error estimate.
     round_off_noted: bool,
@@ -2133,22 +2136,41 @@ impl Watch {
     /// D12 checked step by step: the balance error `E` should change by
     /// the integrator's error of one step, a small fraction of the
     /// energies in play; a change by more than [`ENERGY_JUMP`] of the
-    /// largest energy so far is a step that created or lost energy (a
-    /// spurious root, a step far too long for the motion).
-    fn energy_jump(&mut self, before: &Energies, after: &Energies) -> Option<String> {
-        let so_far = self.largest.max(self.scale(before));
-        self.largest = so_far.max(self.scale(after));
+    /// largest energy of the motion is a step that created or lost energy
+    /// (a spurious root, a step far too long for the motion). The step
+    /// `info` is kept if its change is above that fraction of the largest
+    /// energy so far; [`Watch::warnings`] keeps those above it for the
+    /// whole motion (from rest, the first steps' errors are large next to
+    /// the energies reached so far, and small next to those reached
+    /// later).
+    fn energy_jump(&mut self, info: &IncrementInfo, before: &Energies, after: &Energies) {
+        self.largest = self.largest.max(self.scale(before)).max(self.scale(after));
         let jump = after.balance_error - before.balance_error;
-        (jump.abs() > ENERGY_JUMP * self.largest).then(|| {
-            format!(
-                "the energy balance error changed by {jump:.3e} in one step (from {:.3e} to {:.3e}), more than {} % of the largest energy of the motion ({:.3e} before this step, {:.3e} with it): the step created or lost energy; its results are suspect (shorten time_step, or use adaptive steps)",
-                before.balance_error,
-                after.balance_error,
-                ENERGY_JUMP * 100.0,
-                so_far,
-                self.largest
-            )
-        })
+        if jump.abs() > ENERGY_JUMP * self.largest {
+            self.jumps
+                .push((info.clone(), before.balance_error, after.balance_error));
+        }
+    }
+
+    /// The warnings of the steps kept by [`Watch::energy_jump`] whose
+    /// change of `E` is above [`ENERGY_JUMP`] of the largest energy of the
+    /// motion (once, at the end of the analysis).
+    fn warnings(&mut self) -> Vec<WarningInfo> {
+        let largest = self.largest;
+        std::mem::take(&mut self.jumps)
+            .into_iter()
+            .filter(|(_, before, after)| (after - before).abs() > ENERGY_JUMP * largest)
+            .map(|(info, before, after)| WarningInfo {
+                increment: info.increment,
+                from: info.time - info.step,
+                time: info.time,
+                message: format!(
+                    "the energy balance error changed by {:.3e} in one step (from {before:.3e} to {after:.3e}), more than {} % of the largest energy of the motion ({largest:.3e}): the step created or lost energy; its results are suspect (shorten time_step, or use adaptive steps)",
+                    after - before,
+                    ENERGY_JUMP * 100.0,
+                ),
+            })
+            .collect()
     }
 }
 
@@ -2257,10 +2279,19 @@ mod tests {
             balance_error,
             ..Energies::default()
         };
+        let step = |increment: usize| IncrementInfo {
+            increment,
+            time: 1e-3 * increment as f64,
+            step: 1e-3,
+            iterations: 1,
+            residuals: Vec::new(),
+            output: true,
+        };
         let mut watch = Watch {
             start: at(0.0, 0.0, 9.869604401089, 0.0),
             ..Watch::default()
         };
+        let start = watch.start;
         let step23 = at(
             1.314608087748e-1,
             7.981515779887e-2,
@@ -2279,11 +2310,41 @@ mod tests {
             9.743204174856,
             1.664721e2,
         );
-        let start = watch.start;
-        assert!(watch.energy_jump(&start, &step23).is_none());
-        assert!(watch.energy_jump(&step23, &step24).is_none());
-        let message = watch.energy_jump(&step24, &step25).expect("a jump");
+        watch.energy_jump(&step(23), &start, &step23);
+        watch.energy_jump(&step(24), &step23, &step24);
+        watch.energy_jump(&step(25), &step24, &step25);
+        let warnings = watch.warnings();
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert_eq!(warnings[0].increment, 25);
+        let message = &warnings[0].message;
         assert!(message.contains("changed by 1.665e2"), "{message}");
         assert!(message.contains("more than 5 %"), "{message}");
+    }
+
+    /// From rest, the first steps' balance errors are large next to the
+    /// energies reached so far (a driven body: −1.2e-10 with a kinetic
+    /// energy of 2.8e-10 after the first step) and small next to those of
+    /// the motion (1.4): not reported.
+    #[test]
+    fn the_errors_of_the_first_steps_from_rest_are_not_reported() {
+        let at = |kinetic: f64, balance_error: f64| Energies {
+            kinetic,
+            balance_error,
+            ..Energies::default()
+        };
+        let step = |increment: usize| IncrementInfo {
+            increment,
+            time: 1e-3 * increment as f64,
+            step: 1e-3,
+            iterations: 1,
+            residuals: Vec::new(),
+            output: true,
+        };
+        let mut watch = Watch::default();
+        let (e0, e1, e2) = (at(0.0, 0.0), at(2.846e-10, -1.212e-10), at(1.4, -1.3e-8));
+        watch.energy_jump(&step(1), &e0, &e1);
+        assert_eq!(watch.jumps.len(), 1);
+        watch.energy_jump(&step(2), &e1, &e2);
+        assert!(watch.warnings().is_empty());
     }
 }

@@ -845,3 +845,235 @@ fn events_csv_lists_the_impacts_of_a_stop() {
     let s = summary(&out);
     assert_eq!(s["analyses"][0]["dynamic"]["impacts"], 0);
 }
+
+/// `unfold check MODEL`.
+fn check(model: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args(["check", model.to_str().unwrap()])
+        .output()
+        .unwrap()
+}
+
+/// With `adaptive = false` the steps are `time_step` (docs/model-format.md)
+/// even when `max_step` is given larger, which is warned about as having
+/// no effect: over 0.6 s in steps of 5 ms with an output time at 0.1234,
+/// every step is 5 ms but the one landing on 0.1234 (3.4 ms) and the last
+/// one, landing on 0.6 (1.6 ms). (Before, easy steps grew by 1.5 up to
+/// `max_step`: 1004 steps instead of 10 000 in the case reported.)
+#[test]
+fn fixed_steps_stay_at_time_step_when_max_step_is_given() {
+    let dir = scratch("fixed-max-step");
+    let model = dir.join("pendulum.toml");
+    std::fs::write(
+        &model,
+        pendulum(&FIXED.replace("adaptive", "max_step = 0.05\nadaptive"), ""),
+    )
+    .unwrap();
+    let c = check(&model);
+    let text = String::from_utf8_lossy(&c.stdout).into_owned() + &stderr(&c);
+    assert_eq!(c.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains("max_step (0.05) has no effect with adaptive = false"),
+        "{text}"
+    );
+    assert!(text.contains("time step 0.005 (fixed)"), "{text}");
+    assert!(text.contains("max_step 0.005"), "{text}");
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let rows = table(&out.join("steps.csv"));
+    let sizes: Vec<f64> = rows[1..].iter().map(|r| num(r, "step_size")).collect();
+    // steps.csv writes 7 significant digits
+    let h = 0.005;
+    assert!(sizes.iter().all(|&s| s <= h * (1.0 + 1e-6)), "{sizes:?}");
+    let short: Vec<f64> = sizes
+        .iter()
+        .copied()
+        .filter(|&s| s < h * (1.0 - 1e-6))
+        .collect();
+    assert_eq!(short.len(), 2, "{short:?}");
+    assert!((short[0] - 0.0034).abs() < 1e-9, "{short:?}");
+    assert!((short[1] - 0.0016).abs() < 1e-9, "{short:?}");
+    assert_eq!(sizes.len(), 121);
+}
+
+/// The step settings are checked with messages that name what the user
+/// wrote (docs/model-format.md, dynamic analyses):
+/// - `max_step` alone, smaller than the default first step span/100: the
+///   first step is `max_step` (no error about derived values);
+/// - a `time_step` lost in the round-off of `t` is named as such, not
+///   through the `min_step` derived from it;
+/// - fixed steps of 1 µs over 10 s: too many steps, not a `min_step`
+///   message;
+/// - two output times nearer than a step can be: an error naming both
+///   (before, the second was dropped silently).
+#[test]
+fn step_settings_are_refused_naming_what_was_written() {
+    let dir = scratch("step-settings");
+    let dynamic = |keys: &str| format!("[analysis]\ntype = \"dynamic\"\nend_time = 10.0\n{keys}\n");
+    let cases: [(&str, String, Option<&str>, &[&str]); 4] = [
+        (
+            "max-step-only",
+            dynamic("max_step = 0.01"),
+            None,
+            &["time step 0.01 (adaptive"],
+        ),
+        (
+            "tiny-step",
+            dynamic("time_step = 1e-12\nmax_step = 0.01"),
+            Some("min_step"),
+            &[
+                "analysis: time_step must be at least end_time·1e-12 = 1e-11",
+                "got 1e-12",
+            ],
+        ),
+        (
+            "many-steps",
+            dynamic("time_step = 1e-6\nadaptive = false"),
+            Some("min_step"),
+            &["would need more than 1e6 steps"],
+        ),
+        (
+            "close-output-times",
+            dynamic(
+                "time_step = 0.001\nmax_step = 0.01\noutput_times = [0.0005, 0.00050000001, 3.0]",
+            ),
+            None,
+            &[
+                "output_times 0.0005 and 0.00050000001",
+                "cannot land on both",
+            ],
+        ),
+    ];
+    for (name, analysis, absent, wanted) in cases {
+        let model = dir.join(format!("{name}.toml"));
+        std::fs::write(&model, pendulum(&analysis, "")).unwrap();
+        let c = check(&model);
+        let text = String::from_utf8_lossy(&c.stdout).into_owned() + &stderr(&c);
+        let code = if name == "max-step-only" { 0 } else { 2 };
+        assert_eq!(c.status.code(), Some(code), "{name}: {text}");
+        for w in wanted {
+            assert!(text.contains(w), "{name}: {w:?} not in {text}");
+        }
+        if let Some(a) = absent {
+            assert!(!text.contains(a), "{name}: {a:?} in {text}");
+        }
+    }
+}
+
+/// A fixed step far too long for the motion is noted once, with the
+/// local error estimate it has: the pendulum (small-swing period 1.55 s)
+/// in steps of 0.5 s (an estimate of order 1 of the step's motion); the
+/// same pendulum in steps of 5 ms has none.
+#[test]
+fn a_fixed_step_too_long_for_the_motion_is_noted() {
+    let dir = scratch("long-fixed-step");
+    for (name, analysis, noted) in [
+        (
+            "long",
+            "[analysis]\ntype = \"dynamic\"\nend_time = 3.0\ntime_step = 0.5\nadaptive = false\n"
+                .to_string(),
+            true,
+        ),
+        ("short", FIXED.to_string(), false),
+    ] {
+        let model = dir.join(format!("{name}.toml"));
+        std::fs::write(&model, pendulum(&analysis, "")).unwrap();
+        let out = dir.join(name);
+        let o = run(&model, &out, &[]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+        let notes = log
+            .lines()
+            .filter(|l| l.contains("note:") && l.contains("local error estimate of the fixed step"))
+            .count();
+        assert_eq!(notes, usize::from(noted), "{name}: {log}");
+    }
+}
+
+/// A step accepted at the round-off plateau of its residual, whose log
+/// line ends with a relative residual above `residual_tolerance`, is
+/// explained by a note, once per analysis (docs/results.md, log.txt): a
+/// free 2 m beam in 10 elements falling and spinning at 1 rad/s has such
+/// steps (relative residual ~4e-7 against 1e-8, last correction ~1e-15 of
+/// the unknowns).
+#[test]
+fn a_step_accepted_at_round_off_is_noted_once() {
+    let dir = scratch("round-off");
+    let model = dir.join("falling_beam.toml");
+    std::fs::write(
+        &model,
+        r#"title = "falling spinning beam"
+[analysis]
+type = "dynamic"
+end_time = 2.0
+time_step = 0.001
+max_step = 0.01
+output_times = [0.5, 1.0, 1.5]
+output_every = 1000
+
+[[sections]]
+name = "rod"
+EA = 2.2e7
+GA2 = 7.35e6
+GA3 = 7.35e6
+GJ = 408.0
+EI2 = 550.0
+EI3 = 550.0
+mass_per_length = 0.848
+inertia_per_length = [4.24e-5, 2.12e-5, 2.12e-5]
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 11
+x = [2.0, 0.0, 0.0]
+
+[[beam_lines]]
+nodes = [1, 11]
+elements = 10
+section = "rod"
+orientation = [0.0, 1.0, 0.0]
+first_node = 2
+first_element = 1
+
+[[initial_motion]]
+nodes = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]
+angular_velocity = [0.0, 0.0, 1.0]
+about = [1.0, 0.0, 0.0]
+
+[gravity]
+acceleration = [0.0, 0.0, -9.81]
+"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    let above = log
+        .lines()
+        .filter(|l| l.starts_with("step"))
+        .filter(|l| {
+            l.split_whitespace()
+                .last()
+                .and_then(|r| r.parse::<f64>().ok())
+                .is_some_and(|r| r > 1e-8)
+        })
+        .count();
+    assert!(above >= 1, "{log}");
+    let notes: Vec<&str> = log
+        .lines()
+        .filter(|l| {
+            l.starts_with("note:") && l.contains("converged at the round-off of its residual")
+        })
+        .collect();
+    assert_eq!(notes.len(), 1, "{log}");
+    assert!(
+        notes[0].contains("above residual_tolerance 1e-8"),
+        "{}",
+        notes[0]
+    );
+}

@@ -52,7 +52,7 @@ use super::energy::{Energies, EnergyBalance};
 use super::impact::{self, ContactInfo, ContactKind, LockInfo};
 use super::newton::{non_finite_origin, NewtonFailure, NewtonSolver, SINGULAR_PIVOT};
 use super::settings::DynamicSettings;
-use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer};
+use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer, WarningInfo};
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
 use crate::elements::{ConstraintKind, ConstraintScaling, EvalContext, Need};
 use crate::linalg::{smallest_relative_pivot, SparseLu, SparseMatrix};
@@ -102,6 +102,35 @@ const VELOCITY_TOLERANCE: f64 = 1e-6;
 /// Corrections larger than this times the model size, or than this in
 /// radians, mean the iteration matrix is singular or nearly so.
 const RUNAWAY_CORRECTION: f64 = 1e6;
+
+/// Largest rotation of a node in one converged step, in radians: the
+/// incremental rotation vector `h |Δq_θ|` or the turn at the end
+/// velocity `h |Ω_{n+1}|`. A rotation vector of `2π` is the identity:
+/// beyond half a turn an increment cannot tell its turn from a shorter one
+/// the other way (as the joint angles, docs/joints.md §3.3), and Newton
+/// may converge to a spurious root where a light node spins whole turns
+/// per step while its positions look right (docs/theory.md §15.5). 1 rad
+/// keeps a margin of π; the step is cut back.
+pub const MAX_ROTATION_STEP: f64 = 1.0;
+
+/// Largest change of a node's rotation increment from the predictor to the
+/// converged step (rad): Newton carried the node more than half a turn
+/// from where the step started it, past the turn an increment can tell
+/// (docs/theory.md §15.5); the step is cut back.
+pub const MAX_ROTATION_CORRECTION: f64 = std::f64::consts::PI;
+
+/// Largest change of a node's translation from the predictor to the
+/// converged step, as a multiple of the model's size.
+pub const MAX_TRANSLATION_CORRECTION: f64 = 1.0;
+
+/// A change of the energy balance error `E` in one step by more than this
+/// fraction of the largest energy of the motion so far is reported as a
+/// warning (docs/theory.md §15.6).
+pub const ENERGY_JUMP: f64 = 0.05;
+
+/// With fixed steps, a local error estimate above this fraction of the
+/// step's motion is noted once (docs/theory.md §15.5).
+pub const FIXED_STEP_ERROR_NOTE: f64 = 1e-2;
 
 /// The constants of the generalised-α method (D1).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -279,6 +308,12 @@ struct Run {
     /// coordinate.
     dq: Vec<[f64; 6]>,
     dq_coordinates: Vec<f64>,
+    /// `Δq_n` of the attempted step at its predictor (D5), for the checks
+    /// of the converged step ([`Dynamics::spurious`]).
+    dq_predicted: Vec<[f64; 6]>,
+    /// The checks of the run: energies at the start, largest energy so
+    /// far, notes already given.
+    watch: Watch,
     /// `a_n` for the attempted step, adjusted to its size (D5).
     a_start: Vec<[f64; 6]>,
     a_start_coordinates: Vec<f64>,
@@ -502,6 +537,8 @@ impl DynamicAnalysis {
             accepted: state.clone(),
             dq: vec![[0.0; 6]; model.n_nodes()],
             dq_coordinates: vec![0.0; state.coordinates.len()],
+            dq_predicted: vec![[0.0; 6]; model.n_nodes()],
+            watch: Watch::default(),
             a_start: vec![[0.0; 6]; model.n_nodes()],
             a_start_coordinates: vec![0.0; state.coordinates.len()],
             last_step: self.continuation.and_then(|c| c.last_step),
@@ -584,6 +621,7 @@ impl DynamicAnalysis {
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual().to_vec();
         run.energies = run.balance.record(model, &run.state, Some(&residual));
+        run.watch.start = run.energies;
         observer.energies(&run.energies);
         let info = IncrementInfo {
             increment: 0,
@@ -595,10 +633,15 @@ impl DynamicAnalysis {
         };
         let written = observer.increment(&info, model, &run.state, &residual);
 
+        // fixed steps grow back after a cut-back to time_step, no further
         let bounds = StepBounds {
             initial: s.time_step,
             min: s.min_step,
-            max: s.max_step,
+            max: if s.adaptive {
+                s.max_step
+            } else {
+                s.time_step.min(s.max_step)
+            },
         };
         run.controller = Some(
             StepController::new(bounds, s.end_time)
@@ -652,6 +695,11 @@ impl DynamicAnalysis {
             controller.set_size(size);
         }
         run.controller = Some(controller);
+        if !matches!(result, Ok(Advance::Accepted(_))) {
+            for w in run.watch.warnings() {
+                observer.warning(&w);
+            }
+        }
         match result {
             Ok(Advance::Accepted(info)) => Step::Increment(info),
             Ok(Advance::Finished) => {
@@ -1843,6 +1891,8 @@ impl Dynamics<'_> {
         let sc = self.scheme;
         self.rescale_normal_velocity(h)?;
         self.predict(h);
+        self.run.dq_predicted.clone_from(&self.run.dq);
+        self.run.watch.round_off = None;
         let scale = Scale::new(&model.scaling, sc.beta_prime(h), self.run.mass_scale);
         let t = self.run.state.time;
         let mut residuals = Vec::new();
@@ -1914,6 +1964,10 @@ impl Dynamics<'_> {
                         && (loose.relative_residual <= tol || self.at_round_off(dx, dth))
                 };
                 if converged || plateau() {
+                    if !converged && norms.relative_residual > tol {
+                        let (dx, dth) = last.unwrap_or_default();
+                        self.run.watch.round_off = Some((norms.relative_residual, dx, dth));
+                    }
                     return Ok((iteration, residuals));
                 }
             }
@@ -2096,11 +2150,17 @@ impl Stepper for Dynamics<'_> {
                     Ok(converged)
                 }
             }) {
-            Ok((iterations, residuals)) => Attempt::Converged {
-                iterations,
-                residuals,
-                error: self.settings.adaptive.then(|| self.error_estimate(size)),
-            },
+            Ok((iterations, residuals)) => {
+                if let Some(what) = self.spurious(size) {
+                    return Attempt::Failed(NewtonFailure::Spurious { iterations, what });
+                }
+                self.notes(size, increment, observer);
+                Attempt::Converged {
+                    iterations,
+                    residuals,
+                    error: self.settings.adaptive.then(|| self.error_estimate(size)),
+                }
+            }
             Err(f) => Attempt::Failed(f),
         }
     }
@@ -2176,7 +2236,9 @@ impl Stepper for Dynamics<'_> {
         let run = &mut *self.run;
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual();
+        let before = run.energies;
         run.energies = run.balance.record(model, &run.state, Some(residual));
+        run.watch.energy_jump(info, &before, &run.energies);
         observer.energies(&run.energies);
         observer.increment(info, model, &run.state, residual)?;
         for l in &locks {
@@ -2239,5 +2301,261 @@ impl Dynamics<'_> {
         run.balance.impact(i.energy_lost, i.work);
         run.rebound_step = i.rebound_step;
         Ok(i.events)
+    }
+}
+
+/// What the checks of the converged steps keep (docs/theory.md §15.5,
+/// §15.6).
+#[derive(Default)]
+struct Watch {
+    /// The energies at the start of the analysis.
+    start: Energies,
+    /// The largest energy of the motion so far ([`Watch::scale`]).
+    largest: f64,
+    /// The attempted step was accepted at the round-off plateau of its
+    /// residual above the residual tolerance: the relative residual and
+    /// the last corrections (translation, rotation).
+    round_off: Option<(f64, f64, f64)>,
+    /// The steps whose change of `E` was above [`ENERGY_JUMP`] of the
+    /// largest energy when they were taken: the step, `E` before and
+    /// after. Reported at the end of the analysis against the largest
+    /// energy of the whole motion ([`Watch::warnings`]).
+    jumps: Vec<(IncrementInfo, f64, f64)>,
+    /// Notes given once per analysis: a step accepted at its round-off
+    /// plateau, a fixed step with a large error estimate.
+    round_off_noted: bool,
+    fixed_step_noted: bool,
+}
+
+impl Watch {
+    /// The size of the energies of the motion at `e`: the largest of `T`,
+    /// the strain and spring energies, the change of the weight's
+    /// potential since the start, the work and the dissipation.
+    fn scale(&self, e: &Energies) -> f64 {
+        [
+            e.kinetic,
+            e.strain.abs(),
+            e.spring.abs(),
+            (e.gravity - self.start.gravity).abs(),
+            e.external_work.abs(),
+            e.dissipated.abs(),
+        ]
+        .into_iter()
+        .fold(0.0, f64::max)
+    }
+
+    /// D12 checked step by step: the balance error `E` should change by
+    /// the integrator's error of one step, a small fraction of the
+    /// energies in play; a change by more than [`ENERGY_JUMP`] of the
+    /// largest energy of the motion is a step that created or lost energy
+    /// (a spurious root, a step far too long for the motion). The step
+    /// `info` is kept if its change is above that fraction of the largest
+    /// energy so far; [`Watch::warnings`] keeps those above it for the
+    /// whole motion (from rest, the first steps' errors are large next to
+    /// the energies reached so far, and small next to those reached
+    /// later).
+    fn energy_jump(&mut self, info: &IncrementInfo, before: &Energies, after: &Energies) {
+        self.largest = self.largest.max(self.scale(before)).max(self.scale(after));
+        let jump = after.balance_error - before.balance_error;
+        if jump.abs() > ENERGY_JUMP * self.largest {
+            self.jumps
+                .push((info.clone(), before.balance_error, after.balance_error));
+        }
+    }
+
+    /// The warnings of the steps kept by [`Watch::energy_jump`] whose
+    /// change of `E` is above [`ENERGY_JUMP`] of the largest energy of the
+    /// motion (once, at the end of the analysis).
+    fn warnings(&mut self) -> Vec<WarningInfo> {
+        let largest = self.largest;
+        std::mem::take(&mut self.jumps)
+            .into_iter()
+            .filter(|(_, before, after)| (after - before).abs() > ENERGY_JUMP * largest)
+            .map(|(info, before, after)| WarningInfo {
+                increment: info.increment,
+                from: info.time - info.step,
+                time: info.time,
+                message: format!(
+                    "the energy balance error changed by {:.3e} in one step (from {before:.3e} to {after:.3e}), more than {} % of the largest energy of the motion ({largest:.3e}): the step created or lost energy; its results are suspect (shorten time_step, or use adaptive steps)",
+                    after - before,
+                    ENERGY_JUMP * 100.0,
+                ),
+            })
+            .collect()
+    }
+}
+
+impl Dynamics<'_> {
+    /// The checks of a converged step that its residual cannot make
+    /// (docs/theory.md §15.5): the node that turned by more than
+    /// [`MAX_ROTATION_STEP`] in the step, or that Newton carried more than
+    /// [`MAX_ROTATION_CORRECTION`] or [`MAX_TRANSLATION_CORRECTION`] times
+    /// the model's size from the predictor. Such a step solves the
+    /// equations of the step but is no motion a step of its size can
+    /// follow: it is cut back.
+    fn spurious(&mut self, h: f64) -> Option<String> {
+        let (model, run) = (self.model, &mut *self.run);
+        let dofs = &self.solver.dofs;
+        let norm = |v: &[f64]| h * Vec3::new(v[0], v[1], v[2]).norm();
+        let l = model.length_scale;
+        for node in 0..model.n_nodes() {
+            let free = |c: usize| dofs.equation(6 * node + c) != NO_EQUATION;
+            let (dq, pred) = (&run.dq[node], &run.dq_predicted[node]);
+            let change = |k: usize| {
+                norm(&[
+                    dq[k] - pred[k],
+                    dq[k + 1] - pred[k + 1],
+                    dq[k + 2] - pred[k + 2],
+                ])
+            };
+            let id = model.node_ids[node];
+            let found = if (3..6).any(free) {
+                let turn = norm(&dq[3..6]);
+                let spin = norm(&run.state.velocity[node][3..6]);
+                if turn.max(spin) > MAX_ROTATION_STEP {
+                    Some(format!(
+                        "node {id} turned by {:.3e} rad in one step (h |Δq| = {turn:.3e}, h |Ω| = {spin:.3e}), more than the {MAX_ROTATION_STEP} rad a step may follow",
+                        turn.max(spin)
+                    ))
+                } else if change(3) > MAX_ROTATION_CORRECTION {
+                    Some(format!(
+                        "Newton turned node {id} by {:.3e} rad away from the predictor, more than half a turn",
+                        change(3)
+                    ))
+                } else {
+                    None
+                }
+            } else {
+                None
+            };
+            let found = found.or_else(|| {
+                ((0..3).any(free) && change(0) > MAX_TRANSLATION_CORRECTION * l).then(|| {
+                    format!(
+                        "Newton moved node {id} by {:.3e} away from the predictor, more than the model's size {l:.3e}",
+                        change(0)
+                    )
+                })
+            });
+            if let Some(what) = found {
+                run.location = format!("node {id}");
+                return Some(what);
+            }
+        }
+        None
+    }
+
+    /// The notes of a converged step, each given once per analysis: a step
+    /// accepted at the round-off plateau of its residual with the relative
+    /// residual above `residual_tolerance` (its log line ends above the
+    /// tolerance), and a fixed step whose local error estimate (D11) is
+    /// above [`FIXED_STEP_ERROR_NOTE`] of its motion.
+    fn notes(&mut self, h: f64, increment: usize, observer: &mut dyn Observer) {
+        let t = self.run.state.time;
+        if let Some((relative, dx, dth)) = self.run.watch.round_off {
+            if !self.run.watch.round_off_noted {
+                self.run.watch.round_off_noted = true;
+                observer.note(&format!(
+                    "step {increment} (t = {t}) converged at the round-off of its residual: the relative residual {relative:.1e} is above residual_tolerance {:e} but stopped decreasing at its floating-point floor (last correction max|dx| {dx:.1e}, max|dθ| {dth:.1e}); such steps are accepted, and their log lines end above the tolerance (docs/results.md, log.txt)",
+                    self.settings.residual_tolerance
+                ));
+            }
+        }
+        if !self.settings.adaptive && !self.run.watch.fixed_step_noted {
+            let error = self.error_estimate(h) * self.settings.error_tolerance;
+            if error > FIXED_STEP_ERROR_NOTE {
+                self.run.watch.fixed_step_noted = true;
+                observer.note(&format!(
+                    "step {increment} (t = {t}): the local error estimate of the fixed step {h:e} is {error:.1e} times the step's motion (noted above {FIXED_STEP_ERROR_NOTE:e}): the step is long for the motion; shorten time_step, or use adaptive steps (docs/theory.md §15.5)"
+                ));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The energies of step 24 and 25 of the spurious root of
+    /// tests/data/flexible_hinge_fixed_step.toml (energies.csv of the run
+    /// without the checks of §15.5): the balance error jumps from −3.5e-3
+    /// to 166 with a spring energy of 9.87 at the start, and is reported;
+    /// the step before, changing it by 8.6e-5, is not.
+    #[test]
+    fn an_energy_jump_is_reported() {
+        let at = |kinetic: f64, strain: f64, spring: f64, balance_error: f64| Energies {
+            kinetic,
+            strain,
+            spring,
+            balance_error,
+            ..Energies::default()
+        };
+        let step = |increment: usize| IncrementInfo {
+            increment,
+            time: 1e-3 * increment as f64,
+            step: 1e-3,
+            iterations: 1,
+            residuals: Vec::new(),
+            output: true,
+        };
+        let mut watch = Watch {
+            start: at(0.0, 0.0, 9.869604401089, 0.0),
+            ..Watch::default()
+        };
+        let start = watch.start;
+        let step23 = at(
+            1.314608087748e-1,
+            7.981515779887e-2,
+            9.654877834098,
+            -3.450600e-3,
+        );
+        let step24 = at(
+            1.342314668733e-1,
+            7.277050670905e-2,
+            9.659065747507,
+            -3.536680e-3,
+        );
+        let step25 = at(
+            1.664593631505e2,
+            1.390957047884e-1,
+            9.743204174856,
+            1.664721e2,
+        );
+        watch.energy_jump(&step(23), &start, &step23);
+        watch.energy_jump(&step(24), &step23, &step24);
+        watch.energy_jump(&step(25), &step24, &step25);
+        let warnings = watch.warnings();
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert_eq!(warnings[0].increment, 25);
+        let message = &warnings[0].message;
+        assert!(message.contains("changed by 1.665e2"), "{message}");
+        assert!(message.contains("more than 5 %"), "{message}");
+    }
+
+    /// From rest, the first steps' balance errors are large next to the
+    /// energies reached so far (a driven body: −1.2e-10 with a kinetic
+    /// energy of 2.8e-10 after the first step) and small next to those of
+    /// the motion (1.4): not reported.
+    #[test]
+    fn the_errors_of_the_first_steps_from_rest_are_not_reported() {
+        let at = |kinetic: f64, balance_error: f64| Energies {
+            kinetic,
+            balance_error,
+            ..Energies::default()
+        };
+        let step = |increment: usize| IncrementInfo {
+            increment,
+            time: 1e-3 * increment as f64,
+            step: 1e-3,
+            iterations: 1,
+            residuals: Vec::new(),
+            output: true,
+        };
+        let mut watch = Watch::default();
+        let (e0, e1, e2) = (at(0.0, 0.0), at(2.846e-10, -1.212e-10), at(1.4, -1.3e-8));
+        watch.energy_jump(&step(1), &e0, &e1);
+        assert_eq!(watch.jumps.len(), 1);
+        watch.energy_jump(&step(2), &e1, &e2);
+        assert!(watch.warnings().is_empty());
     }
 }

@@ -215,6 +215,17 @@ pub enum NewtonFailure {
         /// Relative pivot size.
         pivot: f64,
     },
+    /// Dynamics: Newton converged to a motion that no step of this size
+    /// can follow, a spurious root of the step's equations (a node turned
+    /// by more than the step may follow, or carried far from the
+    /// predictor; docs/theory.md §15.5): the step is cut back.
+    #[error("spurious solution after {iterations} iterations: {what}")]
+    Spurious {
+        /// Iterations it took.
+        iterations: usize,
+        /// What is wrong with it, naming the node.
+        what: String,
+    },
     /// The step converged, but its estimated local error is above the
     /// tolerance (the step controller shrinks it).
     #[error("local error estimate {error:.3e} times its tolerance")]
@@ -228,7 +239,9 @@ impl NewtonFailure {
     /// Iterations spent before the failure.
     pub fn iterations_spent(&self) -> usize {
         match self {
-            Self::MaxIterations { iterations, .. } => *iterations,
+            Self::MaxIterations { iterations, .. } | Self::Spurious { iterations, .. } => {
+                *iterations
+            }
             Self::Diverging { iteration, .. }
             | Self::NonFinite { iteration, .. }
             | Self::NoArcRoot { iteration }

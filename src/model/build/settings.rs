@@ -4,6 +4,7 @@
 use super::{
     num, Checker, LARGEST_ELEMENT_VALUE, MAX_INCREMENTS, MAX_ITERATIONS, MIN_RELATIVE_INCREMENT,
 };
+use crate::analysis::control::LANDING_SNAP;
 use crate::analysis::settings::{default_max_step, DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
 use crate::analysis::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
 use crate::eigen::Method;
@@ -484,12 +485,23 @@ fn dynamic_settings(
     let end = a.end_time;
     ck.positive(entity, "end_time", end);
     let span = end - start;
-    let time_step = a.time_step.unwrap_or(span / 100.0);
+    // the default first step is a hundredth of the span, or max_step if
+    // that is smaller
+    let time_step = a.time_step.unwrap_or(match a.max_step {
+        Some(m) if m > 0.0 && m < span / 100.0 => m,
+        _ => span / 100.0,
+    });
+    // the default smallest step is time_step·1e-6, not below the round-off
+    // of t (nor above time_step)
+    let round_off = MIN_RELATIVE_INCREMENT * end.abs();
+    let min_step = a
+        .min_step
+        .unwrap_or((time_step * 1e-6).max(round_off).min(time_step));
     let adaptive = a.adaptive.unwrap_or(true);
-    let s = DynamicSettings {
+    let mut s = DynamicSettings {
         end_time: end,
         time_step,
-        min_step: a.min_step.unwrap_or(time_step * 1e-6),
+        min_step,
         max_step: a.max_step.unwrap_or(if adaptive {
             default_max_step(span, time_step)
         } else {
@@ -515,9 +527,21 @@ fn dynamic_settings(
             ),
         );
     }
-    let steps_ok = ck.positive(entity, "time_step", s.time_step)
+    let mut steps_ok = ck.positive(entity, "time_step", s.time_step)
         & ck.positive(entity, "min_step", s.min_step)
         & ck.positive(entity, "max_step", s.max_step);
+    if steps_ok && s.time_step < round_off {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "time_step must be at least end_time·{MIN_RELATIVE_INCREMENT:e} = {:e} (smaller steps are lost in the round-off of t), got {}",
+                round_off,
+                num(s.time_step)
+            ),
+        );
+        steps_ok = false;
+    }
     if steps_ok && s.min_step > s.max_step {
         ck.push(
             ModelErrorKind::Invalid,
@@ -540,7 +564,22 @@ fn dynamic_settings(
             ),
         );
     }
-    if steps_ok && s.min_step < MIN_RELATIVE_INCREMENT * s.end_time.abs() {
+    // fixed steps: time_step throughout, cut back when Newton fails and
+    // grown back to time_step, never beyond
+    if !adaptive {
+        if let Some(m) = a.max_step.filter(|&m| steps_ok && m > s.time_step) {
+            ck.warn(
+                entity,
+                format!(
+                    "max_step ({}) has no effect with adaptive = false: the steps are time_step ({})",
+                    num(m),
+                    num(s.time_step)
+                ),
+            );
+        }
+        s.max_step = s.max_step.min(s.time_step);
+    }
+    if steps_ok && s.min_step < round_off {
         ck.push(
             ModelErrorKind::Invalid,
             entity,
@@ -621,6 +660,27 @@ fn dynamic_settings(
             entity,
             "output_times must be in increasing order",
         );
+    } else if steps_ok {
+        // times nearer than a step can be to each other (or to the start)
+        // would be landed on as one
+        let apart = s.min_step.max(LANDING_SNAP * end.abs().max(start.abs()));
+        let mut before = start;
+        for &t in &s.output_times {
+            if t - before < apart {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!(
+                        "output_times {} and {} are {:.3e} apart, nearer than a step can be ({}, the larger of min_step and end_time·{LANDING_SNAP:e}): the steps cannot land on both; keep one",
+                        num(before),
+                        num(t),
+                        t - before,
+                        num(apart)
+                    ),
+                );
+            }
+            before = t;
+        }
     }
     s
 }

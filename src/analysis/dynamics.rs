@@ -20,7 +20,9 @@
 //! - consistent initial accelerations and multipliers (D9), initial
 //!   velocities checked against the constraints (D10);
 //! - a local error estimate `(β − 1/6) h² (a_{n+1} − a_n)` for the step
-//!   controller (D11);
+//!   controller (D11), filtered by the iteration matrix to leave out the
+//!   vibrations the step does not resolve (D11a) and measured node by
+//!   node in the metric of the mass (D11b);
 //! - the energy balance of every step ([`super::energy`], D12);
 //! - at `ρ∞ ≥ 0.99`, the projection of the converged velocities on the
 //!   velocity constraints, which keeps the undamped parasitic modes of the
@@ -94,6 +96,11 @@ const PROJECTION_STEP: f64 = 1e-5;
 /// `n ρ∞ⁿ` peaks below 37 at `ρ∞ = 0.99`); at `ρ∞ = 1` they grow as `n`
 /// and stop the analysis.
 pub const PROJECTION_RHO: f64 = 0.99;
+
+/// Applications of the filter of the local error estimate (D11a): the
+/// first cancels the growth `∝ (ωh)²` of the estimate of a vibration the
+/// step does not resolve, the second makes it decay as `(ωh)⁻²`.
+const FILTER_PASSES: usize = 2;
 
 /// Initial velocities whose constraint rates exceed this fraction of the
 /// velocity scale violate the joints (D10).
@@ -329,7 +336,8 @@ struct Run {
     /// Largest diagonal mass of translations and of rotations (`m_scale`
     /// of D8).
     mass_scale: [f64; 2],
-    /// The matrices of the constrained mass system (D9, D13).
+    /// The matrices of the constrained mass system (D9, D13), and of the
+    /// mass matrix of the error estimate (D11a).
     mass_system: MassSystem,
     /// The span of the analysis, `end_time − t₀` (D13).
     span: f64,
@@ -368,6 +376,16 @@ struct Work {
     /// Equations numbered when `scaled` was built (`None` before; a model
     /// without constraints leaves `scaled` empty once built).
     n_equations: Option<usize>,
+    /// The local error `e` of the step by equation (D11), its filtered
+    /// `ê` (D11a), a matrix product, and the solver's residual and flux
+    /// kept across the assembly of the mass matrix.
+    error: Vec<f64>,
+    filtered: Vec<f64>,
+    product: Vec<f64>,
+    spare: Vec<f64>,
+    node_sums: Vec<[f64; 5]>,
+    kept: Vec<f64>,
+    kept_flux: Vec<f64>,
 }
 
 impl Work {
@@ -2035,56 +2053,183 @@ impl Dynamics<'_> {
         unreachable!("the loop returns at max_iterations")
     }
 
-    /// D11: the local error estimate `e = (β − 1/6) h² (a_{n+1} − a_n)`
-    /// per node, relative to the tolerance times the step's motion (or
-    /// 1e-3 of the model size, 1e-3 rad, if larger). The difference is
-    /// taken over the last two steps, `h (a_{n+1} − a_{n−1})/(h + h_{n−1})`,
-    /// which cancels the alternating transient that index-3 constraints
-    /// and changes of step excite in `a` (decaying as `ρ∞ⁿ`), and which is
-    /// not an error of the positions.
-    fn error_estimate(&self, h: f64) -> f64 {
-        let run = &*self.run;
+    /// D11: the local error estimate `e = (β − 1/6) h² (a_{n+1} − a_n)`,
+    /// the difference taken over the last two steps,
+    /// `h (a_{n+1} − a_{n−1})/(h + h_{n−1})`, which cancels the alternating
+    /// transient that index-3 constraints and changes of step excite in `a`
+    /// (decaying as `ρ∞ⁿ`), and which is not an error of the positions.
+    /// Left by equation in `Work::error` (zero on the multipliers).
+    fn local_error(&mut self, h: f64) {
+        let run = &mut *self.run;
         let c = (self.scheme.beta - 1.0 / 6.0).abs() * h * h;
-        let (dx, dth) = self.step_motion(h);
-        let l = self.model.length_scale;
-        let tol = self.settings.error_tolerance;
         let s = &run.state;
         let dofs = &self.solver.dofs;
-        // a_{n+1} − a_n, or over the last two steps when there are two
         let w = run.last_step.map(|hp| h / (h + hp));
         let difference = |a1: f64, a0: f64, before: Option<f64>| match (w, before) {
             (Some(w), Some(am)) => w * (a1 - am),
             _ => a1 - a0,
         };
-        let (mut ex, mut eth) = (0.0f64, 0.0f64);
-        for node in 0..s.n_nodes() {
-            let mut e = [0.0; 6];
-            for (k, ek) in e.iter_mut().enumerate() {
-                if dofs.equation(6 * node + k) != NO_EQUATION {
-                    *ek = c * difference(
-                        s.pseudo_acceleration[node][k],
-                        run.a_start[node][k],
-                        run.a_before.get(node).map(|a| a[k]),
-                    );
-                }
-            }
-            ex = ex.max(Vec3::new(e[0], e[1], e[2]).norm());
-            eth = eth.max(Vec3::new(e[3], e[4], e[5]).norm());
-        }
         let first = dofs.first_coordinate();
-        for k in 0..s.coordinates.len() {
-            if let DofKind::Coordinate { length } = dofs.kind(first + k) {
-                if dofs.equation(first + k) != NO_EQUATION {
-                    let e = c * difference(
-                        s.coordinate_pseudo_accelerations[k],
-                        run.a_start_coordinates[k],
-                        run.a_before_coordinates.get(k).copied(),
-                    );
-                    ex = ex.max(e.abs() * length);
-                }
+        run.work.error.clear();
+        run.work.error.extend((0..dofs.n_equations()).map(|eq| {
+            let d = dofs.dof(eq);
+            if let Some((node, k)) = dofs.node_component(d) {
+                c * difference(
+                    s.pseudo_acceleration[node][k],
+                    run.a_start[node][k],
+                    run.a_before.get(node).map(|a| a[k]),
+                )
+            } else if d < dofs.first_multiplier() {
+                let k = d - first;
+                c * difference(
+                    s.coordinate_pseudo_accelerations[k],
+                    run.a_start_coordinates[k],
+                    run.a_before_coordinates.get(k).copied(),
+                )
+            } else {
+                0.0
+            }
+        }));
+    }
+
+    /// The error measure of the step (docs/theory.md §15.5): the local
+    /// error `e` (D11) filtered by the iteration matrix (D11a),
+    ///
+    /// ```text
+    /// [ S        −kBᵀ ] [ ê ]   [ β′ M u  ]
+    /// [ −kB T     0   ] [ μ ] = [ −kB T u ],   u = e, then u = ê,
+    /// ```
+    ///
+    /// which keeps the error of the motions the step resolves
+    /// (`ωh ≪ 1`: `ê ≈ e`) and removes that of the vibrations it does not
+    /// (`ωh ≫ 1`, damped by `ρ∞ < 1`: `e` grows as `(ωh)²`, `ê` decays as
+    /// `(ωh)⁻²`), the part of `e` across the constraints kept; then, for
+    /// each node, `ê` in the metric of its mass block against a motion of
+    /// `Δx` in every direction of translation and `Δθ` in every direction
+    /// of rotation (D11b),
+    ///
+    /// ```text
+    /// ‖ê_i‖_{M_ii} / (tol · √(Δx² tr M_xx/3 + Δθ² tr M_θθ/3)),
+    /// ```
+    ///
+    /// `Δx`, `Δθ` the largest translation and rotation of the step, at
+    /// least 1e-3 of the model size and 1e-3 rad; the largest over the
+    /// nodes (Euclidean norms for a node without mass; a coordinate's
+    /// `|ê| ℓ` against `Δx`). `S`'s factors are those of the last
+    /// iteration (scaled, D8) and its constraint rows those of the
+    /// converged state (the solver's matrix, unscaled); `M` is assembled
+    /// at the converged state in the buffers of [`MassSystem`], the
+    /// solver's residual and flux kept. Without factors, or if a solve
+    /// fails, `ê = e`.
+    fn error_estimate(&mut self, h: f64) -> f64 {
+        self.local_error(h);
+        let (dx, dth) = self.step_motion(h);
+        let (model, sc) = (self.model, self.scheme);
+        let run = &mut *self.run;
+        let t = run.state.time;
+        let (dofs, assembler, lu) = self.solver.system();
+        let n = dofs.n_equations();
+        // M at the converged state, the solver's residual and flux kept
+        let work = &mut run.work;
+        work.kept.clone_from(&assembler.residual);
+        work.kept_flux.clone_from(&assembler.flux);
+        let buffers = &mut run.mass_system;
+        let same = |m: &SparseMatrix| {
+            m.dim() == assembler.matrix.dim()
+                && m.nnz() == assembler.matrix.nnz()
+                && m.row_indices() == assembler.matrix.row_indices()
+        };
+        if !buffers.stiffness.as_ref().is_some_and(same) {
+            buffers.stiffness = Some(assembler.matrix.clone());
+            buffers.mass = Some(assembler.matrix.clone());
+        }
+        let (stiffness, mass) = (
+            buffers.stiffness.as_mut().expect("set above"),
+            buffers.mass.as_mut().expect("set above"),
+        );
+        let ctx = dynamic_context(model, t, &sc, h).with_need(Need::with_inertia(0.0, 1.0));
+        assembler.assemble_split(model, &ctx, &run.state, stiffness, mass);
+        std::mem::swap(&mut assembler.residual, &mut work.kept);
+        std::mem::swap(&mut assembler.flux, &mut work.kept_flux);
+
+        // D11a, applied FILTER_PASSES times: right-hand side β′ M u, and
+        // −kB T u on the constraint rows (the solver's matrix holds S
+        // unscaled), scaled by D8
+        let scale = Scale::new(&model.scaling, sc.beta_prime(h), run.mass_scale);
+        let bp = sc.beta_prime(h);
+        work.filtered.clone_from(&work.error);
+        work.product.resize(n, 0.0);
+        work.spare.resize(n, 0.0);
+        let mut filtered = lu.is_some();
+        for _ in 0..FILTER_PASSES {
+            let Some(lu) = lu.as_mut().filter(|_| filtered) else {
+                break;
+            };
+            mass.mul_vec(&work.filtered, &mut work.product);
+            assembler.matrix.mul_vec(&work.filtered, &mut work.spare);
+            for (eq, f) in work.product.iter_mut().enumerate() {
+                *f = match dofs.equation_kind(eq) {
+                    k @ DofKind::Multiplier(_) => work.spare[eq] * scale.of(k),
+                    _ => bp * *f,
+                };
+            }
+            filtered = lu.solve_in_place(&mut work.product).is_ok()
+                && work.product.iter().all(|v| v.is_finite());
+            std::mem::swap(&mut work.filtered, &mut work.product);
+        }
+        if !filtered {
+            work.filtered.clone_from(&work.error);
+        }
+        for (eq, u) in work.filtered.iter_mut().enumerate() {
+            if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
+                *u = 0.0;
             }
         }
-        (ex / (tol * dx.max(1e-3 * l))).max(eth / (tol * dth.max(1e-3)))
+
+        // D11b: per node, ê in the metric of its mass block against a
+        // motion of (Δx, Δθ) in every direction
+        let l = model.length_scale;
+        let (x_ref, th_ref) = (dx.max(1e-3 * l), dth.max(1e-3));
+        let nodes = run.state.n_nodes();
+        let e = &work.filtered;
+        let sums = &mut work.node_sums;
+        sums.clear();
+        sums.resize(nodes, [0.0; 5]);
+        for (row, col, m) in mass.entries() {
+            let (Some((a, i)), Some((b, _))) = (
+                dofs.node_component(dofs.dof(row)),
+                dofs.node_component(dofs.dof(col)),
+            ) else {
+                continue;
+            };
+            if a != b {
+                continue;
+            }
+            sums[a][0] += e[row] * m * e[col];
+            if row == col {
+                sums[a][if i < 3 { 1 } else { 2 }] += m;
+            }
+        }
+        let mut measure = 0.0f64;
+        for (eq, &v) in e.iter().enumerate() {
+            let d = dofs.dof(eq);
+            if let Some((node, k)) = dofs.node_component(d) {
+                sums[node][3 + k / 3] += v * v;
+            } else if let DofKind::Coordinate { length } = dofs.kind(d) {
+                measure = measure.max(v.abs() * length / x_ref);
+            }
+        }
+        for &[error, mx, mth, ex, eth] in sums.iter() {
+            let reference = x_ref * x_ref * mx / 3.0 + th_ref * th_ref * mth / 3.0;
+            let ratio = if reference > 0.0 {
+                (error.max(0.0) / reference).sqrt()
+            } else {
+                // no mass: the Euclidean norms, as lengths and angles
+                (ex.sqrt() / x_ref).max(eth.sqrt() / th_ref)
+            };
+            measure = measure.max(ratio);
+        }
+        measure / self.settings.error_tolerance
     }
 }
 
@@ -2144,21 +2289,26 @@ impl Stepper for Dynamics<'_> {
         match self
             .newton(size, increment, observer)
             .and_then(|converged| {
+                // before the projection, which replaces the factors of S
+                // the estimate uses (D11a); with fixed steps, until the
+                // note on a long step has been given
+                let error = (self.settings.adaptive || !self.run.watch.fixed_step_noted)
+                    .then(|| self.error_estimate(size));
                 if self.scheme.projects_velocities() {
-                    self.project_velocities().map(|()| converged)
+                    self.project_velocities().map(|()| (converged, error))
                 } else {
-                    Ok(converged)
+                    Ok((converged, error))
                 }
             }) {
-            Ok((iterations, residuals)) => {
+            Ok(((iterations, residuals), error)) => {
                 if let Some(what) = self.spurious(size) {
                     return Attempt::Failed(NewtonFailure::Spurious { iterations, what });
                 }
-                self.notes(size, increment, observer);
+                self.notes(size, error, increment, observer);
                 Attempt::Converged {
                     iterations,
                     residuals,
-                    error: self.settings.adaptive.then(|| self.error_estimate(size)),
+                    error: error.filter(|_| self.settings.adaptive),
                 }
             }
             Err(f) => Attempt::Failed(f),
@@ -2449,7 +2599,7 @@ impl Dynamics<'_> {
     /// residual above `residual_tolerance` (its log line ends above the
     /// tolerance), and a fixed step whose local error estimate (D11) is
     /// above [`FIXED_STEP_ERROR_NOTE`] of its motion.
-    fn notes(&mut self, h: f64, increment: usize, observer: &mut dyn Observer) {
+    fn notes(&mut self, h: f64, error: Option<f64>, increment: usize, observer: &mut dyn Observer) {
         let t = self.run.state.time;
         if let Some((relative, dx, dth)) = self.run.watch.round_off {
             if !self.run.watch.round_off_noted {
@@ -2460,8 +2610,12 @@ impl Dynamics<'_> {
                 ));
             }
         }
-        if !self.settings.adaptive && !self.run.watch.fixed_step_noted {
-            let error = self.error_estimate(h) * self.settings.error_tolerance;
+        if let (false, false, Some(error)) = (
+            self.settings.adaptive,
+            self.run.watch.fixed_step_noted,
+            error,
+        ) {
+            let error = error * self.settings.error_tolerance;
             if error > FIXED_STEP_ERROR_NOTE {
                 self.run.watch.fixed_step_noted = true;
                 observer.note(&format!(

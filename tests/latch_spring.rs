@@ -746,7 +746,7 @@ unlatch_load = {UNLATCH}
     assert!((c * K_HOLD / UNLATCH - 1.0).abs() <= 1e-5, "{c}");
     assert!((lost / (0.5 * UNLATCH * UNLATCH / K_HOLD) - 1.0).abs() <= 1e-5);
     let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
-    assert!(log.contains("unlatch at element 20 (joint 10)"), "{log}");
+    assert!(log.contains("latch 20: releases joint 10 at c = "), "{log}");
     let (header, rows) = table("latches.csv");
     assert_eq!(
         header,

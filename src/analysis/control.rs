@@ -413,7 +413,10 @@ impl StepController {
             let snap = LANDING_SNAP * self.end_time.abs().max(t.abs());
             let mut size = self.size;
             if let Some(c) = self.crossing {
-                size = size.min(c.span * c.fraction(self.event_values[c.event]));
+                // never below min_step: a crossing grazed by a slow motion
+                // would otherwise shrink each landing step by 1/0.02
+                let landing = c.span * c.fraction(self.event_values[c.event]);
+                size = size.min(landing.max(self.bounds.min));
             }
             let in_time = stepper.sized_in_time();
             let mut lands = false;
@@ -526,9 +529,12 @@ impl StepController {
                         }
                     }
                 }
-                if let Some((i, _)) = first {
+                if let Some((i, theta)) = first {
                     let retries = self.crossing.map_or(0, |c| c.retries) + 1;
-                    if retries <= MAX_EVENT_RETRIES {
+                    // a crossing nearer than min_step to the start is taken
+                    // as happening within this step (the event's own
+                    // restart closes what is left of its gap)
+                    if retries <= MAX_EVENT_RETRIES && theta * size >= self.bounds.min {
                         // retried shortened, from the same start
                         self.counts.event_retries += 1;
                         self.counts.wasted_iterations += iterations;

@@ -1605,10 +1605,10 @@ impl Dynamics<'_> {
         if let Some(rows) = &rows {
             let (_, assembler, _) = self.solver.system();
             let buffers = &mut run.mass_system;
-            if !buffers
+            if buffers
                 .damping
                 .as_ref()
-                .is_some_and(|c| c.row_indices() == assembler.matrix.row_indices())
+                .is_none_or(|c| c.row_indices() != assembler.matrix.row_indices())
             {
                 buffers.damping = Some(assembler.matrix.clone());
                 buffers.damping_rest = Some(assembler.matrix.clone());

@@ -204,11 +204,7 @@ fn reduced_platform_deploys_and_every_mid_hinge_locks_into_the_nominal_geometry(
     assert_eq!(f.locks.len(), 18);
     assert!(f.locks.iter().all(Option::is_some), "{:?}", f.locks);
     // locked at the locking angle, within the event tolerance of the
-    // latches (1e-8 rad, docs/joints.md §6.2), or for a lock grazed so
-    // slowly that its crossing lies within min_step of a step's start,
-    // taken within that step, rate × min_step from it (measured 1.05e-6
-    // rad for one of the 18 locks; limit 1e-5 rad); the restart after the
-    // lock projects the positions on it (D14), checked below
+    // latches (1e-8 rad, docs/joints.md §6.2; measured at most 7.2e-9)
     for lock in &run.outcome.locks {
         let hinge = built
             .parts
@@ -216,7 +212,7 @@ fn reduced_platform_deploys_and_every_mid_hinge_locks_into_the_nominal_geometry(
             .find(|h| h.latch.map(|l| l.id()) == Some(lock.latch))
             .unwrap();
         let off = (lock.coordinate - hinge.locking_angle()).abs();
-        assert!(off <= 1e-5, "latch {}: {off:e} rad", lock.latch);
+        assert!(off <= 1e-8, "latch {}: {off:e} rad", lock.latch);
     }
     for h in &run.records.last().unwrap().hinges {
         assert!(h.locked && (h.opening - PI).abs() < 1e-5, "{h:?}");

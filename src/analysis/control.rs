@@ -58,6 +58,11 @@ pub const ERROR_MEMORY_FLOOR: f64 = 1e-2;
 /// happening within the step where it was found.
 pub const MAX_EVENT_RETRIES: usize = 30;
 
+/// Landing steps are at least this fraction of the largest step: a
+/// crossing nearer than that to a step's start is taken as happening
+/// within the step (docs/theory.md §13).
+pub const LANDING_FLOOR: f64 = 1e-9;
+
 /// What an attempted step gave.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Attempt {
@@ -266,6 +271,12 @@ pub struct StepController {
 }
 
 impl StepController {
+    /// The shortest step that lands on an event, [`LANDING_FLOOR`] of the
+    /// largest step.
+    fn landing_floor(&self) -> f64 {
+        LANDING_FLOOR * self.bounds.max
+    }
+
     /// A controller for steps within `bounds`, from increment 1 to
     /// `end_time`.
     pub fn new(bounds: StepBounds, end_time: f64) -> Self {
@@ -416,7 +427,7 @@ impl StepController {
                 // never below min_step: a crossing grazed by a slow motion
                 // would otherwise shrink each landing step by 1/0.02
                 let landing = c.span * c.fraction(self.event_values[c.event]);
-                size = size.min(landing.max(self.bounds.min));
+                size = size.min(landing.max(self.landing_floor()));
             }
             let in_time = stepper.sized_in_time();
             let mut lands = false;
@@ -534,7 +545,7 @@ impl StepController {
                     // a crossing nearer than min_step to the start is taken
                     // as happening within this step (the event's own
                     // restart closes what is left of its gap)
-                    if retries <= MAX_EVENT_RETRIES && theta * size >= self.bounds.min {
+                    if retries <= MAX_EVENT_RETRIES && theta * size >= self.landing_floor() {
                         // retried shortened, from the same start
                         self.counts.event_retries += 1;
                         self.counts.wasted_iterations += iterations;

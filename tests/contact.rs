@@ -7,12 +7,10 @@
 //! relative rate reversed), the results and events files, and the input
 //! errors of `[[contacts]]`.
 
-use std::sync::Arc;
+mod common;
 
-use unfold::analysis::{
-    AnalysisSettings, ContactInfo, ContactKind, DynamicAnalysis, DynamicOutcome, IncrementInfo,
-    Observer,
-};
+use common::events::run;
+use unfold::analysis::{ContactInfo, ContactKind, IncrementInfo};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::so3::Vec3;
@@ -25,45 +23,6 @@ const RADIUS: f64 = 0.1;
 /// The event tolerance of a length in a model of one node (length scale
 /// 1 m): 1e-8 m (docs/joints.md §6.3).
 const GAP_TOLERANCE: f64 = 1e-8;
-
-/// Every accepted state and every event of a contact.
-#[derive(Default)]
-struct Record {
-    steps: Vec<(IncrementInfo, State)>,
-    contacts: Vec<ContactInfo>,
-}
-
-impl Observer for Record {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.steps.push((info.clone(), state.clone()));
-        Ok(())
-    }
-    fn contact(&mut self, info: &ContactInfo) {
-        self.contacts.push(info.clone());
-    }
-}
-
-fn parse(text: &str) -> (Arc<Model>, Vec<AnalysisSettings>) {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    let model = Model::from_input(&input).expect("valid model");
-    (Arc::new(model), input.analyses().expect("valid analyses"))
-}
-
-fn run(text: &str) -> (Arc<Model>, DynamicOutcome, Record) {
-    let (model, analyses) = parse(text);
-    let settings = analyses[0].as_dynamic().unwrap().clone();
-    let mut a = DynamicAnalysis::new(model.clone(), settings);
-    let mut record = Record::default();
-    let out = a.run(model.initial_state(), &mut record);
-    assert!(out.error.is_none(), "{:?}", out.error);
-    (model, out, record)
-}
 
 /// A ball of radius 0.1 m and mass 2 kg (a rigid body, inertia
 /// 2/5 m r²) on the free node 1 at `x`, under gravity −z, with the

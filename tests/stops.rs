@@ -6,57 +6,16 @@
 //! impact law of a rotation with the hinge's constraints active), the
 //! release of a contact, and the input errors of `[[stops]]`.
 
-use std::sync::Arc;
+mod common;
 
-use unfold::analysis::{
-    AnalysisSettings, ContactInfo, ContactKind, DynamicAnalysis, DynamicOutcome, IncrementInfo,
-    Observer,
-};
+use common::events::{run, Record};
+use unfold::analysis::{ContactInfo, ContactKind};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::state::State;
 
 const G: f64 = 9.81;
 const MASS: f64 = 2.0;
-
-/// Every accepted state and every event of a stop.
-#[derive(Default)]
-struct Record {
-    steps: Vec<(IncrementInfo, State)>,
-    contacts: Vec<ContactInfo>,
-}
-
-impl Observer for Record {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.steps.push((info.clone(), state.clone()));
-        Ok(())
-    }
-    fn contact(&mut self, info: &ContactInfo) {
-        self.contacts.push(info.clone());
-    }
-}
-
-fn parse(text: &str) -> (Arc<Model>, Vec<AnalysisSettings>) {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    let model = Model::from_input(&input).expect("valid model");
-    (Arc::new(model), input.analyses().expect("valid analyses"))
-}
-
-fn run(text: &str) -> (Arc<Model>, DynamicOutcome, Record) {
-    let (model, analyses) = parse(text);
-    let settings = analyses[0].as_dynamic().unwrap().clone();
-    let mut a = DynamicAnalysis::new(model.clone(), settings);
-    let mut record = Record::default();
-    let out = a.run(model.initial_state(), &mut record);
-    assert!(out.error.is_none(), "{:?}", out.error);
-    (model, out, record)
-}
 
 /// A point mass on node 1 at the origin, on a prismatic joint to the
 /// ground along z (its `slide` is the height), under gravity −z, with

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod elliptic;
+pub mod events;
 pub mod quadrature;
 pub mod rigid_body;
 

@@ -1,0 +1,51 @@
+//! A dynamic run of a model file's text that records every accepted state
+//! and every event of its stops and contacts (tests/stops.rs,
+//! tests/contact.rs).
+
+use std::sync::Arc;
+
+use unfold::analysis::{
+    AnalysisSettings, ContactInfo, DynamicAnalysis, DynamicOutcome, IncrementInfo, Observer,
+};
+use unfold::model::input::ModelInput;
+use unfold::model::Model;
+use unfold::state::State;
+
+/// Every accepted state and every event of a stop or contact.
+#[derive(Default)]
+pub struct Record {
+    pub steps: Vec<(IncrementInfo, State)>,
+    pub contacts: Vec<ContactInfo>,
+}
+
+impl Observer for Record {
+    fn increment(
+        &mut self,
+        info: &IncrementInfo,
+        _: &Model,
+        state: &State,
+        _: &[f64],
+    ) -> std::io::Result<()> {
+        self.steps.push((info.clone(), state.clone()));
+        Ok(())
+    }
+    fn contact(&mut self, info: &ContactInfo) {
+        self.contacts.push(info.clone());
+    }
+}
+
+pub fn parse(text: &str) -> (Arc<Model>, Vec<AnalysisSettings>) {
+    let input: ModelInput = toml::from_str(text).expect("valid toml");
+    let model = Model::from_input(&input).expect("valid model");
+    (Arc::new(model), input.analyses().expect("valid analyses"))
+}
+
+pub fn run(text: &str) -> (Arc<Model>, DynamicOutcome, Record) {
+    let (model, analyses) = parse(text);
+    let settings = analyses[0].as_dynamic().unwrap().clone();
+    let mut a = DynamicAnalysis::new(model.clone(), settings);
+    let mut record = Record::default();
+    let out = a.run(model.initial_state(), &mut record);
+    assert!(out.error.is_none(), "{:?}", out.error);
+    (model, out, record)
+}

@@ -224,6 +224,17 @@ pub enum DynamicError {
         /// Why.
         failure: NewtonFailure,
     },
+    /// A stop or contact starts beyond its limit: its coordinate is on the
+    /// wrong side of it, which no impact law can resolve.
+    #[error("{what} starts beyond its limit at t = {time}: {detail}")]
+    StartsBeyondLimit {
+        /// The stop or contact (`stop 3`, `contact 30`).
+        what: String,
+        /// Start time.
+        time: f64,
+        /// The coordinate, the limit, by how much, and what to check.
+        detail: String,
+    },
     /// The impact of a latch locking could not be computed.
     #[error("at t = {time}: the lock of {latches}: {reason}")]
     Impact {
@@ -590,6 +601,11 @@ impl DynamicAnalysis {
         // latches at their value lock, without impact (docs/joints.md §6.2)
         impact::lock_at_start(model, &mut run.state);
         impact::close_at_start(model, &mut run.state);
+        if let Some(e) = impact::beyond_limit_at_start(model, &run.state) {
+            run.error = Some(e);
+            self.run = Some(run);
+            return Step::Stopped;
+        }
 
         // rank of the constraints: redundant ones out
         let rank = self.solver.constraint_rank(model, &run.state, t0);

@@ -297,3 +297,93 @@ fn initial_velocity_messages_name_the_node_once() {
         assert!(!err.contains("from node"), "{name}: {err}");
     }
 }
+
+/// A slide on a vertical prismatic joint to the ground, starting at
+/// `c = 0`, with the stop `limit` (`upper = -1.0`, …) on its coordinate.
+fn slide_on_stop(limit: &str) -> String {
+    format!(
+        r#"title = "mass on a stop"
+[analysis]
+type = "dynamic"
+end_time = 0.5
+time_step = 0.002
+max_step = 0.01
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 1.0]
+
+[[rigid_bodies]]
+id = 1
+node = 1
+mass = 1.0
+inertia = [0.004, 0.004, 0.004]
+
+[gravity]
+acceleration = [0.0, 0.0, -9.81]
+
+[[joints]]
+id = 2
+type = "prismatic"
+nodes = [1]
+axis = [0.0, 0.0, 1.0]
+
+[[stops]]
+id = 3
+joint = 2
+{limit}
+restitution = 0.5
+"#
+    )
+}
+
+/// A stop whose limit the coordinate already passes at the start (an
+/// `upper` written for a `lower`, a `lower` above the start) is refused
+/// by `unfold check` and `unfold run` alike, exit code 2, naming the stop,
+/// its joint, the coordinate, the limit and the overshoot; no impact law
+/// resolves such a start (before this check, a run found a zero impulse
+/// "impact" at every step of 1e-11 s, or closed the stop at the start
+/// value, reporting a negative gap). A stop just reached at the start
+/// (within the event tolerance) closes there, and one clear of it runs.
+#[test]
+fn a_stop_that_starts_beyond_its_limit_is_an_input_error() {
+    let dir = scratch("stop-beyond");
+    let cases = [
+        (
+            "upper",
+            "upper = -1.0",
+            "upper limit -1.000000e0 by 1.000e0",
+        ),
+        (
+            "lower",
+            "lower = 0.5",
+            "lower limit 5.000000e-1 by 5.000e-1",
+        ),
+    ];
+    for (name, limit, wanted) in cases {
+        let model = dir.join(format!("{name}.toml"));
+        std::fs::write(&model, slide_on_stop(limit)).unwrap();
+        let out = dir.join(name);
+        let ((code, check_err), (run_code, _, run_err)) = check_and_run(&model, &out);
+        assert_eq!(code, 2, "{name}: {check_err}");
+        assert_eq!(run_code, 2, "{name}: {run_err}");
+        let line = format!(
+            "error: {}: dynamic analysis at t = 0: stop 3 starts beyond its limit at t = 0: the coordinate of joint 2 is 0.000000e0, beyond the {wanted}",
+            model.display()
+        );
+        assert!(
+            check_err.contains(&line),
+            "{name}: {line:?} not in {check_err}"
+        );
+        assert_eq!(check_err, run_err, "{name}");
+        assert_eq!(files(&out), ["summary.json"], "{name}");
+    }
+    // clear of its limit, and exactly on it: both run
+    for (name, limit) in [("clear", "lower = -0.1"), ("touching", "lower = 0.0")] {
+        let model = dir.join(format!("{name}.toml"));
+        std::fs::write(&model, slide_on_stop(limit)).unwrap();
+        let ((code, err), (run_code, _, run_err)) = check_and_run(&model, &dir.join(name));
+        assert_eq!(code, 0, "{name}: {err}");
+        assert_eq!(run_code, 0, "{name}: {run_err}");
+    }
+}

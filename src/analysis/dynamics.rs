@@ -224,6 +224,17 @@ pub enum DynamicError {
         /// Why.
         failure: NewtonFailure,
     },
+    /// A stop or contact starts beyond its limit: its coordinate is on the
+    /// wrong side of it, which no impact law can resolve.
+    #[error("{what} starts beyond its limit at t = {time}: {detail}")]
+    StartsBeyondLimit {
+        /// The stop or contact (`stop 3`, `contact 30`).
+        what: String,
+        /// Start time.
+        time: f64,
+        /// The coordinate, the limit, by how much, and what to check.
+        detail: String,
+    },
     /// The impact of a latch locking could not be computed.
     #[error("at t = {time}: the lock of {latches}: {reason}")]
     Impact {
@@ -590,6 +601,11 @@ impl DynamicAnalysis {
         // latches at their value lock, without impact (docs/joints.md §6.2)
         impact::lock_at_start(model, &mut run.state);
         impact::close_at_start(model, &mut run.state);
+        if let Some(e) = impact::beyond_limit_at_start(model, &run.state) {
+            run.error = Some(e);
+            self.run = Some(run);
+            return Step::Stopped;
+        }
 
         // rank of the constraints: redundant ones out
         let rank = self.solver.constraint_rank(model, &run.state, t0);
@@ -1139,6 +1155,28 @@ fn constraint_name(model: &Model, solver: &NewtonSolver, dof: usize) -> String {
     solver.dof_label(model, dof)
 }
 
+/// Weight of the unknowns without mass in the metric of the projections
+/// (D13–D15), relative to the largest mass of their kind: small enough that
+/// the projections move them rather than the unknowns with mass (with
+/// their stiffness rows as weight, a massless hinge node joined rigidly to
+/// a panel shared each correction with the panel: an energy error of
+/// first order in `h` at ρ∞ = 1, 2e-2 J of 4 J at `h = 0.01`), large
+/// enough to keep the pivots of the matrix far from round-off.
+const LIGHT_WEIGHT: f64 = 1e-8;
+
+/// What the rows of unknowns without mass take in
+/// [`constrained_mass_system`].
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum MasslessRows {
+    /// Their rows of `K + M` (D9): the accelerations of unknowns without
+    /// mass follow from their equilibrium.
+    Stiffness,
+    /// [`LIGHT_WEIGHT`] times the mass scale of their kind on the diagonal
+    /// (D13–D15): the `M`-orthogonal projections, whose metric `M` alone
+    /// would be singular there, move them first.
+    Light,
+}
+
 /// The matrix of the constrained mass system at `state`,
 ///
 /// ```text
@@ -1147,7 +1185,7 @@ fn constraint_name(model: &Model, solver: &NewtonSolver, dof: usize) -> String {
 /// ```
 ///
 /// with the rows of unknowns without mass taken from `K + M` instead of
-/// `M`, and the multiplier rows and columns scaled by `m_s/k` (D8 with
+/// `M` (or a light diagonal weight, `massless`), and the multiplier rows and columns scaled by `m_s/k` (D8 with
 /// `β′ = 1`, without the lower bound 1), left in the solver's matrix: the
 /// matrix of the initial accelerations (D9) and of the velocity projection
 /// (D13). Returns the mass scales `m_s` of translations and rotations and
@@ -1158,6 +1196,7 @@ fn constrained_mass_system(
     state: &State,
     buffers: &mut MassSystem,
     velocity_rows: Option<(&[bool], &SparseMatrix)>,
+    massless: MasslessRows,
 ) -> Result<([f64; 2], Vec<f64>), NewtonFailure> {
     let t = state.time;
     let (dofs, assembler, _) = solver.system();
@@ -1202,7 +1241,19 @@ fn constrained_mass_system(
             DofKind::Multiplier(_) => {}
         }
     }
-    let massless = |eq: usize| match dofs.equation_kind(eq) {
+    // the light weight of a massless unknown: the mass scale of its kind,
+    // or of the other kind through the model's size if it has none
+    let length2 = model.length_scale * model.length_scale;
+    let light_weight = |eq: usize| {
+        let m = match dofs.equation_kind(eq) {
+            DofKind::Rotation if scale[1] > 0.0 => scale[1],
+            DofKind::Rotation => scale[0] * length2,
+            _ if scale[0] > 0.0 => scale[0],
+            _ => scale[1] / length2,
+        };
+        LIGHT_WEIGHT * if m > 0.0 { m } else { 1.0 }
+    };
+    let is_massless = |eq: usize| match dofs.equation_kind(eq) {
         DofKind::Translation | DofKind::Coordinate { .. } => diagonal[eq] <= MASSLESS * scale[0],
         DofKind::Rotation => diagonal[eq] <= MASSLESS * scale[1],
         DofKind::Multiplier(_) => false,
@@ -1210,7 +1261,7 @@ fn constrained_mass_system(
     let is_multiplier: Vec<bool> = (0..n)
         .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
         .collect();
-    let light: Vec<bool> = (0..n).map(massless).collect();
+    let light: Vec<bool> = (0..n).map(is_massless).collect();
     // multiplier rows and columns scaled to the mass (D8 with β′ = 1)
     let s_eq: Vec<f64> = (0..n)
         .map(|eq| match dofs.equation_kind(eq) {
@@ -1235,8 +1286,14 @@ fn constrained_mass_system(
         // the rows of velocity constraints take their ∂r/∂v
         let v = if let Some((c, true)) = velocity_rows.map(|(r, c)| (c, r[dof_of[row]])) {
             c.values()[i]
-        } else if is_multiplier[row] || is_multiplier[col] || light[row] {
+        } else if is_multiplier[row] || is_multiplier[col] {
             k[i] + m[i]
+        } else if light[row] {
+            match massless {
+                MasslessRows::Stiffness => k[i] + m[i],
+                MasslessRows::Light if row == col => light_weight(row),
+                MasslessRows::Light => 0.0,
+            }
         } else {
             m[i]
         };
@@ -1314,7 +1371,14 @@ fn initial_accelerations(
         None
     };
     let rows = damping.as_ref().map(|c| (by_dof.as_slice(), c));
-    let (scale, s_eq) = constrained_mass_system(model, solver, state, &mut run.mass_system, rows)?;
+    let (scale, s_eq) = constrained_mass_system(
+        model,
+        solver,
+        state,
+        &mut run.mass_system,
+        rows,
+        MasslessRows::Stiffness,
+    )?;
     run.mass_scale = scale;
     let (dofs, assembler, _) = solver.system();
     let mut rhs: Vec<f64> = (0..dofs.n_equations())
@@ -1381,7 +1445,14 @@ fn project_positions(
     }
     let state = &mut run.state;
     let residual = constraint_residual(model, solver, state);
-    let (_, s_eq) = constrained_mass_system(model, solver, state, &mut run.mass_system, None)?;
+    let (_, s_eq) = constrained_mass_system(
+        model,
+        solver,
+        state,
+        &mut run.mass_system,
+        None,
+        MasslessRows::Light,
+    )?;
     let dofs = &solver.dofs;
     let mut rhs: Vec<f64> = (0..dofs.n_equations())
         .map(|eq| {
@@ -1635,6 +1706,7 @@ impl Dynamics<'_> {
             state,
             &mut run.mass_system,
             velocity_rows,
+            MasslessRows::Light,
         );
         run.mass_system.damping = damping;
         let (_, s_eq) = scaled?;
@@ -1698,8 +1770,14 @@ impl Dynamics<'_> {
         }
         let state = &run.accepted;
         let rate = constraint_rate(model, self.solver, state, run.span);
-        let (_, s_eq) =
-            constrained_mass_system(model, self.solver, state, &mut run.mass_system, None)?;
+        let (_, s_eq) = constrained_mass_system(
+            model,
+            self.solver,
+            state,
+            &mut run.mass_system,
+            None,
+            MasslessRows::Light,
+        )?;
         let dofs = &self.solver.dofs;
         let mut rhs: Vec<f64> = (0..dofs.n_equations())
             .map(|eq| {

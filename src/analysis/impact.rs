@@ -191,6 +191,44 @@ pub fn close_at_start(model: &Model, state: &mut State) {
     }
 }
 
+/// The first stop or contact of `model` whose coordinate starts beyond its
+/// limit by more than the event tolerance, as the error that stops the
+/// analysis: a stop placed on the wrong side of the start (`upper` written
+/// for `lower`), or bodies that a previous analysis left interpenetrating.
+/// No impact law resolves such a start: a step would close the stop where
+/// the coordinate is, not at its limit, or find an impact at every step.
+pub fn beyond_limit_at_start(model: &Model, state: &State) -> Option<DynamicError> {
+    model.elements.iter().find_map(|e| {
+        let s = e.as_stop()?;
+        let (g, side) = s.gap(state);
+        if g >= -gap_tolerance(model, s) {
+            return None;
+        }
+        let c = s.coordinate(state);
+        let unit = if s.is_angle() { " rad" } else { "" };
+        let detail = match s.joint() {
+            Some(joint) => {
+                let (name, limit) = match side {
+                    Contact::Upper => ("upper", s.limit(Contact::Upper)),
+                    _ => ("lower", s.limit(Contact::Lower)),
+                };
+                format!(
+                    "the coordinate of joint {joint} is {c:.6e}{unit}, beyond the {name} limit {limit:.6e}{unit} by {:.3e}{unit}; a stop acts on a coordinate that starts within [lower, upper]: check which limit is meant (lower or upper) and the joint's reference",
+                    -g
+                )
+            }
+            None => format!(
+                "its gap is {g:.3e} (the bodies interpenetrate); start the sphere(s) clear of the surface"
+            ),
+        };
+        Some(DynamicError::StartsBeyondLimit {
+            what: format!("{} {}", s.noun(), e.id()),
+            time: state.time,
+            detail,
+        })
+    })
+}
+
 /// What [`lock_latches`] did.
 pub struct Impact {
     /// The latches locked.

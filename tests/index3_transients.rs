@@ -302,7 +302,8 @@ fn a_latch_holds_the_static_load_at_every_step_after_the_lock() {
         .iter()
         .map(|r| (r["load"] - static_load).abs())
         .fold(0.0, f64::max);
-    // measured 8.3e-4 N·m (2.6e-4 of kπ/2); before D14: 30 N·m, of
+    // measured 8.4e-9 N·m with D16 (6.0e-5 with D14–D15 alone, earlier
+    // 8.3e-4, 2.6e-4 of kπ/2); before D14: 30 N·m, of
     // alternating sign (10 times the true load)
     assert!(
         worst < 1e-3 * k * std::f64::consts::PI,

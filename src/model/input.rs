@@ -671,6 +671,11 @@ pub struct AnalysisInput {
     /// (increasing, within the analysis's span).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output_times: Option<Vec<f64>>,
+    /// Dynamics: results written at the start of the analysis plus every
+    /// multiple of this interval (and at `output_times`, the events and
+    /// the end), the steps landing on them; excludes `output_every`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_interval: Option<f64>,
     /// Scaling factor `k` of constraint equations (eq. 17), default the
     /// largest diagonal stiffness of the model (docs/joints.md §1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -745,6 +750,7 @@ impl Default for AnalysisInput {
             rotation_tolerance: None,
             output_every: None,
             output_times: None,
+            output_interval: None,
             constraint_scale: None,
             constraint_penalty: None,
             control: None,

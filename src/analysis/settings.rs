@@ -115,6 +115,11 @@ pub struct StaticSettings {
 /// `[analysis] type = "dynamic"`; docs/theory.md §15).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DynamicSettings {
+    /// Start of the analysis (0 for the first of a model; the end of the
+    /// one before in a sequence): a run restarted within the analysis
+    /// takes the span of the analysis from it, as the run never stopped
+    /// did.
+    pub start_time: f64,
     /// Final time.
     pub end_time: f64,
     /// First time step.
@@ -163,6 +168,7 @@ impl DynamicSettings {
     /// `max_step` from its own span.
     pub fn new(end_time: f64, time_step: f64) -> Self {
         Self {
+            start_time: 0.0,
             end_time,
             time_step,
             min_step: time_step * 1e-6,

@@ -500,6 +500,7 @@ fn dynamic_settings(
         .unwrap_or((time_step * 1e-6).max(round_off).min(time_step));
     let adaptive = a.adaptive.unwrap_or(true);
     let mut s = DynamicSettings {
+        start_time: start,
         end_time: end,
         time_step,
         min_step,

@@ -713,7 +713,7 @@ fn output_interval(
             "output_interval must be positive and finite, got {}",
             num(dt)
         )
-    } else if !(span > 0.0) {
+    } else if span.is_nan() || span <= 0.0 {
         // end_time before the start: reported with end_time
         return s;
     } else if dt > span {

@@ -404,6 +404,9 @@ pub struct LatchInput {
     /// Spring mode: the load (N·m or N) at which it releases; none: never.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unlatch_load: Option<f64>,
+    /// Spring mode: the side of `c_L` its spring acts on (default both).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side: Option<LatchSide>,
 }
 
 /// A unilateral stop on a joint coordinate (docs/joints.md §6.3): the
@@ -522,6 +525,22 @@ pub enum Approach {
     Increasing,
     /// With the coordinate decreasing.
     Decreasing,
+}
+
+/// The side of the locking value on which a spring latch's spring acts,
+/// relative to the direction of approach.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LatchSide {
+    /// Both: it holds the coordinate about `c_L` either way.
+    #[default]
+    Both,
+    /// Only against the coordinate going on past `c_L` in the direction
+    /// of approach: a compliant end stop, free coming back.
+    Beyond,
+    /// Only against the coordinate coming back from `c_L`: a pawl that
+    /// holds it, free going on.
+    Behind,
 }
 
 /// What a latch does once locked.

@@ -503,7 +503,10 @@ side = "beyond"
     // the reach beyond θ_L: ω₀/Ω, within 1e-3 (the sampling of the peak)
     let reach = OMEGA_0 / big_omega;
     let top = x.iter().map(|p| p.1).fold(f64::MIN, f64::max);
-    assert!(top <= reach * (1.0 + 1e-6) && top >= reach * (1.0 - 1e-3), "{top} vs {reach}");
+    assert!(
+        top <= reach * (1.0 + 1e-6) && top >= reach * (1.0 - 1e-3),
+        "{top} vs {reach}"
+    );
     // behind θ_L, free: no load (exactly zero), no contact, the rate −ω₀
     // (within 1e-4) and θ = θ_L − ω₀ (t − t_exit) (within 1e-6 rad)
     let mut free = 0;
@@ -514,10 +517,19 @@ side = "beyond"
         free += 1;
         let r = latch_results(&model, s);
         assert_eq!(r[1], 1.0, "still latched");
-        assert_eq!((r[3], r[4]), (0.0, 0.0), "load behind θ_L at t = {}", i.time);
+        assert_eq!(
+            (r[3], r[4]),
+            (0.0, 0.0),
+            "load behind θ_L at t = {}",
+            i.time
+        );
         assert!((x[k].2 / OMEGA_0 + 1.0).abs() <= 1e-4, "{:?}", x[k]);
         let free_angle = -OMEGA_0 * (i.time - exit.0);
-        assert!((x[k].1 - free_angle).abs() <= 1e-6, "{:?} vs {free_angle}", x[k]);
+        assert!(
+            (x[k].1 - free_angle).abs() <= 1e-6,
+            "{:?} vs {free_angle}",
+            x[k]
+        );
     }
     assert!(free > 100, "{free}");
 }

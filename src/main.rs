@@ -432,7 +432,7 @@ fn print_plan(plan: &[AnalysisSettings]) {
     for (k, a) in plan.iter().enumerate() {
         if let Some(d) = a.as_dynamic() {
             println!(
-                "analysis {}: dynamic to t = {}: time step {} ({}), min_step {}, max_step {}, rho_infinity {}",
+                "analysis {}: dynamic to t = {}: time step {} ({}), min_step {}, max_step {}, rho_infinity {}; {}",
                 k + 1,
                 format_time(d.end_time),
                 format_time(d.time_step),
@@ -443,7 +443,8 @@ fn print_plan(plan: &[AnalysisSettings]) {
                 },
                 format_time(d.min_step),
                 format_time(d.max_step),
-                d.rho_infinity
+                d.rho_infinity,
+                output_plan(d)
             );
         }
         if let Some(m) = a.as_modal() {
@@ -460,6 +461,28 @@ fn print_plan(plan: &[AnalysisSettings]) {
                 m.time,
                 unfold::io::modes::solver_name(m.solver)
             );
+        }
+    }
+}
+
+/// When a dynamic analysis writes its results, for `unfold check`.
+fn output_plan(d: &DynamicSettings) -> String {
+    match d.output_interval {
+        Some(dt) => format!(
+            "output every {} ({} times, with output_times and the end)",
+            format_time(dt),
+            d.output_times.iter().filter(|&&t| t < d.end_time).count() + 1
+        ),
+        None => {
+            let every = match d.output_every {
+                1 => "output every step".to_string(),
+                n => format!("output every {n} steps"),
+            };
+            if d.output_times.is_empty() {
+                every
+            } else {
+                format!("{every} and at {} output_times", d.output_times.len())
+            }
         }
     }
 }

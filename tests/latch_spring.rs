@@ -438,6 +438,139 @@ backlash = {BACKLASH}
     assert!(out.energies.balance_error.abs() <= 1e-4 * e0);
 }
 
+// ---------- (2b) one-sided spring latches ----------
+
+/// Spinning freely at ω₀ = 2 rad/s, the panel reaches the latch at
+/// θ_L = 0.5 rad (t = 0.25 s) whose spring (k = 300 N·m/rad, no dead band)
+/// acts only beyond θ_L (`side = "beyond"`: a compliant end stop). It
+/// enters the spring at ω₀, is turned back in half a cycle of
+/// `Ω = √(k/J)` = 30 rad/s (`π/Ω` = 0.10472 s of contact, reaching
+/// `ω₀/Ω` = 0.0667 rad beyond θ_L), and leaves at −ω₀ (a linear spring
+/// without damping returns the rate it received); behind θ_L the latch is
+/// free: the panel turns back at −ω₀ with no load on the latch. ρ∞ = 1
+/// and fixed steps of 5e-4 s, as for the rattle above.
+#[test]
+fn a_one_sided_spring_latch_turns_the_panel_back_and_lets_it_go() {
+    let text = panel(
+        "end_time = 0.6\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
+        &format!(
+            r#"
+[[initial_motion]]
+nodes = [2]
+angular_velocity = [0.0, 0.0, {OMEGA_0}]
+
+[[latches]]
+id = 20
+joint = 10
+value = {THETA_R}
+mode = "spring"
+stiffness = {K_RATTLE}
+side = "beyond"
+"#
+        ),
+    );
+    let (model, _, rec) = run(&text);
+    let big_omega = (K_RATTLE / J).sqrt();
+    let x: Vec<(f64, f64, f64)> = rec
+        .steps
+        .iter()
+        .map(|(i, s)| (i.time, angle(s) - THETA_R, s.velocity[1][5]))
+        .collect();
+    // the entry (the lock) and the exit are landed on: the states at
+    // θ_L within 1e-8 rad (the event tolerance) moving beyond / back
+    let entry = x
+        .windows(2)
+        .find(|w| w[0].1.abs() <= 1e-8 && w[1].1 > 1e-8)
+        .expect("an entry")[0];
+    let exit = x
+        .windows(2)
+        .find(|w| w[0].0 > entry.0 && w[0].1.abs() <= 1e-8 && w[1].1 < -1e-8)
+        .expect("an exit")[0];
+    eprintln!(
+        "entry {entry:?}, exit {exit:?}; contact {} vs π/Ω = {}",
+        exit.0 - entry.0,
+        std::f64::consts::PI / big_omega
+    );
+    // the entry at θ_L/ω₀ (1e-5 s, as for the rattle) and at ω₀
+    assert!((entry.0 - THETA_R / OMEGA_0).abs() <= 1e-5, "{entry:?}");
+    assert!((entry.2 / OMEGA_0 - 1.0).abs() <= 1e-4, "{entry:?}");
+    // contact for half a cycle: π/Ω within 1e-4 of it
+    let contact = exit.0 - entry.0;
+    let half = std::f64::consts::PI / big_omega;
+    assert!((contact / half - 1.0).abs() <= 1e-4, "{contact} vs {half}");
+    // the exit rate −ω₀ within 1e-4 (no damping: the rate returned)
+    assert!((exit.2 / OMEGA_0 + 1.0).abs() <= 1e-4, "{exit:?}");
+    // the reach beyond θ_L: ω₀/Ω, within 1e-3 (the sampling of the peak)
+    let reach = OMEGA_0 / big_omega;
+    let top = x.iter().map(|p| p.1).fold(f64::MIN, f64::max);
+    assert!(
+        top <= reach * (1.0 + 1e-6) && top >= reach * (1.0 - 1e-3),
+        "{top} vs {reach}"
+    );
+    // behind θ_L, free: no load (exactly zero), no contact, the rate −ω₀
+    // (within 1e-4) and θ = θ_L − ω₀ (t − t_exit) (within 1e-6 rad)
+    let mut free = 0;
+    for (k, (i, s)) in rec.steps.iter().enumerate() {
+        if i.time <= exit.0 {
+            continue;
+        }
+        free += 1;
+        let r = latch_results(&model, s);
+        assert_eq!(r[1], 1.0, "still latched");
+        assert_eq!(
+            (r[3], r[4]),
+            (0.0, 0.0),
+            "load behind θ_L at t = {}",
+            i.time
+        );
+        assert!((x[k].2 / OMEGA_0 + 1.0).abs() <= 1e-4, "{:?}", x[k]);
+        let free_angle = -OMEGA_0 * (i.time - exit.0);
+        assert!(
+            (x[k].1 - free_angle).abs() <= 1e-6,
+            "{:?} vs {free_angle}",
+            x[k]
+        );
+    }
+    assert!(free > 100, "{free}");
+}
+
+/// The same panel with the spring acting only behind θ_L (`side =
+/// "behind"`: a pawl that holds the panel against coming back): it locks
+/// at θ_L and goes on past it freely at ω₀, with no load on the latch.
+#[test]
+fn a_one_sided_spring_latch_lets_the_panel_go_on_past_it() {
+    let text = panel(
+        "end_time = 0.5\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
+        &format!(
+            r#"
+[[initial_motion]]
+nodes = [2]
+angular_velocity = [0.0, 0.0, {OMEGA_0}]
+
+[[latches]]
+id = 20
+joint = 10
+value = {THETA_R}
+mode = "spring"
+stiffness = {K_RATTLE}
+side = "behind"
+"#
+        ),
+    );
+    let (model, _, rec) = run(&text);
+    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
+    let lock = &rec.events[0];
+    assert!((lock.coordinate - THETA_R).abs() <= 1e-8, "{lock:?}");
+    let (i, s) = rec.steps.last().unwrap();
+    // on at ω₀: θ = ω₀ t within 1e-6 rad, the rate within 1e-6
+    assert!((angle(s) - OMEGA_0 * i.time).abs() <= 1e-6, "{}", angle(s));
+    assert!((s.velocity[1][5] / OMEGA_0 - 1.0).abs() <= 1e-6);
+    for (i, s) in rec.steps.iter().filter(|(i, _)| i.time > lock.time) {
+        let r = latch_results(&model, s);
+        assert_eq!((r[1], r[3], r[4]), (1.0, 0.0, 0.0), "t = {}", i.time);
+    }
+}
+
 // ---------- (3) the release under a load ramp ----------
 
 const K_HOLD: f64 = 100.0;

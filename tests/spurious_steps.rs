@@ -155,3 +155,145 @@ fn fixed_steps_grow_back_to_time_step_and_no_further() {
         .iter()
         .any(|s| (s.step - h).abs() <= 1e-9 * h));
 }
+
+/// A compound pendulum (a body of m = 2 kg, J_c = 0.01 kg·m² at d = 0.5 m
+/// below a hinge on z, J_O = 0.51 kg·m²) launched from the bottom at
+/// `rate` rad/s, in fixed steps of `h` with ρ∞ = 0.5 over 10 s: steps
+/// far too long for the motion (a small swing has a period of 1.43 s),
+/// whose numerical dissipation takes energy out but never puts any in.
+fn pendulum(rate: f64, h: f64) -> (Arc<Model>, DynamicSettings) {
+    let text = format!(
+        r#"title = "pendulum in long fixed steps"
+[analysis]
+type = "dynamic"
+end_time = 10.0
+time_step = {h}
+adaptive = false
+rho_infinity = 0.5
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+[[nodes]]
+id = 2
+x = [0.0, -0.5, 0.0]
+angular_velocity = [0.0, 0.0, {rate}]
+velocity = [{v}, 0.0, 0.0]
+[[supports]]
+node = 1
+fixed = ["all"]
+[[rigid_bodies]]
+id = 1
+node = 2
+mass = 2.0
+inertia = [0.01, 0.01, 0.01]
+[[joints]]
+id = 3
+type = "revolute"
+nodes = [1, 2]
+axis = [0.0, 0.0, 1.0]
+position = [0.0, 0.0, 0.0]
+[gravity]
+acceleration = [0.0, -9.81, 0.0]
+"#,
+        v = 0.5 * rate
+    );
+    let input =
+        unfold::io::model_file::parse_model(&text, std::path::Path::new("pendulum.toml")).unwrap();
+    let model = Arc::new(Model::from_input(&input).unwrap());
+    let settings = input.analyses().unwrap()[0].as_dynamic().unwrap().clone();
+    (model, settings)
+}
+
+/// The spurious failures among the cut-backs, as text.
+fn spurious_reasons(record: &Record) -> Vec<String> {
+    record
+        .cutbacks
+        .iter()
+        .filter(|c| matches!(c.reason, NewtonFailure::Spurious { .. }))
+        .map(|c| c.reason.to_string())
+        .collect()
+}
+
+/// The pendulum launched at 10 rad/s goes over the top (kinetic energy
+/// ½(J_c θ̇² + m v²) = 25.5 J at the bottom against 2mgd = 19.62 J to
+/// climb). In fixed steps of 0.2 s the first step converges (7 Newton
+/// iterations) to a false root in which the body spins at h|Ω| = 29 rad
+/// per step (145 rad/s: 5e3 J of kinetic energy from nothing). The turn
+/// check of docs/theory.md §15.5 rejects it and the step is cut back;
+/// the run completes with every accepted step turning the body by at
+/// most [`unfold::analysis::dynamics::MAX_ROTATION_STEP`] = 1 rad and the
+/// kinetic energy never above the 25.5 J it started with (no work is done
+/// on the pendulum: gravity only exchanges it; the scheme's dissipation
+/// only takes it out). Without the check (measured by disabling it) the
+/// false roots are accepted: the kinetic energy reaches 4.2e4 J and
+/// the body turns by 582 rad in a step.
+#[test]
+fn a_false_root_turning_the_body_by_whole_turns_is_rejected() {
+    let (model, settings) = pendulum(10.0, 0.2);
+    let start = 0.5 * (0.01 * 100.0 + 2.0 * 25.0);
+    let mut record = Record::default();
+    let out = DynamicAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut record);
+    assert!(out.error.is_none(), "{:?}", out.error);
+    assert!((out.time - 10.0).abs() < 1e-12);
+    // the first attempt, from t = 0, is the false root
+    let first = &record.cutbacks[0];
+    assert_eq!(first.increment, 1);
+    assert_eq!(first.time, 0.0);
+    let text = first.reason.to_string();
+    assert!(
+        matches!(first.reason, NewtonFailure::Spurious { .. })
+            && text.contains("node 2 turned by")
+            && text.contains("more than the 1 rad a step may follow"),
+        "{text}"
+    );
+    assert!(
+        record.largest_turn <= 1.0,
+        "largest turn {}",
+        record.largest_turn
+    );
+    // measured 25.5 J (the start, to the digits printed): within 1e-9
+    assert!(
+        record.largest_kinetic <= start * (1.0 + 1e-9),
+        "largest kinetic energy {} above the {start} J of the start",
+        record.largest_kinetic
+    );
+}
+
+/// Launched at 5 rad/s (6.375 J, a swing to 1.5 rad) in fixed steps of
+/// 0.5 s, Newton converges to false roots of both kinds of
+/// docs/theory.md §15.5: a turn of more than 1 rad in the step, and a
+/// root more than the model's size (0.5 m, the pendulum's length) away
+/// from the predictor. Both are rejected and cut back, and the run
+/// completes with the kinetic energy never above the 6.375 J it started
+/// with. Without the checks (measured by disabling them) the false roots
+/// are accepted: the kinetic energy reaches 5.2e2 J and the body turns
+/// by 155 rad in a step.
+#[test]
+fn false_roots_far_from_the_predictor_are_rejected() {
+    let (model, settings) = pendulum(5.0, 0.5);
+    let start = 0.5 * (0.01 * 25.0 + 2.0 * 6.25);
+    let mut record = Record::default();
+    let out = DynamicAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut record);
+    assert!(out.error.is_none(), "{:?}", out.error);
+    assert!((out.time - 10.0).abs() < 1e-12);
+    let reasons = spurious_reasons(&record);
+    assert!(
+        reasons.iter().any(|r| r.contains("Newton moved node 2 by")
+            && r.contains("away from the predictor, more than the model's size 5.000e-1")),
+        "{reasons:?}"
+    );
+    assert!(
+        reasons.iter().any(|r| r.contains("node 2 turned by")),
+        "{reasons:?}"
+    );
+    assert!(
+        record.largest_turn <= 1.0,
+        "largest turn {}",
+        record.largest_turn
+    );
+    assert!(
+        record.largest_kinetic <= start * (1.0 + 1e-9),
+        "largest kinetic energy {} above the {start} J of the start",
+        record.largest_kinetic
+    );
+}

@@ -602,7 +602,9 @@ impl DynamicAnalysis {
             energies: Energies::default(),
             mass_scale: [0.0; 2],
             mass_system: MassSystem::default(),
-            span: (s.end_time - t0).abs(),
+            // a continued run (a restart within the analysis) keeps the
+            // span of the analysis, as the run never stopped did
+            span: (s.end_time - if self.continued { s.start_time } else { t0 }).abs(),
             normal_velocity: None,
             redundant: 0,
             location: String::new(),

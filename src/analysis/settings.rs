@@ -115,6 +115,11 @@ pub struct StaticSettings {
 /// `[analysis] type = "dynamic"`; docs/theory.md §15).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DynamicSettings {
+    /// Start of the analysis (0 for the first of a model; the end of the
+    /// one before in a sequence): a run restarted within the analysis
+    /// takes the span of the analysis from it, as the run never stopped
+    /// did.
+    pub start_time: f64,
     /// Final time.
     pub end_time: f64,
     /// First time step.
@@ -146,6 +151,10 @@ pub struct DynamicSettings {
     pub output_every: usize,
     /// Times the analysis lands on and writes results at, increasing.
     pub output_times: Vec<f64>,
+    /// The interval of the grid of output times set by
+    /// [`DynamicSettings::with_output_interval`] (its times are among
+    /// `output_times`), for reports.
+    pub output_interval: Option<f64>,
 }
 
 impl DynamicSettings {
@@ -159,6 +168,7 @@ impl DynamicSettings {
     /// `max_step` from its own span.
     pub fn new(end_time: f64, time_step: f64) -> Self {
         Self {
+            start_time: 0.0,
             end_time,
             time_step,
             min_step: time_step * 1e-6,
@@ -172,7 +182,35 @@ impl DynamicSettings {
             rotation_tolerance: 1e-6,
             output_every: 1,
             output_times: Vec::new(),
+            output_interval: None,
         }
+    }
+
+    /// Results at `start + k·interval` (`k = 1, 2, …` up to `end_time`),
+    /// the steps landing on them, besides the `output_times` already given
+    /// (a grid time nearer than `apart` to one of them or to `end_time`
+    /// is left out: the steps could not land on both), and at the events
+    /// and `end_time`; no longer every `output_every` steps. `start` is the
+    /// start of the analysis (the grid is the same when a run restarts
+    /// within it).
+    pub fn with_output_interval(mut self, start: f64, interval: f64, apart: f64) -> Self {
+        let mut times = self.output_times.clone();
+        let mut k = 1.0;
+        loop {
+            let t = start + k * interval;
+            if t > self.end_time - apart {
+                break;
+            }
+            if self.output_times.iter().all(|&o| (o - t).abs() >= apart) {
+                times.push(t);
+            }
+            k += 1.0;
+        }
+        times.sort_by(f64::total_cmp);
+        self.output_times = times;
+        self.output_interval = Some(interval);
+        self.output_every = usize::MAX;
+        self
     }
 
     /// Fixed steps of `time_step` (cut back only when Newton fails).

@@ -78,6 +78,9 @@ pub struct SpringLatch {
     pub damping: f64,
     /// `F_u > 0`: the load `|f|` at which the latch releases (none: never).
     pub unlatch_load: Option<f64>,
+    /// The sign of `x = c − c_L` on which the spring acts (a one-sided
+    /// latch: free on the other side of `c_L`); `None`: both.
+    pub side: Option<f64>,
 }
 
 impl SpringLatch {
@@ -85,7 +88,9 @@ impl SpringLatch {
     /// slope of the branch it is on (`k` outside, 0 inside, 0 on an edge).
     pub fn spring_force(&self, x: f64) -> (f64, f64) {
         let h = 0.5 * self.backlash;
-        if x > h {
+        if !self.acts_at(x) {
+            (0.0, 0.0)
+        } else if x > h {
             (self.stiffness * (x - h), self.stiffness)
         } else if x < -h {
             (self.stiffness * (x + h), self.stiffness)
@@ -94,8 +99,28 @@ impl SpringLatch {
         }
     }
 
-    /// `½ k (|x| − b/2)²` outside the band, 0 inside.
+    /// Whether the spring acts at `x` (on its side of `c_L`, if one-sided).
+    pub fn acts_at(&self, x: f64) -> bool {
+        self.side.is_none_or(|s| s * x > 0.0)
+    }
+
+    /// The dashpot's coefficient at `x`: `d` where the spring acts (or
+    /// within the band of a two-sided latch), 0 on the free side of a
+    /// one-sided one.
+    pub fn dashpot(&self, x: f64) -> f64 {
+        if self.acts_at(x) {
+            self.damping
+        } else {
+            0.0
+        }
+    }
+
+    /// `½ k (|x| − b/2)²` outside the band (on the spring's side), 0
+    /// inside.
     pub fn energy(&self, x: f64) -> f64 {
+        if !self.acts_at(x) {
+            return 0.0;
+        }
         let over = (x.abs() - 0.5 * self.backlash).max(0.0);
         0.5 * self.stiffness * over * over
     }
@@ -247,7 +272,7 @@ impl Latch {
         match self.spring {
             Some(s) if self.is_locked(state) => {
                 let rate = self.rate(state).0;
-                (x, rate, s.spring_force(x).0 + s.damping * rate)
+                (x, rate, s.spring_force(x).0 + s.dashpot(x) * rate)
             }
             _ => (x, 0.0, 0.0),
         }
@@ -273,7 +298,7 @@ impl Latch {
         }
         let (x, _, f) = self.spring_state(state);
         let h = 0.5 * s.backlash;
-        let band = if s.backlash > 0.0 {
+        let band = if s.backlash > 0.0 || s.side.is_some() {
             let side = self.side(state);
             if side == 0.0 {
                 (h - x.abs()) / tol
@@ -492,7 +517,9 @@ impl Element for Latch {
             all[1] = 1.0;
             all[3] = -f;
             let h = 0.5 * s.backlash;
-            all[4] = if x > h {
+            all[4] = if !s.acts_at(x) {
+                0.0
+            } else if x > h {
                 1.0
             } else if x < -h {
                 -1.0
@@ -520,7 +547,7 @@ impl Element for Latch {
         match &self.spring {
             Some(s) if self.is_locked(state) && s.damping > 0.0 => {
                 let rate = self.rate(state).0;
-                s.damping * rate * rate
+                s.dashpot(self.coordinate(state) - self.value) * rate * rate
             }
             _ => 0.0,
         }
@@ -560,14 +587,18 @@ impl Latch {
             }
             let rate: f64 = g.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
             let (fs, ks) = s.spring_force(c[0] - self.value);
-            let d = if ctx.dynamics { s.damping } else { 0.0 };
+            let d = if ctx.dynamics {
+                s.dashpot(c[0] - self.value)
+            } else {
+                0.0
+            };
             let total = fs + d * rate;
             for r in 0..n {
                 out.residual[r] += total * g[r];
             }
             if let (Some(w), Some(m)) = (ctx.need.inertia, out.inertia.as_deref_mut()) {
                 // ∂r/∂v = d g gᵀ
-                let cd = w.damping * s.damping;
+                let cd = w.damping * d;
                 if cd != 0.0 {
                     for col in 0..n {
                         for r in 0..n {

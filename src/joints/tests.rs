@@ -298,18 +298,25 @@ fn spring_latch_tangents_match_finite_differences_on_each_branch() {
             for _ in 0..4 {
                 let (src, x, q) = revolute_coordinate(&mut rng, grounded, c);
                 let nn = src.nodes.len();
-                for (backlash, offset, side) in [
-                    (0.2, 0.05, 0.0),
-                    (0.2, 0.35, 1.0),
-                    (0.2, -0.4, -1.0),
-                    (0.0, 0.3, 1.0),
-                    (0.0, -0.2, -1.0),
+                // one-sided (acting where `acts · x > 0`) on its side and on
+                // the free one
+                for (backlash, offset, side, acts) in [
+                    (0.2, 0.05, 0.0, None),
+                    (0.2, 0.35, 1.0, None),
+                    (0.2, -0.4, -1.0, None),
+                    (0.0, 0.3, 1.0, None),
+                    (0.0, -0.2, -1.0, None),
+                    (0.2, 0.35, 1.0, Some(1.0)),
+                    (0.2, -0.4, 0.0, Some(1.0)),
+                    (0.0, -0.2, -1.0, Some(-1.0)),
+                    (0.0, 0.3, 0.0, Some(-1.0)),
                 ] {
                     let spring = SpringLatch {
                         stiffness: 3.0,
                         backlash,
                         damping: 0.7,
                         unlatch_load: Some(5.0),
+                        side: acts,
                     };
                     let probe = Latch::new(5, 1, src.clone(), 0.0, 1.0).with_spring(spring);
                     let mut s = moved(&mut rng, &x[..nn], &q[..nn], &probe);

@@ -404,6 +404,9 @@ pub struct LatchInput {
     /// Spring mode: the load (N·m or N) at which it releases; none: never.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unlatch_load: Option<f64>,
+    /// Spring mode: the side of `c_L` its spring acts on (default both).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side: Option<LatchSide>,
 }
 
 /// A unilateral stop on a joint coordinate (docs/joints.md §6.3): the
@@ -522,6 +525,22 @@ pub enum Approach {
     Increasing,
     /// With the coordinate decreasing.
     Decreasing,
+}
+
+/// The side of the locking value on which a spring latch's spring acts,
+/// relative to the direction of approach.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LatchSide {
+    /// Both: it holds the coordinate about `c_L` either way.
+    #[default]
+    Both,
+    /// Only against the coordinate going on past `c_L` in the direction
+    /// of approach: a compliant end stop, free coming back.
+    Beyond,
+    /// Only against the coordinate coming back from `c_L`: a pawl that
+    /// holds it, free going on.
+    Behind,
 }
 
 /// What a latch does once locked.
@@ -671,6 +690,11 @@ pub struct AnalysisInput {
     /// (increasing, within the analysis's span).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output_times: Option<Vec<f64>>,
+    /// Dynamics: results written at the start of the analysis plus every
+    /// multiple of this interval (and at `output_times`, the events and
+    /// the end), the steps landing on them; excludes `output_every`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_interval: Option<f64>,
     /// Scaling factor `k` of constraint equations (eq. 17), default the
     /// largest diagonal stiffness of the model (docs/joints.md §1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -745,6 +769,7 @@ impl Default for AnalysisInput {
             rotation_tolerance: None,
             output_every: None,
             output_times: None,
+            output_interval: None,
             constraint_scale: None,
             constraint_penalty: None,
             control: None,

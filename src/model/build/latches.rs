@@ -4,7 +4,7 @@ use super::joints::{angle_unit, joint_coordinate, Context, Joints};
 use super::AngleLimit;
 use crate::joints::latch::SpringLatch;
 use crate::joints::Latch;
-use crate::model::input::{Approach, LatchInput, LatchMode};
+use crate::model::input::{Approach, LatchInput, LatchMode, LatchSide};
 use crate::model::ModelErrorKind;
 
 pub(super) fn latch(
@@ -50,6 +50,7 @@ pub(super) fn latch(
                 ("backlash", l.backlash),
                 ("damping", l.damping),
                 ("unlatch_load", l.unlatch_load),
+                ("side", l.side.map(|_| 0.0)),
             ]
             .iter()
             .filter(|(_, v)| v.is_some())
@@ -70,7 +71,13 @@ pub(super) fn latch(
             Some(latch)
         }
         LatchMode::Spring => {
-            let spring = spring(cx, entity, l, unit, latch.is_angle())?;
+            let mut spring = spring(cx, entity, l, unit, latch.is_angle())?;
+            // the sign of c − c_L the spring acts on
+            spring.side = match l.side.unwrap_or_default() {
+                LatchSide::Both => None,
+                LatchSide::Beyond => Some(approach),
+                LatchSide::Behind => Some(-approach),
+            };
             Some(latch.with_spring(spring))
         }
     }
@@ -143,5 +150,6 @@ fn spring(
         backlash: backlash * unit,
         damping: damping / unit,
         unlatch_load: l.unlatch_load,
+        side: None,
     })
 }

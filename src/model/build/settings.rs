@@ -165,8 +165,9 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
 }
 
 /// The keys that only dynamic analyses take, and whether each is given.
-fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 6] {
+fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 7] {
     [
+        ("output_interval", a.output_interval.is_some()),
         ("time_step", a.time_step.is_some()),
         ("min_step", a.min_step.is_some()),
         ("max_step", a.max_step.is_some()),
@@ -499,6 +500,7 @@ fn dynamic_settings(
         .unwrap_or((time_step * 1e-6).max(round_off).min(time_step));
     let adaptive = a.adaptive.unwrap_or(true);
     let mut s = DynamicSettings {
+        start_time: start,
         end_time: end,
         time_step,
         min_step,
@@ -516,6 +518,7 @@ fn dynamic_settings(
         rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
         output_every: a.output_every.unwrap_or(1),
         output_times: a.output_times.clone().unwrap_or_default(),
+        output_interval: None,
     };
     if !(s.rho_infinity.is_finite() && (0.0..=1.0).contains(&s.rho_infinity)) {
         ck.push(
@@ -682,5 +685,60 @@ fn dynamic_settings(
             before = t;
         }
     }
+    match a.output_interval {
+        Some(dt) => output_interval(ck, entity, a, s, start, dt, steps_ok),
+        None => s,
+    }
+}
+
+/// Checks `output_interval = dt` of a dynamic analysis from `start` and
+/// adds its grid of output times to `s`.
+fn output_interval(
+    ck: &mut Checker,
+    entity: &str,
+    a: &AnalysisInput,
+    s: DynamicSettings,
+    start: f64,
+    dt: f64,
+    steps_ok: bool,
+) -> DynamicSettings {
+    let span = s.end_time - start;
+    let apart = s
+        .min_step
+        .max(LANDING_SNAP * s.end_time.abs().max(start.abs()));
+    let message = if a.output_every.is_some() {
+        "output_interval and output_every cannot both be given: output_interval writes results at regular times, output_every at every n-th step; keep one".to_string()
+    } else if !(dt.is_finite() && dt > 0.0) {
+        format!(
+            "output_interval must be positive and finite, got {}",
+            num(dt)
+        )
+    } else if span.is_nan() || span <= 0.0 {
+        // end_time before the start: reported with end_time
+        return s;
+    } else if dt > span {
+        format!(
+            "output_interval ({}) must not exceed the span of the analysis ({}, from t = {} to end_time {})",
+            num(dt),
+            num(span),
+            num(start),
+            num(s.end_time)
+        )
+    } else if steps_ok && dt < apart {
+        format!(
+            "output_interval ({}) is shorter than a step can be ({}, the larger of min_step and end_time·{LANDING_SNAP:e}): the steps cannot land on every output time",
+            num(dt),
+            num(apart)
+        )
+    } else if span / dt > MAX_INCREMENTS {
+        format!(
+            "output_interval ({}) asks for {:.3e} output times, more than {MAX_INCREMENTS:e}",
+            num(dt),
+            span / dt
+        )
+    } else {
+        return s.with_output_interval(start, dt, apart);
+    };
+    ck.push(ModelErrorKind::Invalid, entity, message);
     s
 }

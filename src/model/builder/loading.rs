@@ -533,6 +533,13 @@ impl Analysis {
         self
     }
 
+    /// Dynamics: results written every `interval` of time from the start
+    /// of the analysis, the steps landing on those times.
+    pub fn output_interval(mut self, interval: f64) -> Self {
+        self.0.output_interval = Some(interval);
+        self
+    }
+
     /// Scaling factor `k` of the constraint equations (default from the
     /// model's stiffness).
     pub fn constraint_scale(mut self, k: f64) -> Self {

@@ -9,7 +9,7 @@ use crate::model::handles::{
 };
 use crate::model::input::{
     AngleUnit, Approach, ContactInput, ContactType, DriverInput, HingeLawInput, JointInput,
-    JointSpringInput, LatchInput, LatchMode, RollingDiscInput, StartBranch, StopInput,
+    JointSpringInput, LatchInput, LatchMode, LatchSide, RollingDiscInput, StartBranch, StopInput,
     TapeSpringInput,
 };
 use crate::model::Id;
@@ -455,6 +455,13 @@ impl Latch {
     /// the reference configuration, where it is 0).
     pub fn approach(mut self, approach: Approach) -> Self {
         self.input.approach = Some(approach);
+        self
+    }
+
+    /// The side of the locking value a spring latch's spring acts on
+    /// (default both; docs/model-format.md, `side`).
+    pub fn side(mut self, side: LatchSide) -> Self {
+        self.input.side = Some(side);
         self
     }
 

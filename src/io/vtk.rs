@@ -8,7 +8,8 @@
 //! Each array there is a header of little-endian `u64`,
 //! `[blocks, block size, size of the last block (0 if full), compressed
 //! size of each block]`, then its blocks, each a zlib stream of up to
-//! [`BLOCK_SIZE`] bytes of little-endian values; the `offset` attribute of
+//! [`BLOCK_SIZE`] bytes of little-endian values (a stored, uncompressed
+//! stream for an array under `STORED_BELOW` bytes); the `offset` attribute of
 //! the `DataArray` counts from the byte after the `_` that opens the
 //! block. [`Encoding::Ascii`] writes every number as text instead.
 //!

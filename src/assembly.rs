@@ -21,7 +21,7 @@
 //! relative residual tolerance.
 
 use crate::dofs::{DofMap, NO_EQUATION};
-use crate::elements::{Element, ElementOutput, EvalContext};
+use crate::elements::{Element, ElementOutput, EvalContext, Need};
 use crate::linalg::SparseMatrix;
 use crate::model::Model;
 use crate::so3::Mat3;
@@ -359,6 +359,37 @@ impl Assembler {
         self.assemble_into(model, ctx, state, None, Target::Split(stiffness, inertia));
     }
 
+    /// Evaluates every element without its stiffness and assembles the
+    /// residual and the flux (in [`Assembler::residual`],
+    /// [`Assembler::flux`]) and the inertia matrix alone into `inertia`, a
+    /// matrix with the pattern of [`Assembler::matrix`] (a clone of it),
+    /// with the weights of `ctx.need.inertia` (`(0, 1)` for the mass
+    /// matrix). [`Assembler::matrix`] is left as it was.
+    pub fn assemble_inertia(
+        &mut self,
+        model: &Model,
+        ctx: &EvalContext,
+        state: &State,
+        inertia: &mut SparseMatrix,
+    ) {
+        assert!(
+            ctx.need.inertia.is_some(),
+            "an inertia assembly asks for it"
+        );
+        assert!(
+            inertia.nnz() == self.matrix.nnz(),
+            "matrix on the assembler's pattern"
+        );
+        let ctx = EvalContext {
+            need: Need {
+                stiffness: false,
+                ..ctx.need
+            },
+            ..*ctx
+        };
+        self.assemble_into(model, &ctx, state, None, Target::Inertia(inertia));
+    }
+
     fn assemble_into(
         &mut self,
         model: &Model,
@@ -402,6 +433,10 @@ impl Assembler {
                 k.values_mut().fill(0.0);
                 d.values_mut().fill(0.0);
                 (k.values_mut(), Some(d.values_mut()))
+            }
+            Target::Inertia(d) => {
+                d.values_mut().fill(0.0);
+                (&mut [][..], Some(d.values_mut()))
             }
         };
         let mut inertia_matrix = inertia_matrix;
@@ -449,6 +484,8 @@ enum Target<'a> {
     Own,
     /// The stiffness and the inertia matrix into these two.
     Split(&'a mut SparseMatrix, &'a mut SparseMatrix),
+    /// The inertia matrix alone into this one (no stiffness asked).
+    Inertia(&'a mut SparseMatrix),
 }
 
 /// Where each element's slices start in the evaluation buffers (absolute
@@ -476,7 +513,9 @@ impl<'a> Layout<'a> {
     }
 }
 
-/// Elements per task below which the evaluation runs sequentially.
+/// Elements per task below which the evaluation runs sequentially (as
+/// it does whatever their number on one thread: a task handed to the
+/// pool's only worker costs two context switches).
 const SEQUENTIAL_CHUNK: usize = 256;
 
 /// Evaluates `elements` into `buffer` (stiffness and residual) and
@@ -492,7 +531,7 @@ fn evaluate_range(
     state: &State,
     factors: Option<&[Mat3]>,
 ) {
-    if elements.len() <= SEQUENTIAL_CHUNK {
+    if elements.len() <= SEQUENTIAL_CHUNK || rayon::current_num_threads() == 1 {
         let (base, ibase) = (layout.offsets[0], layout.inertia_offsets[0]);
         let mut inertia = inertia;
         for (k, e) in elements.iter().enumerate() {

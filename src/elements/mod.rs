@@ -421,10 +421,11 @@ pub(crate) fn add_scaled<const N: usize>(
     w: f64,
     m: &nalgebra::SMatrix<f64, N, N>,
 ) {
-    for j in 0..N {
+    // column by column on slices: no bounds check per entry, vectorised
+    for (j, column) in m.as_slice().chunks_exact(N).enumerate() {
         let base = (row + j) * n + row;
-        for i in 0..N {
-            buf[base + i] += w * m[(i, j)];
+        for (b, &v) in buf[base..base + N].iter_mut().zip(column) {
+            *b += w * v;
         }
     }
 }

@@ -8,7 +8,8 @@
 //! Each array there is a header of little-endian `u64`,
 //! `[blocks, block size, size of the last block (0 if full), compressed
 //! size of each block]`, then its blocks, each a zlib stream of up to
-//! [`BLOCK_SIZE`] bytes of little-endian values; the `offset` attribute of
+//! [`BLOCK_SIZE`] bytes of little-endian values (a stored, uncompressed
+//! stream for an array under `STORED_BELOW` bytes); the `offset` attribute of
 //! the `DataArray` counts from the byte after the `_` that opens the
 //! block. [`Encoding::Ascii`] writes every number as text instead.
 //!
@@ -178,12 +179,31 @@ impl Document {
     }
 }
 
+/// Arrays of fewer bytes than this are written as stored (uncompressed)
+/// zlib streams: resetting the compressor zeroes its ~300 kB of tables,
+/// more work than compressing a few kilobytes of values saves (on the
+/// beam pendulum of 80 elements, 10 % of the instructions of a whole
+/// dynamic run went into those resets).
+const STORED_BELOW: usize = 16 * 1024;
+
 /// Appends `raw` to `out` as VTK compressed blocks: the `u64` header
 /// `[blocks, BLOCK_SIZE, last block size (0 if full), compressed sizes…]`
 /// then the zlib stream of each block. Level 1 (fast): on a grid of 20,000
 /// beams it writes in about the time of the ASCII text, 10 % larger than
-/// level 6 at half its time.
+/// level 6 at half its time. Below [`STORED_BELOW`] bytes, one stored
+/// stream ([`store_block`]).
 fn compress_blocks(raw: &[u8], out: &mut Vec<u8>) {
+    if !raw.is_empty() && raw.len() < STORED_BELOW {
+        for h in [1, BLOCK_SIZE, raw.len() % BLOCK_SIZE] {
+            out.extend_from_slice(&(h as u64).to_le_bytes());
+        }
+        let sizes_at = out.len();
+        out.extend_from_slice(&[0; 8]);
+        store_block(raw, out);
+        let size = (out.len() - sizes_at - 8) as u64;
+        out[sizes_at..sizes_at + 8].copy_from_slice(&size.to_le_bytes());
+        return;
+    }
     // One compressor per thread, reset for each block: a new one per block
     // allocates (and frees) its ~300 kB of state every time, which made
     // the allocator grow and trim the heap tens of times per output step.
@@ -222,6 +242,30 @@ fn compress_blocks(raw: &[u8], out: &mut Vec<u8>) {
         }
     });
     debug_assert!(out.len() >= start + 24);
+}
+
+/// Appends `block` (at most 65,535 bytes) to `out` as a zlib stream
+/// holding one stored deflate block (RFC 1950 §2.2, RFC 1951 §3.2.4):
+/// header `78 01`, then `BFINAL = 1, BTYPE = 00`, `LEN`, `!LEN`
+/// (little-endian), the bytes, and their Adler-32 (big-endian).
+fn store_block(block: &[u8], out: &mut Vec<u8>) {
+    let len = u16::try_from(block.len()).expect("a stored block holds at most 65,535 bytes");
+    out.extend_from_slice(&[0x78, 0x01, 0x01]);
+    out.extend_from_slice(&len.to_le_bytes());
+    out.extend_from_slice(&(!len).to_le_bytes());
+    out.extend_from_slice(block);
+    // Adler-32: sums modulo 65,521, reduced every 5,552 bytes (the most
+    // that cannot overflow a u32)
+    let (mut a, mut b) = (1u32, 0u32);
+    for chunk in block.chunks(5552) {
+        for &byte in chunk {
+            a += u32::from(byte);
+            b += a;
+        }
+        a %= 65521;
+        b %= 65521;
+    }
+    out.extend_from_slice(&((b << 16) | a).to_be_bytes());
 }
 
 /// The joint points of every element at `state`, with the element's
@@ -630,6 +674,59 @@ mod tests {
     use crate::elements::{Element, ElementOutput};
     use crate::model::input::ModelInput;
     use crate::model::Id;
+
+    /// Decodes the VTK compressed blocks of one array with flate2's zlib
+    /// decoder (which checks each stream's Adler-32).
+    fn decode_blocks(data: &[u8]) -> Vec<u8> {
+        use std::io::Read;
+        let word = |k: usize| u64::from_le_bytes(data[8 * k..8 * k + 8].try_into().unwrap());
+        let blocks = word(0) as usize;
+        let mut at = 8 * (3 + blocks);
+        let mut raw = Vec::new();
+        for b in 0..blocks {
+            let size = word(3 + b) as usize;
+            flate2::read::ZlibDecoder::new(&data[at..at + size])
+                .read_to_end(&mut raw)
+                .expect("a valid zlib stream");
+            at += size;
+        }
+        assert_eq!(at, data.len(), "nothing after the last block");
+        raw
+    }
+
+    /// Arrays below STORED_BELOW are stored, the others compressed, and
+    /// both decode to their bytes, with the block header VTK reads:
+    /// empty, one byte, the Adler-32 reductions (over 5,552 bytes of 0xff),
+    /// the limit, and several blocks.
+    #[test]
+    fn stored_and_compressed_blocks_decode_to_their_bytes() {
+        for n in [
+            0,
+            1,
+            5553,
+            STORED_BELOW - 1,
+            STORED_BELOW,
+            3 * BLOCK_SIZE + 7,
+        ] {
+            let raw: Vec<u8> = (0..n)
+                .map(|i| if n == 5553 { 0xff } else { (i * 7 % 251) as u8 })
+                .collect();
+            let mut out = Vec::new();
+            compress_blocks(&raw, &mut out);
+            assert_eq!(decode_blocks(&out), raw, "{n} bytes");
+            let word = |k: usize| u64::from_le_bytes(out[8 * k..8 * k + 8].try_into().unwrap());
+            assert_eq!(
+                word(0) as usize,
+                n.div_ceil(BLOCK_SIZE),
+                "{n} bytes: blocks"
+            );
+            assert_eq!(word(2) as usize, n % BLOCK_SIZE, "{n} bytes: last block");
+            if n > 0 && n < STORED_BELOW {
+                // stored: 2 + 5 + n + 4 bytes
+                assert_eq!(out.len(), 32 + n + 11, "{n} bytes: stored");
+            }
+        }
+    }
 
     /// A four-node element drawn as a quadrilateral (as a shell is), with
     /// no stiffness.

@@ -1211,6 +1211,16 @@ fn constrained_mass_system(
         .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
         .collect();
     let light: Vec<bool> = (0..n).map(massless).collect();
+    // massless rows held by a constraint keep their mass row (zero): the
+    // constraints carry them, and a stiffness row there (the penalty
+    // p BᵀB of the joints) would pass the constraints' rates on to the
+    // bodies they hold (as the impact, docs/theory.md §16)
+    let mut held = vec![false; n];
+    for (row, col, v) in stiffness.entries() {
+        if v != 0.0 && light[row] && is_multiplier[col] {
+            held[row] = true;
+        }
+    }
     // multiplier rows and columns scaled to the mass (D8 with β′ = 1)
     let s_eq: Vec<f64> = (0..n)
         .map(|eq| match dofs.equation_kind(eq) {
@@ -1235,7 +1245,7 @@ fn constrained_mass_system(
         // the rows of velocity constraints take their ∂r/∂v
         let v = if let Some((c, true)) = velocity_rows.map(|(r, c)| (c, r[dof_of[row]])) {
             c.values()[i]
-        } else if is_multiplier[row] || is_multiplier[col] || light[row] {
+        } else if is_multiplier[row] || is_multiplier[col] || (light[row] && !held[row]) {
             k[i] + m[i]
         } else {
             m[i]

@@ -356,6 +356,9 @@ struct Run {
     /// The size of the step after a rebound from a stop: the time its
     /// coordinate takes to rise to the top of its flight (§16.4).
     rebound_step: Option<f64>,
+    /// A stop closed at the last step: the steps resume with the size they
+    /// had before landing on it (§16.4).
+    closed: bool,
     started: Instant,
     finished: bool,
     error: Option<DynamicError>,
@@ -582,6 +585,7 @@ impl DynamicAnalysis {
             lock_rank_analyses: 0,
             contacts: Vec::new(),
             rebound_step: None,
+            closed: false,
             started,
             finished: false,
             error: None,
@@ -711,6 +715,8 @@ impl DynamicAnalysis {
         let run = stepper.run;
         if let Some(size) = run.rebound_step.take() {
             controller.set_size(size);
+        } else if std::mem::take(&mut run.closed) {
+            controller.resume_after_landing();
         }
         run.controller = Some(controller);
         if !matches!(result, Ok(Advance::Accepted(_))) {
@@ -2460,6 +2466,7 @@ impl Dynamics<'_> {
         run.a_before_coordinates.clear();
         run.balance.impact(i.energy_lost, i.work);
         run.rebound_step = i.rebound_step;
+        run.closed = i.events.iter().any(|c| c.kind == ContactKind::Close);
         Ok(i.events)
     }
 }

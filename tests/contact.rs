@@ -521,7 +521,7 @@ fn two_spheres_stay_in_contact_when_pushed_together() {
             );
         }
         // N = m_b F/(m_a + m_b): 1e-8 relative, the constraint's
-        // convergence (measured: 1.3e-9; 7.4e-3 alternating from step to
+        // convergence (measured: 1.1e-9; 7.4e-3 alternating from step to
         // step when the steps resumed from the landing step of 5e-7 s,
         // whose round-off of the positions, 1e-16 m, the index-3 scheme
         // divides by βh²: the steps now resume with the size they had

@@ -260,17 +260,19 @@ fn a_false_root_turning_the_body_by_whole_turns_is_rejected() {
 }
 
 /// Launched at 5 rad/s (6.375 J, a swing to 1.5 rad) in fixed steps of
-/// 0.5 s, Newton converges to false roots of both kinds of
+/// 0.7 s, Newton converges to false roots of both kinds of
 /// docs/theory.md §15.5: a turn of more than 1 rad in the step, and a
 /// root more than the model's size (0.5 m, the pendulum's length) away
 /// from the predictor. Both are rejected and cut back, and the run
 /// completes with the kinetic energy never above the 6.375 J it started
 /// with. Without the checks (measured by disabling them) the false roots
-/// are accepted: the kinetic energy reaches 5.2e2 J and the body turns
-/// by 155 rad in a step.
+/// are accepted (at 0.5 s steps: the kinetic energy reaches 5.2e2 J and
+/// the body turns by 155 rad in a step). Which false roots Newton finds
+/// depends on the whole step sequence: measured with this settings, 1
+/// root beyond the model's size and 8 turns beyond 1 rad.
 #[test]
 fn false_roots_far_from_the_predictor_are_rejected() {
-    let (model, settings) = pendulum(5.0, 0.5);
+    let (model, settings) = pendulum(5.0, 0.7);
     let start = 0.5 * (0.01 * 25.0 + 2.0 * 6.25);
     let mut record = Record::default();
     let out = DynamicAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut record);

@@ -259,6 +259,9 @@ pub struct StepController {
     event_values: Vec<f64>,
     event_sides: Vec<f64>,
     crossing: Option<Crossing>,
+    /// The size of the step that first crossed the event being located
+    /// (or last landed on), before it was shortened to land.
+    approach: Option<f64>,
     /// The size of the next step is set by the error estimate.
     error_controlled: bool,
     /// Error estimate of the last accepted step (at least
@@ -294,6 +297,7 @@ impl StepController {
             event_values: Vec::new(),
             event_sides: Vec::new(),
             crossing: None,
+            approach: None,
             error_controlled: false,
             last_error: None,
             rejected: false,
@@ -335,6 +339,19 @@ impl StepController {
     pub fn set_size(&mut self, size: f64) {
         if size.is_finite() && size > 0.0 {
             self.size = size.clamp(self.bounds.min, self.bounds.max);
+        }
+    }
+
+    /// Resumes, after a step landed on an event, with the size of the step
+    /// that first crossed it (if larger than the size the landing step's
+    /// error estimate gave): the size the motion allowed before the event
+    /// was located, for a restart whose accelerations are consistent
+    /// again (a contact that closed, docs/theory.md §16.4).
+    pub fn resume_after_landing(&mut self) {
+        if let Some(size) = self.approach.take() {
+            if size > self.size {
+                self.set_size(size);
+            }
         }
     }
 
@@ -547,6 +564,9 @@ impl StepController {
                     // restart closes what is left of its gap)
                     if retries <= MAX_EVENT_RETRIES && theta * size >= self.landing_floor() {
                         // retried shortened, from the same start
+                        if self.crossing.is_none() {
+                            self.approach = Some(size);
+                        }
                         self.counts.event_retries += 1;
                         self.counts.wasted_iterations += iterations;
                         stepper.reject();

@@ -192,9 +192,7 @@ fn main() -> ExitCode {
                 match Group::from_name(w) {
                     Some(g) => groups.push(g),
                     None => {
-                        eprintln!(
-                            "error: {w:?}: not a kind of chart; give joints, moments or energies"
-                        );
+                        eprintln!("error: {w:?}: not a kind of chart; give {}", Group::NAMES);
                         return ExitCode::from(EXIT_INPUT);
                     }
                 }
@@ -248,6 +246,23 @@ fn main() -> ExitCode {
                 );
                 return ExitCode::from(EXIT_INPUT);
             }
+            // a restart into the directory of the run it continues would
+            // replace that run's histories (steps.csv, events.csv, …) with
+            // those from the restart's t on
+            if let Some(r) = restart.as_deref() {
+                if restart_in_output(r, &out) {
+                    let stem = out
+                        .file_name()
+                        .map_or("results".into(), |s| s.to_string_lossy().into_owned());
+                    eprintln!(
+                        "error: --restart {}: the restart file is in the output directory {}, whose results this run would replace; give the continued run a directory of its own, e.g. --out {}",
+                        r.display(),
+                        out.display(),
+                        out.with_file_name(format!("{stem}-continued")).display()
+                    );
+                    return ExitCode::from(EXIT_INPUT);
+                }
+            }
             let encoding = if vtk_ascii {
                 Encoding::Ascii
             } else {
@@ -256,6 +271,16 @@ fn main() -> ExitCode {
             run(&model, &out, quiet, encoding, restart.as_deref())
         }
     }
+}
+
+/// Whether the restart file `restart` lies in the output directory `out`
+/// (compared as canonical paths; an output directory that does not exist
+/// yet holds nothing).
+fn restart_in_output(restart: &Path, out: &Path) -> bool {
+    let (Ok(file), Ok(dir)) = (restart.canonicalize(), out.canonicalize()) else {
+        return false;
+    };
+    file.parent() == Some(dir.as_path())
 }
 
 /// `unfold plot`: draws the charts of `request` from the results in
@@ -269,6 +294,24 @@ fn plot(
     out: &Path,
     format: Format,
 ) -> ExitCode {
+    // a model file named on the command line must be there: the charts
+    // would otherwise mix angles and lengths without a word
+    if let Some(m) = model {
+        let parsed = std::fs::read_to_string(m)
+            .map_err(|e| e.to_string())
+            .and_then(|text| {
+                unfold::io::model_file::parse_model(&text, m)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            });
+        if let Err(e) = parsed {
+            eprintln!(
+                "error: --model {}: cannot read the model file: {e}",
+                m.display()
+            );
+            return ExitCode::from(EXIT_INPUT);
+        }
+    }
     let drawn = Histories::read(dir, model).and_then(|h| {
         for note in h.notes() {
             eprintln!("note: {note}");

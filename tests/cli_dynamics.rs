@@ -499,6 +499,51 @@ fn a_restarted_dynamic_run_repeats_the_uninterrupted_one() {
     assert_eq!(summary(&part)["analyses"][0]["dynamic"]["steps"], 60);
 }
 
+/// A restart into the directory that holds its restart file would replace
+/// the histories of the run it continues: refused with exit 2, the
+/// histories left as they were, the way out named.
+#[test]
+fn a_restart_into_its_own_results_directory_is_refused() {
+    let dir = scratch("restart-same-dir");
+    let model = dir.join("pendulum.toml");
+    std::fs::write(&model, pendulum(FIXED, "[output]\nrestart_times = [0.3]\n")).unwrap();
+    let first = dir.join("first");
+    let o = run(&model, &first, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let steps = std::fs::read_to_string(first.join("steps.csv")).unwrap();
+    for file in ["restart-0.3.json", "restart.json"] {
+        // the same directory, named another way (a trailing `.`)
+        let o = run(
+            &model,
+            &first.join("."),
+            &["--restart", first.join(file).to_str().unwrap()],
+        );
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains(file)
+                && err.contains("is in the output directory")
+                && err.contains("first-continued"),
+            "{err}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(first.join("steps.csv")).unwrap(),
+            steps,
+            "the first run's histories are kept"
+        );
+    }
+    // into another directory: accepted
+    let o = run(
+        &model,
+        &dir.join("second"),
+        &[
+            "--restart",
+            first.join("restart-0.3.json").to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 /// Bad input is refused before any step, exit 2, naming the analysis or
 /// the entity and what is wrong.
 #[test]

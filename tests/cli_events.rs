@@ -449,3 +449,79 @@ fn coefficients_per_degree_are_noted_in_radians() {
         text(&check.stderr)
     );
 }
+
+/// A stop on the wrong side of the motion: the panel swings from 0
+/// towards +360° but its only limit is 10° below the start. The run
+/// completes with a note, as for a latch that never locks, naming the
+/// stop, its joint, the range the joint covered and the stop's limits.
+#[test]
+fn a_stop_never_struck_is_noted() {
+    let dir = scratch("never-struck");
+    let model = dir.join("panel.toml");
+    let stop = "\n[[stops]]\nid = 6\njoint = 3\nlower = -10.0\nunit = \"deg\"\nrestitution = 0.3\n";
+    std::fs::write(&model, panel(DYNAMIC, -90.0, stop)).unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &["--quiet"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    let note = stdout
+        .lines()
+        .find(|l| l.starts_with("note: stop 6 was never struck in the dynamic analysis to t = 1"))
+        .unwrap_or_else(|| panic!("no note in {stdout}"));
+    assert!(
+        note.contains("joint 3 stayed within [0 rad (0.00°), 5.5"),
+        "{note}"
+    );
+    assert!(
+        note.contains("the stop's limits are [-0.174533 rad (-10.00°), ∞]"),
+        "{note}"
+    );
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    assert!(log.contains(note), "{log}");
+    // a stop that is struck gets no note: the same stop at 10° above the
+    // start, which the panel reaches at once
+    let struck = stop.replace("lower = -10.0", "upper = 10.0");
+    std::fs::write(&model, panel(DYNAMIC, -90.0, &struck)).unwrap();
+    let o = run(&model, &out, &["--quiet"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        !text(&o.stdout).contains("never struck"),
+        "{}",
+        text(&o.stdout)
+    );
+}
+
+/// A spring latch (2 N·m/° = 114.59 N·m/rad, dead band 1°, unlatch load
+/// 5 N·m) that the panel reaches at 0.43 s and pulls open: the run's last
+/// line and `summary.json` count one lock and one unlatch, not two locks,
+/// and the energy the spring held at the release, `½ F_u²/k = 0.10908 J`
+/// (docs/joints.md §6.2), as lost in impacts and unlatches.
+#[test]
+fn an_unlatch_is_counted_as_an_unlatch() {
+    let dir = scratch("unlatch");
+    let model = dir.join("panel.toml");
+    let spring = "mode = \"spring\"\nstiffness = 2.0\nbacklash = 1.0\nunlatch_load = 5.0\n";
+    std::fs::write(&model, panel(DYNAMIC, 90.0, spring)).unwrap();
+    let out = dir.join("out");
+    let o = run(&model, &out, &["--quiet"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(kinds(&out), ["lock", "unlatch"]);
+    let d = &summary(&out)["analyses"][0]["dynamic"];
+    assert_eq!(
+        (d["locks"].as_u64(), d["unlatches"].as_u64()),
+        (Some(1), Some(1)),
+        "{d}"
+    );
+    let k = 2.0 * 180.0 / std::f64::consts::PI;
+    let held = 0.5 * 5.0 * 5.0 / k;
+    let lost = d["impact_energy_lost"].as_f64().unwrap();
+    // the release lands within the event tolerance of the unlatch load
+    assert!((lost - held).abs() < 1e-4 * held, "{lost} vs {held}");
+    let last = text(&o.stderr) + &text(&o.stdout);
+    assert!(
+        last.contains(&format!(
+            "1 lock, 1 unlatch, energy lost in impacts and unlatches {lost:.3e}"
+        )),
+        "{last}"
+    );
+}

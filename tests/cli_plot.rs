@@ -310,3 +310,187 @@ fn static_run_and_bad_input() {
         &["joints.csv, line 1", "no column `time`"],
     );
 }
+
+/// One sign convention on the moments chart: each curve is the moment its
+/// element applies on the joint's second body, positive increasing the
+/// coordinate. In the static equilibrium of the driven hinge (no other
+/// load on the link) the driver's moment balances the hinge law's, so the
+/// two curves are opposite at every step (to the residual tolerance,
+/// 1e-6 of the 10 N·m peak). The hinge-law chart draws `M` (as in
+/// hinge_laws.csv) against the angle, with `∫ M dc` over the run in the
+/// legend and the latch's angle marked.
+#[test]
+fn moments_share_one_sign_convention_and_hinge_laws_draw_their_loop() {
+    use unfold::io::histories::{Group, Histories, Request};
+
+    let dir = scratch("convention");
+    // a latch at 90° on the hinge (a static run passes it with a note)
+    let latch = "\n[[latches]]\nid = 9\njoint = 1\nvalue = 90.0\nunit = \"deg\"\n";
+    let (out, _) = driven_hinge(&dir, latch);
+    let h = Histories::read(&out, None).unwrap();
+    let figures = h
+        .figures(&Request {
+            groups: vec![Group::Moments, Group::HingeLaws],
+            ..Request::default()
+        })
+        .unwrap();
+    let moments = &figures
+        .iter()
+        .find(|f| f.name == "moments_joint_1")
+        .expect("moments chart")
+        .chart;
+    let series = |label: &str| {
+        moments
+            .series
+            .iter()
+            .find(|s| s.label == label)
+            .unwrap_or_else(|| panic!("no {label:?}"))
+            .points
+            .clone()
+    };
+    let (law, driver) = (series("hinge law 2, angle"), series("driver 3, angle"));
+    assert_eq!(law.len(), driver.len());
+    let peak = law.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
+    assert!(peak > 9.0, "the law reaches its locking peak: {peak}");
+    for (a, b) in law.iter().zip(&driver) {
+        assert!(
+            (a.1 + b.1).abs() < 1e-6 * peak,
+            "t = {}: {} + {}",
+            a.0,
+            a.1,
+            b.1
+        );
+    }
+    // the law's curve is minus the file's M (positive resisting an increase)
+    let file = read(&out.join("hinge_laws.csv"));
+    let rows: Vec<(f64, f64)> = file
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (f[3], f[4])
+        })
+        .collect();
+    assert_eq!(rows.len(), law.len());
+    for (r, p) in rows.iter().zip(&law) {
+        assert_eq!(p.1, -r.1);
+    }
+
+    // the loop: (c, M) of the file, the work by the trapezoidal rule
+    let hinge = &figures
+        .iter()
+        .find(|f| f.name == "hinge_law_2")
+        .expect("hinge-law chart")
+        .chart;
+    assert_eq!(hinge.series[0].points, rows);
+    let work: f64 = rows
+        .windows(2)
+        .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
+        .sum();
+    assert!(work > 0.0, "a hysteresis loop dissipates: {work}");
+    assert!(
+        hinge.series[0].label.contains("∫ M dc = "),
+        "{:?}",
+        hinge.series[0].label
+    );
+    assert_eq!(hinge.x.label(), "angle (rad)");
+    assert_eq!(hinge.y.label(), "moment M (N·m)");
+    assert_eq!(hinge.events.len(), 1);
+    assert!((hinge.events[0].0 - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    assert_eq!(hinge.events[0].1, "latch 9 locks at 1.571 rad");
+
+    // the command line: `hinge_laws` is a kind of chart, in degrees
+    let plots = dir.join("plots");
+    let o = unfold(&[
+        "plot",
+        s(&out),
+        "hinge_laws",
+        "--degrees",
+        "--out",
+        s(&plots),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_drawn_png(&plots.join("hinge_law_2.png"));
+    let svg = read(&plots.join("hinge_law_2.svg"));
+    for text in ["angle (°)", "moment M (N·m)", "latch 9 locks at 90 °"] {
+        assert!(svg.contains(text), "hinge_law_2.svg lacks {text:?}");
+    }
+}
+
+/// Many events close together are labelled once as a group: 13 impacts
+/// whose intervals halve (a ball coming to rest) give a few labels, the
+/// last of which counts the group and gives its interval and loss; every
+/// impact keeps its line.
+#[test]
+fn close_events_are_labelled_as_a_group() {
+    use unfold::io::histories::{Group, Histories, Request};
+
+    let dir = scratch("groups");
+    let (out, _) = latched_panels(&dir, "");
+    let mut csv = String::from("time,joint,event,energy_lost\n");
+    for k in 0..13 {
+        let t = 0.005 + 0.03 * (1.0 - 0.5f64.powi(k));
+        csv += &format!("{t:e},10,impact,1.0\n");
+    }
+    std::fs::write(out.join("events.csv"), csv).unwrap();
+    let h = Histories::read(&out, None).unwrap();
+    let figures = h
+        .figures(&Request {
+            groups: vec![Group::Joints],
+            ..Request::default()
+        })
+        .unwrap();
+    let chart = &figures[0].chart;
+    let impacts = chart
+        .events
+        .iter()
+        .filter(|e| e.1 != "latch 20 locks")
+        .count();
+    // 13 impact lines, and the lock's (its label may join a group)
+    assert_eq!(chart.events.len(), 14);
+    assert!(impacts >= 13);
+    let labels: Vec<&str> = chart
+        .events
+        .iter()
+        .map(|e| e.1.as_str())
+        .filter(|l| !l.is_empty())
+        .collect();
+    assert!(labels.len() <= 6, "{labels:?}");
+    let group = labels
+        .iter()
+        .find(|l| l.contains("impacts at joint 10"))
+        .unwrap_or_else(|| panic!("no group label in {labels:?}"));
+    assert!(
+        group.contains(" s, ") && group.contains(" J lost"),
+        "{group}"
+    );
+}
+
+/// `--model` naming a file that cannot be read is an error (exit 2), and
+/// a missing joints.csv is named as missing, not as a model without
+/// joints.
+#[test]
+fn a_missing_model_file_or_joints_csv_is_named() {
+    let dir = scratch("missing");
+    let (out, _) = latched_panels(&dir, "");
+    let none = dir.join("none.toml");
+    let o = unfold(&["plot", s(&out), "--model", s(&none)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!(
+            "error: --model {}: cannot read the model file",
+            s(&none)
+        )),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_file(out.join("joints.csv")).unwrap();
+    let o = unfold(&["plot", s(&out), "joints"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("joints.csv is missing from")
+            && stderr(&o).contains("although the model has joints"),
+        "{}",
+        stderr(&o)
+    );
+}

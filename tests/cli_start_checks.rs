@@ -249,8 +249,34 @@ fn a_latch_locked_at_the_start_gets_its_own_advice() {
         assert!(err.contains(wanted), "{wanted:?} not in {err}");
     }
     assert!(!err.contains("one rigid motion"), "{err}");
+    // the joint's own rate: the body turns at +0.1 rad/s about the hinge's
+    // axis z, the joint angle increases (joints.csv of the same motion)
+    assert!(err.contains("its rate is 1.000e-1 "), "{err}");
     assert_eq!(err, run_err);
     assert_eq!(files(&out), ["summary.json"]);
+}
+
+/// A disc that slips at the start gets rolling advice, not the generic
+/// advice of a joint: the centre speed v = 2 m/s along n × a = +y needs
+/// the spin −v/r = −4 rad/s about the axle a = +x; −3 rad/s slips.
+#[test]
+fn a_slipping_disc_gets_rolling_advice() {
+    let dir = scratch("slip-advice");
+    let model = dir.join("slip.toml");
+    std::fs::write(&model, disc(-3.0)).unwrap();
+    let out = dir.join("out");
+    let ((code, err), (run_code, _, run_err)) = check_and_run(&model, &out);
+    assert_eq!((code, run_code), (2, 2), "{err}\n{run_err}");
+    for wanted in [
+        "the initial velocities violate rolling disc 2 equation",
+        "no slip along the plane's tangent",
+        "the disc must roll",
+        "−v/r about the axle",
+    ] {
+        assert!(err.contains(wanted), "{wanted:?} not in {err}");
+    }
+    assert!(!err.contains("one rigid motion"), "{err}");
+    assert_eq!(err, run_err);
 }
 
 /// A node given an initial velocity twice, and a velocity on a supported

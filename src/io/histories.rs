@@ -38,19 +38,32 @@ pub enum Group {
     /// dampers, hinge laws, latch loads and driver loads, one chart per
     /// joint.
     Moments,
+    /// The moment of each hinge law against its coordinate (the
+    /// hysteresis loop), one chart per law.
+    HingeLaws,
     /// Energies of a dynamic analysis, and its balance error.
     Energies,
 }
 
 impl Group {
     /// Every group, in the order charts are written.
-    pub const ALL: [Group; 3] = [Group::Joints, Group::Moments, Group::Energies];
+    pub const ALL: [Group; 4] = [
+        Group::Joints,
+        Group::Moments,
+        Group::HingeLaws,
+        Group::Energies,
+    ];
+
+    /// What a name of a chart may be, for messages.
+    pub const NAMES: &'static str =
+        "joints, moments or energies (against t), or hinge_laws (moment against angle)";
 
     /// Name on the command line and in `[output] plots`.
     pub fn name(self) -> &'static str {
         match self {
             Group::Joints => "joints",
             Group::Moments => "moments",
+            Group::HingeLaws => "hinge_laws",
             Group::Energies => "energies",
         }
     }
@@ -343,6 +356,10 @@ fn significant(x: f64) -> String {
     }
 }
 
+/// Events closer in time to the one before than this fraction of a
+/// chart's time range are labelled as one group.
+const EVENT_GROUP: f64 = 0.03;
+
 /// Whether a series has a finite value.
 fn has_values(points: &[(f64, f64)]) -> bool {
     points.iter().any(|p| p.0.is_finite() && p.1.is_finite())
@@ -356,6 +373,8 @@ struct Coordinates {
     /// Joint and coordinate of each joint spring, hinge law, latch and
     /// joint driver, by file and id.
     acting: BTreeMap<(&'static str, Id), (Id, Coordinate)>,
+    /// Locking value of each latch (m or rad).
+    latch_values: BTreeMap<Id, f64>,
 }
 
 impl Coordinates {
@@ -375,6 +394,7 @@ impl Coordinates {
             Some((joint, c))
         };
         let mut acting = BTreeMap::new();
+        let mut latch_values = BTreeMap::new();
         for s in &input.joint_springs {
             if let Some(c) = resolve(s.joint, &s.coordinate) {
                 acting.insert(("joint_springs", s.id), c);
@@ -388,6 +408,12 @@ impl Coordinates {
         for l in &input.latches {
             if let Some(c) = resolve(l.joint, &l.coordinate) {
                 acting.insert(("latches", l.id), c);
+                let unit = if c.1.is_angle() {
+                    l.unit.unwrap_or_default().radians()
+                } else {
+                    1.0
+                };
+                latch_values.insert(l.id, l.value * unit);
             }
         }
         for d in &input.drivers {
@@ -395,7 +421,11 @@ impl Coordinates {
                 acting.insert(("drivers", d.id), c);
             }
         }
-        Some(Self { joints, acting })
+        Some(Self {
+            joints,
+            acting,
+            latch_values,
+        })
     }
 }
 
@@ -406,6 +436,9 @@ struct Event {
     time: f64,
     joint: Option<Id>,
     label: String,
+    /// Kind of event of `events.csv` (`impact`, `lock`), to count the
+    /// events of a group; `None` for a lock read from `latches.csv`.
+    kind: Option<String>,
     /// Energy lost at the event (`events.csv`), in the model's units.
     lost: Option<f64>,
 }
@@ -526,6 +559,7 @@ impl Histories {
                         time: t.number(r, time)?,
                         joint,
                         label: format!("latch {id} locks"),
+                        kind: None,
                         lost: None,
                     });
                 }
@@ -544,10 +578,11 @@ impl Histories {
                     Some(c) if !t.rows[r].1[c].is_empty() => Some(t.id(r, c)?),
                     _ => None,
                 };
-                let mut label = match kind {
+                let kind = match kind {
                     Some(c) if !t.rows[r].1[c].is_empty() => t.rows[r].1[c].clone(),
                     _ => "event".to_string(),
                 };
+                let mut label = kind.clone();
                 if let Some(j) = joint {
                     label += &format!(" at joint {j}");
                 }
@@ -570,6 +605,7 @@ impl Histories {
                     time: at,
                     joint,
                     label,
+                    kind: Some(kind),
                     lost,
                 });
             }
@@ -616,6 +652,9 @@ impl Histories {
             || self.drivers.is_some()
         {
             groups.push(Group::Moments);
+        }
+        if self.hinge_laws.is_some() {
+            groups.push(Group::HingeLaws);
         }
         if self.energies.is_some() {
             groups.push(Group::Energies);
@@ -666,21 +705,32 @@ impl Histories {
         let mut figures = Vec::new();
         for group in groups {
             if !available.contains(&group) {
+                let missing = format!("joints.csv is missing from {}", self.dir.display());
                 let reason = match group {
-                    Group::Joints => "the model has no joints (no joints.csv)",
+                    Group::Joints => match &self.coordinates {
+                        Some(c) if c.joints.is_empty() => {
+                            "the model has no joints (no joints.csv)".to_string()
+                        }
+                        Some(_) => format!("{missing}, although the model has joints"),
+                        None => missing,
+                    },
                     Group::Moments => {
-                        "the model has no joint springs, hinge laws, latches or drivers"
+                        "the model has no joint springs, hinge laws, latches or drivers".into()
                     }
-                    Group::Energies => "no energies.csv: energies are written by dynamic analyses",
+                    Group::HingeLaws => "no hinge_laws.csv: the model has no hinge laws".into(),
+                    Group::Energies => {
+                        "no energies.csv: energies are written by dynamic analyses".into()
+                    }
                 };
                 return Err(HistoryError::Unavailable {
                     group: group.name(),
-                    reason: reason.into(),
+                    reason,
                 });
             }
             match group {
                 Group::Joints => figures.extend(self.joint_figures(request, &chosen)?),
                 Group::Moments => figures.extend(self.moment_figures(request, &chosen)?),
+                Group::HingeLaws => figures.extend(self.hinge_law_figures(request, &chosen)?),
                 Group::Energies => figures.extend(self.energy_figures(request)?),
             }
         }
@@ -703,15 +753,93 @@ impl Histories {
             .filter(move |e| joint.is_none() || e.joint.is_none() || e.joint == joint)
     }
 
+    /// Draws the events of `joint` on `chart`: each a vertical line;
+    /// events closer to the one before than [`EVENT_GROUP`] of the chart's
+    /// time range are labelled once as a group ("10 impacts at joint 2,
+    /// 1.242–1.354 s, 0.6131 J lost"), so that a run of rebounds does not
+    /// pile up its labels.
     fn with_events(&self, mut chart: Chart, joint: Option<Id>, units: UnitLabels) -> Chart {
-        for e in self.events_of(joint) {
-            let label = match e.lost {
-                Some(lost) => format!("{}, {} {} lost", e.label, significant(lost), units.energy()),
-                None => e.label.clone(),
-            };
-            chart = chart.event(e.time, label);
+        let mut events: Vec<&Event> = self.events_of(joint).collect();
+        events.sort_by(|a, b| a.time.total_cmp(&b.time));
+        let (lo, hi) = chart
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .map(|p| p.0)
+            .filter(|x| x.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+        let close = if hi > lo {
+            EVENT_GROUP * (hi - lo)
+        } else {
+            0.0
+        };
+        let mut groups: Vec<Vec<&Event>> = Vec::new();
+        for e in events {
+            match groups.last_mut() {
+                Some(g) if e.time - g[g.len() - 1].time <= close => g.push(e),
+                _ => groups.push(vec![e]),
+            }
+        }
+        let time_unit = match chart.x.unit.as_str() {
+            "–" => String::new(),
+            u => format!(" {u}"),
+        };
+        for group in groups {
+            let label = Self::group_label(&group, units, &time_unit);
+            chart = chart.event(group[0].time, label);
+            for e in &group[1..] {
+                chart = chart.event(e.time, "");
+            }
         }
         chart
+    }
+
+    /// The label of a group of events: the event's own for one event;
+    /// otherwise how many of each kind, the joint if they share one, the
+    /// interval of time and the energy lost in all.
+    fn group_label(group: &[&Event], units: UnitLabels, time_unit: &str) -> String {
+        let lost = group.iter().filter_map(|e| e.lost).sum::<f64>();
+        let any_lost = group.iter().any(|e| e.lost.is_some());
+        let with_lost = |text: String| {
+            if any_lost {
+                format!("{text}, {} {} lost", significant(lost), units.energy())
+            } else {
+                text
+            }
+        };
+        if let [e] = group {
+            return with_lost(e.label.clone());
+        }
+        // counts by kind, in order of first appearance
+        let mut counts: Vec<(String, usize)> = Vec::new();
+        for e in group {
+            let noun = e.kind.clone().unwrap_or_else(|| e.label.clone());
+            match counts.iter_mut().find(|c| c.0 == noun) {
+                Some(c) => c.1 += 1,
+                None => counts.push((noun, 1)),
+            }
+        }
+        let what: Vec<String> = counts
+            .iter()
+            .map(|(noun, n)| match n {
+                1 => format!("1 {noun}"),
+                _ if noun.ends_with("ch") || noun.ends_with('s') => format!("{n} {noun}es"),
+                _ => format!("{n} {noun}s"),
+            })
+            .collect();
+        let joint = group[0].joint.filter(|j| {
+            group.iter().all(|e| e.joint == Some(*j)) && group.iter().all(|e| e.kind.is_some())
+        });
+        let at = joint.map_or(String::new(), |j| format!(" at joint {j}"));
+        let (first, last) = (group[0].time, group[group.len() - 1].time);
+        with_lost(format!(
+            "{}{at}, {}–{}{time_unit}",
+            what.join(", "),
+            significant(first),
+            significant(last),
+        ))
     }
 
     /// The unit of coordinate `c` (and the factor from the file's values).
@@ -831,8 +959,13 @@ impl Histories {
         chosen: &dyn Fn(Id) -> bool,
     ) -> Result<Vec<Figure>, HistoryError> {
         // the files of loads along joint coordinates: (table, its name in
-        // `Coordinates::acting`, id column, [(column, legend)])
-        type Source<'t> = (&'t Option<Table>, &'static str, &'static str, Legends);
+        // `Coordinates::acting`, id column, [(column, legend)], and the
+        // sign that turns the file's value into the load on the joint's
+        // second body, positive in the sense of increasing coordinate:
+        // springs, dampers and hinge laws are written positive resisting
+        // an increase (they apply −f on the second body), latch and driver
+        // loads positive pushing the coordinate up (docs/results.md))
+        type Source<'t> = (&'t Option<Table>, &'static str, &'static str, Legends, f64);
         type Legends = &'static [(&'static str, &'static str)];
         let sources: [Source; 4] = [
             (
@@ -840,20 +973,28 @@ impl Histories {
                 "joint_springs",
                 "element",
                 &[("spring", "spring"), ("damper", "damper")],
+                -1.0,
             ),
             (
                 &self.hinge_laws,
                 "hinge_laws",
                 "element",
                 &[("moment", "hinge law")],
+                -1.0,
             ),
-            (&self.latches, "latches", "latch", &[("load", "latch")]),
-            (&self.drivers, "drivers", "driver", &[("load", "driver")]),
+            (&self.latches, "latches", "latch", &[("load", "latch")], 1.0),
+            (
+                &self.drivers,
+                "drivers",
+                "driver",
+                &[("load", "driver")],
+                1.0,
+            ),
         ];
         // series by joint and by kind of coordinate (angle or not): None
         // when unknown
         let mut charts: BTreeMap<(Option<Id>, bool), Vec<Series>> = BTreeMap::new();
-        for (table, file, id_column, columns) in sources {
+        for (table, file, id_column, columns, sign) in sources {
             let Some(t) = table else { continue };
             let cols: Vec<&str> = columns.iter().map(|c| c.0).collect();
             for (id, histories) in t.histories(id_column, &cols)? {
@@ -879,10 +1020,10 @@ impl Histories {
                         continue;
                     }
                     let coordinate = acting.map_or(String::new(), |a| format!(", {}", a.1.name()));
-                    charts
-                        .entry(key)
-                        .or_default()
-                        .push(Series::new(format!("{legend} {id}{coordinate}"), points));
+                    charts.entry(key).or_default().push(Series::new(
+                        format!("{legend} {id}{coordinate}"),
+                        points.into_iter().map(|(t, v)| (t, sign * v)),
+                    ));
                 }
             }
         }
@@ -903,11 +1044,11 @@ impl Histories {
             };
             let (title, mut name) = match joint {
                 Some(j) => (
-                    format!("Joint {j}: {quantity}s along its coordinates"),
+                    format!("Joint {j}: {quantity}s on its second body, + increasing c"),
                     format!("moments_joint_{j}"),
                 ),
                 None => (
-                    "Moments and forces along the joint coordinates".into(),
+                    "Loads on the joints' second bodies, + increasing c".into(),
                     "moments".into(),
                 ),
             };
@@ -921,6 +1062,112 @@ impl Histories {
             figures.push(Figure {
                 name,
                 chart: self.with_events(chart, joint, request.units),
+            });
+        }
+        Ok(figures)
+    }
+
+    /// One chart per hinge law: its moment `M` (positive resisting an
+    /// increase of the coordinate, as in `hinge_laws.csv`) against its
+    /// coordinate, the hysteresis loop, with the work `∫ M dc` over the
+    /// run (trapezoidal rule on the output steps: the energy the law
+    /// dissipated, over closed cycles) in the legend and the locking value
+    /// of each latch on the same coordinate as a vertical line.
+    fn hinge_law_figures(
+        &self,
+        request: &Request,
+        chosen: &dyn Fn(Id) -> bool,
+    ) -> Result<Vec<Figure>, HistoryError> {
+        let Some(t) = &self.hinge_laws else {
+            return Ok(Vec::new());
+        };
+        let mut figures = Vec::new();
+        for (id, mut columns) in t.histories("element", &["coordinate", "moment"])? {
+            let moment = columns.pop().unwrap_or_default();
+            let coordinate = columns.pop().unwrap_or_default();
+            let acting = self
+                .coordinates
+                .as_ref()
+                .and_then(|c| c.acting.get(&("hinge_laws", id)))
+                .copied();
+            if acting.is_some_and(|a| !chosen(a.0)) {
+                continue;
+            }
+            // (c, M) at each output step
+            let loop_points: Vec<(f64, f64)> = coordinate
+                .iter()
+                .zip(&moment)
+                .map(|(c, m)| (c.1, m.1))
+                .collect();
+            if !has_values(&loop_points) {
+                continue;
+            }
+            let work: f64 = loop_points
+                .windows(2)
+                .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
+                .filter(|w| w.is_finite())
+                .sum();
+            let angle = acting.is_none_or(|a| a.1.is_angle());
+            let (x_axis, factor, y_axis, energy) = match acting {
+                Some((_, c)) => {
+                    let (unit, factor) = Self::coordinate_unit(c, request);
+                    let (quantity, y) = if c.is_angle() {
+                        ("angle", Axis::new("moment M", request.units.moment()))
+                    } else {
+                        ("displacement", Axis::new("force F", request.units.force()))
+                    };
+                    (
+                        Axis::new(
+                            if c.name() == quantity {
+                                quantity.to_string()
+                            } else {
+                                format!("{quantity} {}", c.name())
+                            },
+                            unit,
+                        ),
+                        factor,
+                        y,
+                        request.units.energy(),
+                    )
+                }
+                None => (
+                    Axis::new("coordinate", format!("rad or {}", request.units.length())),
+                    1.0,
+                    Axis::new(
+                        "moment or force",
+                        format!("{} or {}", request.units.moment(), request.units.force()),
+                    ),
+                    request.units.energy(),
+                ),
+            };
+            let title = match acting {
+                Some((joint, c)) => format!(
+                    "Hinge law {id} on joint {joint}: {} against {}, + resisting an increase",
+                    if angle { "moment" } else { "force" },
+                    c.name()
+                ),
+                None => format!("Hinge law {id}: moment against coordinate"),
+            };
+            let mut chart = Chart::new(title, x_axis, y_axis).series(Series::new(
+                format!("hinge law {id}, ∫ M dc = {} {energy}", significant(work)),
+                loop_points.iter().map(|&(c, m)| (c * factor, m)),
+            ));
+            // the locking values of the latches on this coordinate
+            if let (Some((joint, c)), Some(coords)) = (acting, &self.coordinates) {
+                for (&latch, &value) in &coords.latch_values {
+                    if coords.acting.get(&("latches", latch)) == Some(&(joint, c)) {
+                        let shown = value * factor;
+                        let unit = chart.x.unit.clone();
+                        chart = chart.event(
+                            shown,
+                            format!("latch {latch} locks at {} {unit}", significant(shown)),
+                        );
+                    }
+                }
+            }
+            figures.push(Figure {
+                name: format!("hinge_law_{id}"),
+                chart,
             });
         }
         Ok(figures)

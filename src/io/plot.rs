@@ -80,6 +80,19 @@ const MARKERS_PER_SERIES: usize = 12;
 /// Size of a marker, pixels.
 const MARK_SIZE: i32 = 5;
 
+/// Font size of the event labels, and the height of a row of them, pixels.
+const EVENT_FONT: u32 = 13;
+const EVENT_ROW: i32 = 16;
+
+/// Rows of event labels at the top of a chart, at most: a label that
+/// finds no free room in them goes into the row that frees first.
+const EVENT_ROWS: usize = 4;
+
+/// Width of the plotting area of a chart (its size less the margins and
+/// the label area of the vertical axis), pixels, to place event labels
+/// before the axes are drawn.
+const PLOT_WIDTH: i32 = SIZE.0 as i32 - 2 * 15 - 80;
+
 /// An axis: the quantity shown and its unit, written `quantity (unit)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Axis {
@@ -140,7 +153,8 @@ pub struct Chart {
     pub y: Axis,
     /// The curves.
     pub series: Vec<Series>,
-    /// Vertical lines at `x` with a label (a change of stage).
+    /// Vertical lines at `x` with a label (a change of stage); an empty
+    /// label draws the line alone.
     pub events: Vec<(f64, String)>,
 }
 
@@ -281,7 +295,8 @@ impl Chart {
     }
 
     /// Adds a vertical line at `x` labelled `label` (an event: a change of
-    /// stage, a lock).
+    /// stage, a lock); an empty label draws the line alone (one of a group
+    /// of events labelled once).
     pub fn event(mut self, x: f64, label: impl Into<String>) -> Self {
         self.events.push((x, label.into()));
         self
@@ -313,14 +328,29 @@ impl Chart {
             let hi = all.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
             padded(lo, hi)
         };
-        let (x0, x1) = range(|p| p.0);
+        let (mut x0, mut x1) = range(|p| p.0);
+        // an event outside the curves' range is still drawn
+        for (x, _) in self.events.iter().filter(|e| e.0.is_finite()) {
+            if *x < x0 || *x > x1 {
+                (x0, x1) = padded(x0.min(*x), x1.max(*x));
+            }
+        }
         let (y0, mut y1) = range(|p| p.1);
+        register()?;
+        let labels = self.event_rows(root, (x0, x1))?;
+        let label_rows = labels.iter().map(|l| l.1 + 1).max().unwrap_or(0);
         // headroom for the legend in the upper right corner, about 22 px
-        // per line of a plot area about 450 px high, so that it covers no
-        // curve
+        // per line of a plot area about 450 px high, and for the rows of
+        // event labels, so that they cover no curve
         let labelled = self.series.iter().any(|s| !s.label.is_empty());
-        if labelled {
-            let f = ((22 * self.series.len() + 15) as f64 / 450.0).min(0.6);
+        let legend = if labelled {
+            22 * self.series.len() + 15
+        } else {
+            0
+        };
+        let headroom = legend + EVENT_ROW as usize * label_rows;
+        if headroom > 0 {
+            let f = (headroom as f64 / 450.0).min(0.6);
             y1 += (y1 - y0) * f / (1.0 - f);
         }
 
@@ -342,9 +372,10 @@ impl Chart {
             .draw()
             .map_err(|e| drawing_error(&e))?;
 
-        // events: grey vertical lines labelled at the top
+        // events: grey vertical lines, labelled in rows below the
+        // legend so that no label covers another
         let grey = RGBColor(110, 110, 110);
-        for (x, label) in &self.events {
+        for (x, _) in &self.events {
             chart
                 .draw_series(std::iter::once(DashedPathElement::new(
                     [(*x, y0), (*x, y1)],
@@ -353,13 +384,27 @@ impl Chart {
                     grey.stroke_width(1),
                 )))
                 .map_err(|e| drawing_error(&e))?;
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    format!(" {label}"),
-                    (*x, y1),
-                    ("sans-serif", 13).into_font().color(&grey),
-                )))
-                .map_err(|e| drawing_error(&e))?;
+        }
+        let (left, right) = (
+            chart.backend_coord(&(x0, y1)),
+            chart.backend_coord(&(x1, y1)),
+        );
+        let font = ("sans-serif", EVENT_FONT).into_font().color(&grey);
+        for (k, row, width) in labels {
+            let (x, label) = &self.events[k];
+            let (px, top) = chart.backend_coord(&(*x, y1));
+            // to the right of its line, or to the left at the right edge
+            let px = if px + width > right.0 {
+                (px - width).max(left.0)
+            } else {
+                px
+            };
+            root.draw(&Text::new(
+                format!(" {label} "),
+                (px, top + legend as i32 + 2 + EVENT_ROW * row as i32),
+                font.clone(),
+            ))
+            .map_err(|e| drawing_error(&e))?;
         }
 
         let n_series = self.series.len().max(1);
@@ -411,6 +456,50 @@ impl Chart {
         }
         root.present().map_err(|e| drawing_error(&e))?;
         Ok(())
+    }
+
+    /// The labelled events (index in `events`), each with its row at the
+    /// top of the chart and its width in pixels: a label goes into the
+    /// first row where it covers no other (horizontal range `x_range`
+    /// over about [`PLOT_WIDTH`] pixels).
+    fn event_rows<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        x_range: (f64, f64),
+    ) -> Result<Vec<(usize, usize, i32)>, PlotError> {
+        let font: TextStyle = ("sans-serif", EVENT_FONT).into();
+        let span = (x_range.1 - x_range.0).max(f64::MIN_POSITIVE);
+        let mut order: Vec<usize> = (0..self.events.len())
+            .filter(|&k| !self.events[k].1.is_empty() && self.events[k].0.is_finite())
+            .collect();
+        order.sort_by(|&a, &b| self.events[a].0.total_cmp(&self.events[b].0));
+        // the right end of the last label in each row
+        let mut ends: Vec<i32> = Vec::new();
+        let mut placed = Vec::with_capacity(order.len());
+        for k in order {
+            let (x, label) = &self.events[k];
+            let (w, _) = root
+                .estimate_text_size(&format!(" {label} "), &font)
+                .map_err(|e| drawing_error(&e))?;
+            let w = w as i32;
+            let px = ((x - x_range.0) / span * f64::from(PLOT_WIDTH)).round() as i32;
+            let px = if px + w > PLOT_WIDTH {
+                (px - w).max(0)
+            } else {
+                px
+            };
+            let row = match ends.iter().position(|&end| end < px) {
+                Some(r) => r,
+                None if ends.len() < EVENT_ROWS => {
+                    ends.push(i32::MIN);
+                    ends.len() - 1
+                }
+                None => (0..ends.len()).min_by_key(|&r| ends[r]).unwrap_or(0),
+            };
+            ends[row] = px + w;
+            placed.push((k, row, w));
+        }
+        Ok(placed)
     }
 
     /// The chart as SVG text.

@@ -41,8 +41,8 @@ use serde::Serialize;
 
 use super::vtk;
 use crate::analysis::{
-    AnalysisSettings, ContactKind, DynamicOutcome, Energies, IncrementInfo, Observer,
-    StaticAnalysis, StaticOutcome,
+    AnalysisSettings, ContactKind, DynamicOutcome, Energies, IncrementInfo, LatchEventKind,
+    Observer, StaticAnalysis, StaticOutcome,
 };
 use crate::elements::{ElementKind, Need};
 use crate::model::Model;
@@ -150,19 +150,23 @@ pub struct DynamicRecord {
     pub largest_energy_balance_error: f64,
     /// Largest kinetic energy over the steps: the scale of the errors.
     pub largest_kinetic_energy: f64,
-    /// Events written to `events.csv`: latches locked, impacts of stops
-    /// with rebound, contacts closed (plastic impacts), contacts released.
+    /// Events written to `events.csv`: latches locked, spring latches
+    /// released (unlatched), impacts of stops with rebound, contacts
+    /// closed (plastic impacts), contacts released.
     pub locks: usize,
+    /// See [`Self::locks`].
+    pub unlatches: usize,
     /// See [`Self::locks`].
     pub impacts: usize,
     /// See [`Self::locks`].
     pub contacts_closed: usize,
     /// See [`Self::locks`].
     pub contacts_released: usize,
-    /// Energy dissipated by the impacts of these events (the sum of
-    /// `energy_lost` of `events.csv`, each impact counted once: latches
-    /// that lock in one step, and stops struck in one step, share one
-    /// impact and report its whole loss on each row).
+    /// Energy dissipated by the impacts of these events, and dropped by
+    /// the spring latches that released (the sum of `energy_lost` of
+    /// `events.csv`, each impact counted once: latches that lock in one
+    /// step, and stops struck in one step, share one impact and report its
+    /// whole loss on each row).
     pub impact_energy_lost: f64,
 }
 
@@ -171,6 +175,7 @@ impl DynamicRecord {
     /// energy seen over its steps.
     pub fn of(outcome: &DynamicOutcome, largest_error: f64, largest_kinetic: f64) -> Self {
         let count = |k| outcome.contacts.iter().filter(|c| c.kind == k).count();
+        let latch_events = |k| outcome.locks.iter().filter(|l| l.kind == k).count();
         Self {
             steps: outcome.steps,
             rejected_steps: outcome.rejected_steps,
@@ -181,7 +186,8 @@ impl DynamicRecord {
             energy_balance_error: outcome.energies.balance_error,
             largest_energy_balance_error: largest_error.max(outcome.energies.balance_error.abs()),
             largest_kinetic_energy: largest_kinetic.max(outcome.energies.kinetic),
-            locks: outcome.locks.len(),
+            locks: latch_events(LatchEventKind::Lock),
+            unlatches: latch_events(LatchEventKind::Unlatch),
             impacts: count(ContactKind::Impact),
             contacts_closed: count(ContactKind::Close),
             contacts_released: count(ContactKind::Release),

@@ -60,6 +60,7 @@ use crate::analysis::{
     StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
+use crate::joints::stop::Contact;
 use crate::model::{Id, Model};
 use crate::state::State;
 
@@ -277,6 +278,22 @@ pub fn dynamic_error_message(model: &Model, state: &State, error: &DynamicError)
     else {
         return error.to_string();
     };
+    // a rolling disc (docs/joints.md §3.8): equation 1 keeps the rim on
+    // the plane, equations 2 and 3 are the no-slip conditions along the
+    // plane's tangents t₁, t₂
+    if let Some(rest) = constraint.strip_prefix("rolling disc ") {
+        let equation = rest.rsplit(' ').next().unwrap_or("");
+        let id = rest.split(' ').next().unwrap_or("");
+        return match equation {
+            "2" | "3" => format!(
+                "the initial velocities violate rolling disc {id} equation {equation} (no slip along the plane's tangent t{}): its contact point slides at {rate:.3e} (tolerance {tolerance:.1e}); the disc must roll: give its centre the velocity ω × (centre − contact point), so that a centre speed v goes with a spin v/r about the axle (−v/r about the axle a for a disc rolling along n × a, n the plane's normal; docs/joints.md §3.8)",
+                if equation == "2" { 1 } else { 2 }
+            ),
+            _ => format!(
+                "the initial velocities violate rolling disc {id} equation {equation} (contact with the plane): its rim's lowest point moves along the plane's normal at {rate:.3e} (tolerance {tolerance:.1e}); give the centre a velocity in the plane, and the disc no tilting rate that raises or lowers its rim (docs/joints.md §3.8)"
+            ),
+        };
+    }
     let latch = model.elements.iter().find_map(|e| {
         let l = e.as_latch()?;
         (*constraint == format!("{} {} equation 1", e.kind().name(), e.id())).then_some((e.id(), l))
@@ -286,8 +303,11 @@ pub fn dynamic_error_message(model: &Model, state: &State, error: &DynamicError)
     };
     let c = latch.coordinate(state);
     let unit = if latch.is_angle() { " rad" } else { "" };
+    // the joint's own rate `ċ` (the constraint's rate `Φ̇` has the sign of
+    // its equation, not of the coordinate)
+    let joint_rate = latch.rate(state).0;
     format!(
-        "latch {id} is at its locking value at t = {} (joint {} at {}{unit}, the latch's value {}{unit}), so it is locked from the start, but the initial velocities move the joint: its rate is {rate:.3e} (tolerance {tolerance:.1e}); give the joint's nodes velocities that keep the coordinate still, or start the joint away from the latch's value",
+        "latch {id} is at its locking value at t = {} (joint {} at {}{unit}, the latch's value {}{unit}), so it is locked from the start, but the initial velocities move the joint: its rate is {joint_rate:.3e} (tolerance {tolerance:.1e}); give the joint's nodes velocities that keep the coordinate still, or start the joint away from the latch's value",
         format_time(state.time),
         latch.joint(),
         format_time(c),
@@ -308,6 +328,7 @@ fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
     };
     let parts: Vec<String> = [
         plural(sum(|d| d.locks), "lock", "locks"),
+        plural(sum(|d| d.unlatches), "unlatch", "unlatches"),
         plural(sum(|d| d.impacts), "impact", "impacts"),
         plural(
             sum(|d| d.contacts_closed),
@@ -327,8 +348,14 @@ fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
         return None;
     }
     let lost: f64 = records.iter().map(|d| d.impact_energy_lost).sum();
+    // a spring latch that releases drops the energy its spring held
+    let how = if sum(|d| d.unlatches) > 0 {
+        "in impacts and unlatches"
+    } else {
+        "in impacts"
+    };
     Some(format!(
-        "{}, energy lost in impacts {lost:.3e}",
+        "{}, energy lost {how} {lost:.3e}",
         parts.join(", ")
     ))
 }
@@ -460,6 +487,53 @@ pub struct Recorder {
     motion: Option<Continuation>,
     /// The latches of the model over the running analysis.
     latches: Vec<LatchWatch>,
+    /// The stops and contacts over the running analysis.
+    stops: Vec<StopWatch>,
+}
+
+/// What the recorder follows of a stop or contact over a dynamic
+/// analysis: whether it was struck, and the range of its coordinate (of
+/// its gap, for a contact), for the note on one never struck.
+struct StopWatch {
+    /// The stop's index among the model's elements.
+    element: usize,
+    id: Id,
+    /// The joint of a stop (`None` for a contact).
+    joint: Option<Id>,
+    /// Whether `c` is an angle.
+    angle: bool,
+    /// `(c_min, c_max)`.
+    limits: (f64, f64),
+    /// Closed when the analysis started, or by an event since.
+    struck: bool,
+    /// The range of `c` over the converged steps.
+    low: f64,
+    high: f64,
+}
+
+impl StopWatch {
+    /// The stops and contacts of `model` at `state`.
+    fn of(model: &Model, state: &State) -> Vec<Self> {
+        model
+            .elements
+            .iter()
+            .enumerate()
+            .filter_map(|(element, e)| {
+                let stop = e.as_stop()?;
+                let c = stop.coordinate(state);
+                Some(Self {
+                    element,
+                    id: e.id(),
+                    joint: stop.joint(),
+                    angle: stop.is_angle(),
+                    limits: stop.limits(),
+                    struck: stop.contact(state) != Contact::Open,
+                    low: c,
+                    high: c,
+                })
+            })
+            .collect()
+    }
 }
 
 /// What the recorder follows of a latch over an analysis, for the notes
@@ -710,6 +784,7 @@ impl Recorder {
             energies: None,
             motion: None,
             latches: Vec::new(),
+            stops: Vec::new(),
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -913,6 +988,60 @@ impl Recorder {
                 )
             })
             .collect();
+        for n in notes {
+            self.note_line(&n);
+        }
+        self.never_struck(end);
+    }
+
+    /// At the end of a dynamic analysis that reached its end: a note for
+    /// each stop or contact it never closed, with the range its coordinate
+    /// (or gap) covered: a limit on the wrong side or of the wrong sign
+    /// shows there.
+    fn never_struck(&mut self, end: &AnalysisEnd) {
+        if self.current.kind != "dynamic" || end.error.is_some() {
+            return;
+        }
+        let mut notes = Vec::new();
+        for w in self.stops.iter().filter(|w| !w.struck) {
+            let show = |c: f64| {
+                if w.angle {
+                    format!("{} rad ({:.2}°)", format_time(c), c.to_degrees())
+                } else {
+                    format_time(c)
+                }
+            };
+            notes.push(match w.joint {
+                Some(joint) => {
+                    let (lower, upper) = w.limits;
+                    let limit = |c: f64| {
+                        if c.is_finite() {
+                            show(c)
+                        } else if c > 0.0 {
+                            "∞".to_string()
+                        } else {
+                            "−∞".to_string()
+                        }
+                    };
+                    format!(
+                        "stop {} was never struck in the dynamic analysis to t = {}: joint {joint} stayed within [{}, {}], and the stop's limits are [{}, {}]",
+                        w.id,
+                        format_time(end.time),
+                        show(w.low),
+                        show(w.high),
+                        limit(lower),
+                        limit(upper)
+                    )
+                }
+                None => format!(
+                    "contact {} never closed in the dynamic analysis to t = {}: its gap stayed within [{}, {}]",
+                    w.id,
+                    format_time(end.time),
+                    format_time(w.low),
+                    format_time(w.high)
+                ),
+            });
+        }
         for n in notes {
             self.note_line(&n);
         }
@@ -1141,8 +1270,16 @@ impl Observer for Recorder {
                 self.latches = LatchWatch::of(model, &model.initial_state());
             }
             LatchWatch::start(&mut self.latches, model, state);
+            self.stops = StopWatch::of(model, state);
         }
         self.watch_latches(info, model, state);
+        for w in &mut self.stops {
+            if let Some(stop) = model.elements.get(w.element).and_then(|e| e.as_stop()) {
+                let c = stop.coordinate(state);
+                w.low = w.low.min(c);
+                w.high = w.high.max(c);
+            }
+        }
         // a later analysis starts at the final state of the one before,
         // written already: its equilibrium there is logged, not written
         let restart =
@@ -1261,6 +1398,9 @@ impl Observer for Recorder {
     }
 
     fn contact(&mut self, info: &ContactInfo) {
+        for w in self.stops.iter_mut().filter(|w| w.id == info.stop) {
+            w.struck = true;
+        }
         self.write_event(&EventRow {
             increment: info.increment + self.increment_offset,
             time: info.time,

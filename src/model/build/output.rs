@@ -36,7 +36,9 @@ pub(super) fn check(ck: &mut Checker, output: Option<&OutputInput>, end_time: f6
             ck.push(
                 ModelErrorKind::Invalid,
                 "output",
-                format!("plots: {name:?} is not a kind of chart; give \"joints\", \"moments\" or \"energies\""),
+                format!(
+                    "plots: {name:?} is not a kind of chart; give \"joints\", \"moments\", \"hinge_laws\" or \"energies\""
+                ),
             );
         }
     }

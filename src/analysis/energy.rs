@@ -21,6 +21,7 @@
 use crate::elements::inertia::Momenta;
 use crate::elements::{ElementKind, ElementOutput, Need};
 use crate::model::Model;
+use crate::so3;
 use crate::state::State;
 
 /// Energies at one state of a motion.
@@ -43,8 +44,13 @@ pub struct Energies {
     /// Energy dissipated by dampers and impacts (latches locking) since the
     /// start of the motion.
     pub dissipated: f64,
-    /// `(T + V) − (T₀ + V₀) − W + D`.
+    /// `(T + V) − (T₀ + V₀) − W − W_h + D`.
     pub balance_error: f64,
+    /// Work `W_h = −∫ M dc` done on the model by hinge laws since the start
+    /// of the motion (they have no potential; a hysteresis loop cycled
+    /// adds minus its area).
+    #[serde(default)]
+    pub hinge_law_work: f64,
 }
 
 impl Energies {
@@ -137,20 +143,55 @@ pub fn powers(model: &Model, state: &State, residual: Option<&[f64]>) -> (f64, f
 /// The energies along a motion, with the work and the dissipation
 /// integrated over its steps (see the module documentation). Give it every
 /// accepted state in order.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct EnergyBalance {
+    /// `α_f` of the generalised-α method (D1): the forces without
+    /// potential work at `t_{n+1−α_f}` (D12a).
+    alpha_f: f64,
     /// `T₀ + V₀`.
     initial: Option<f64>,
-    /// Time and powers at the last state.
-    last: Option<(f64, f64, f64)>,
+    /// Time and external power at the last state.
+    last: Option<(f64, f64)>,
     work: f64,
     dissipated: f64,
+    hinge_law_work: f64,
+    /// The last state, for the increments of the next step (D12a).
+    previous: Option<State>,
+    /// The forces without potential of every element at the last state
+    /// ([`Element::nonconservative_forces`](crate::elements::Element::nonconservative_forces)),
+    /// `n_local` each, in the order of the model's elements; and those of
+    /// the state being recorded.
+    forces: Vec<f64>,
+    current: Vec<f64>,
+}
+
+impl Default for EnergyBalance {
+    fn default() -> Self {
+        Self {
+            alpha_f: 0.5,
+            initial: None,
+            last: None,
+            work: 0.0,
+            dissipated: 0.0,
+            hinge_law_work: 0.0,
+            previous: None,
+            forces: Vec::new(),
+            current: Vec::new(),
+        }
+    }
 }
 
 impl EnergyBalance {
-    /// A balance that starts at the first state it is given.
+    /// A balance that starts at the first state it is given, for steps of
+    /// the trapezoidal rule (`α_f = ½`, `ρ∞ = 1`).
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// The same balance for steps of the generalised-α method with this
+    /// `α_f` (D1, D12a).
+    pub fn with_alpha_f(self, alpha_f: f64) -> Self {
+        Self { alpha_f, ..self }
     }
 
     /// Adds an impact at the current instant (a latch locking,
@@ -163,13 +204,17 @@ impl EnergyBalance {
 
     /// A balance that goes on from a state of a motion whose energies were
     /// `at` (the first state it is given): its work, dissipation and
-    /// `T₀ + V₀ = T + V − W + D − E` carry on.
+    /// `T₀ + V₀ = T + V − W − W_h + D − E` carry on.
     pub fn continuing(at: &Energies) -> Self {
         Self {
-            initial: Some(at.total() - at.external_work + at.dissipated - at.balance_error),
-            last: None,
+            initial: Some(
+                at.total() - at.external_work - at.hinge_law_work + at.dissipated
+                    - at.balance_error,
+            ),
             work: at.external_work,
             dissipated: at.dissipated,
+            hinge_law_work: at.hinge_law_work,
+            ..Self::default()
         }
     }
 
@@ -177,18 +222,96 @@ impl EnergyBalance {
     /// energies. `residual`: as in [`powers`].
     pub fn record(&mut self, model: &Model, state: &State, residual: Option<&[f64]>) -> Energies {
         let mut e = energies(model, state);
-        let (p_ext, p_d) = powers(model, state, residual);
-        if let Some((t, q_ext, q_d)) = self.last {
+        let (p_ext, _) = powers(model, state, residual);
+        if let Some((t, q_ext)) = self.last {
             // trapezoidal rule over the step
             let h = state.time - t;
             self.work += 0.5 * h * (p_ext + q_ext);
-            self.dissipated += 0.5 * h * (p_d + q_d);
         }
-        self.last = Some((state.time, p_ext, p_d));
+        self.last = Some((state.time, p_ext));
+        self.nonconservative_work(model, state);
         let initial = *self.initial.get_or_insert(e.total());
         e.external_work = self.work;
         e.dissipated = self.dissipated;
-        e.balance_error = e.total() - initial - self.work + self.dissipated;
+        e.hinge_law_work = self.hinge_law_work;
+        e.balance_error = e.total() - initial - self.work - self.hinge_law_work + self.dissipated;
         e
+    }
+
+    /// Closes the step that ended at `state` (the solution of the step,
+    /// before an impact or a projection at the same instant changes its
+    /// velocities): adds the work of the forces without potential over it
+    /// with the forces at `state`. The next [`EnergyBalance::record`], at
+    /// the same positions, then adds no work and keeps the forces at the
+    /// velocities after the impact for the next step.
+    pub fn close_step(&mut self, model: &Model, state: &State) {
+        self.nonconservative_work(model, state);
+    }
+
+    /// Adds the work of the forces without potential over the step from
+    /// the last state to `state` (D12a): `½ (f_n + f_{n+1})·δ` per element,
+    /// `δ` the increments of its unknowns over the step (`Δx` global,
+    /// `ΔΘ = log(R_nᵀ R_{n+1})` material, conjugate to the residual's
+    /// rows, and the coordinates' changes). Dampers' forces go to `D`,
+    /// hinge laws' to `W_h` (the work done on the model, `−∫M dc`).
+    fn nonconservative_work(&mut self, model: &Model, state: &State) {
+        let ctx = crate::elements::EvalContext {
+            dynamics: true,
+            ..model.context(state.time, Need::RESIDUAL)
+        };
+        let n: usize = model.elements.iter().map(|el| el.n_local()).sum();
+        self.current.clear();
+        self.current.resize(n, 0.0);
+        let mut start = 0;
+        for el in &model.elements {
+            let m = el.n_local();
+            el.nonconservative_forces(&ctx, state, &mut self.current[start..start + m]);
+            start += m;
+        }
+        if let Some(before) = &self.previous {
+            if self.forces.len() == n {
+                let (mut damped, mut hinge) = (0.0, 0.0);
+                let mut start = 0;
+                for (i, el) in model.elements.iter().enumerate() {
+                    let m = el.n_local();
+                    let (f0, f1) = (
+                        &self.forces[start..start + m],
+                        &self.current[start..start + m],
+                    );
+                    start += m;
+                    if f0.iter().chain(f1).all(|&f| f == 0.0) {
+                        continue;
+                    }
+                    // D12a: the forces at t_{n+1−α_f}
+                    let af = self.alpha_f;
+                    let mean = |k: usize| af * f0[k] + (1.0 - af) * f1[k];
+                    let mut w = 0.0;
+                    let nodes = el.nodes();
+                    for (k, &node) in nodes.iter().enumerate() {
+                        let dx = state.x[node] - before.x[node];
+                        let dtheta = so3::log(&(before.q[node].inverse() * state.q[node]));
+                        for c in 0..3 {
+                            w += mean(6 * k + c) * dx[c] + mean(6 * k + 3 + c) * dtheta[c];
+                        }
+                    }
+                    let o = model.offsets(i).coordinates;
+                    for c in 0..el.n_coordinates() {
+                        let dc = state.coordinates[o + c] - before.coordinates[o + c];
+                        w += mean(6 * nodes.len() + c) * dc;
+                    }
+                    match el.kind() {
+                        ElementKind::HingeLaw => hinge -= w,
+                        _ => damped += w,
+                    }
+                }
+                self.dissipated += damped;
+                self.hinge_law_work += hinge;
+            }
+        }
+        std::mem::swap(&mut self.forces, &mut self.current);
+        match &mut self.previous {
+            Some(p) => p.clone_from(state),
+            None => self.previous = Some(state.clone()),
+        }
     }
 }

@@ -140,6 +140,21 @@ pub fn powers(model: &Model, state: &State, residual: Option<&[f64]>) -> (f64, f
     (external, dissipated)
 }
 
+/// The power of the reactions at prescribed unknowns, `−Σ r_d v_d`.
+fn prescribed_power(model: &Model, state: &State, residual: &[f64]) -> f64 {
+    let mut external = 0.0;
+    for p in &model.prescribed {
+        let (node, comps) = match *p {
+            crate::model::Prescribed::Translation { node, axis, .. } => (node, axis..axis + 1),
+            crate::model::Prescribed::Rotation { node, .. } => (node, 3..6),
+        };
+        for c in comps {
+            external -= residual[6 * node + c] * state.velocity[node][c];
+        }
+    }
+    external
+}
+
 /// The energies along a motion, with the work and the dissipation
 /// integrated over its steps (see the module documentation). Give it every
 /// accepted state in order.
@@ -222,7 +237,7 @@ impl EnergyBalance {
     /// energies. `residual`: as in [`powers`].
     pub fn record(&mut self, model: &Model, state: &State, residual: Option<&[f64]>) -> Energies {
         let mut e = energies(model, state);
-        let (p_ext, _) = powers(model, state, residual);
+        let p_ext = residual.map_or(0.0, |r| prescribed_power(model, state, r));
         if let Some((t, q_ext)) = self.last {
             // trapezoidal rule over the step
             let h = state.time - t;
@@ -265,12 +280,19 @@ impl EnergyBalance {
         let mut start = 0;
         for el in &model.elements {
             let m = el.n_local();
-            el.nonconservative_forces(&ctx, state, &mut self.current[start..start + m]);
+            let f = &mut self.current[start..start + m];
+            if matches!(el.kind(), ElementKind::NodalLoad | ElementKind::Driver) {
+                // the load's or the driver's residual: the force on the
+                // model is −r
+                el.evaluate(&ctx, state, &mut ElementOutput::residual(f));
+            } else {
+                el.nonconservative_forces(&ctx, state, f);
+            }
             start += m;
         }
         if let Some(before) = &self.previous {
             if self.forces.len() == n {
-                let (mut damped, mut hinge) = (0.0, 0.0);
+                let (mut damped, mut hinge, mut external) = (0.0, 0.0, 0.0);
                 let mut start = 0;
                 for (i, el) in model.elements.iter().enumerate() {
                     let m = el.n_local();
@@ -301,11 +323,13 @@ impl EnergyBalance {
                     }
                     match el.kind() {
                         ElementKind::HingeLaw => hinge -= w,
+                        ElementKind::NodalLoad | ElementKind::Driver => external -= w,
                         _ => damped += w,
                     }
                 }
                 self.dissipated += damped;
                 self.hinge_law_work += hinge;
+                self.work += external;
             }
         }
         std::mem::swap(&mut self.forces, &mut self.current);

@@ -3,18 +3,21 @@
 //! At a state: the kinetic energy `T` (inertia of beams, rigid bodies and
 //! point masses, eqs. I1, I7), the strain energy of beams, the potential of
 //! the weight `−Σ m g·x_c`, the energy of springs and joint springs. Along a
-//! motion, [`EnergyBalance`] adds, by the trapezoidal rule over the steps,
-//! the work `W = ∫ P_ext dt` done on the model by nodal loads, drivers and
-//! prescribed motions (`P_ext = −Σ rₑ·vₑ` over those elements, and
-//! `−Σ r_d v_d` over prescribed dofs: the reactions' power) and the energy
-//! `D = ∫ P_d dt` taken out by dampers, and the balance error
+//! motion, [`EnergyBalance`] adds the work `W` done on the model by nodal
+//! loads, drivers and prescribed motions, the work `W_h = −∫ M dc` of hinge
+//! laws, the energy `D` taken out by dampers and impacts, and the balance
+//! error
 //!
 //! ```text
-//! E = (T + V) − (T₀ + V₀) − W + D,    V = V_strain + V_weight + V_spring,
+//! E = (T + V) − (T₀ + V₀) − W − W_h + D,    V = V_strain + V_weight + V_spring,
 //! ```
 //!
 //! zero for the exact motion; the numerical dissipation of `ρ∞ < 1` and
-//! the error of the trapezoidal rule show there. With a gravity that
+//! the error of the quadratures show there. Loads, drivers, dampers and
+//! hinge laws work over a step as the integrator's equations use them:
+//! their forces at `t_{n+1−α_f}` on the step's increments (D12a); the
+//! reactions at prescribed unknowns by the trapezoidal rule on their power
+//! `−Σ r_d v_d`. With a gravity that
 //! follows a curve, `V_weight` uses the gravity of the current time (a
 //! constant gravity is the conservative case).
 
@@ -95,7 +98,8 @@ pub fn momenta(model: &Model, state: &State) -> Momenta {
 }
 
 /// The power of the loads, drivers and prescribed motions on the model, and
-/// that of its dampers, at `state` (see the module documentation).
+/// that of its dampers, at `state` (the balance integrates the work of
+/// loads, drivers and dampers by D12a, not from these powers).
 /// `residual` is the assembled residual at every dof (reactions at fixed
 /// dofs), if known.
 pub fn powers(model: &Model, state: &State, residual: Option<&[f64]>) -> (f64, f64) {
@@ -127,15 +131,7 @@ pub fn powers(model: &Model, state: &State, residual: Option<&[f64]>) -> (f64, f
         }
     }
     if let Some(residual) = residual {
-        for p in &model.prescribed {
-            let (node, comps) = match *p {
-                crate::model::Prescribed::Translation { node, axis, .. } => (node, axis..axis + 1),
-                crate::model::Prescribed::Rotation { node, .. } => (node, 3..6),
-            };
-            for c in comps {
-                external -= residual[6 * node + c] * state.velocity[node][c];
-            }
-        }
+        external += prescribed_power(model, state, residual);
     }
     (external, dissipated)
 }

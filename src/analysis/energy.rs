@@ -300,8 +300,12 @@ impl EnergyBalance {
                     if f0.iter().chain(f1).all(|&f| f == 0.0) {
                         continue;
                     }
-                    // D12a: the forces at t_{n+1−α_f}
-                    let af = self.alpha_f;
+                    // D12a: the forces at t_{n+1−α_f}; loads and drivers,
+                    // which the integrator does not damp, at mid-step (D12b)
+                    let af = match el.kind() {
+                        ElementKind::NodalLoad | ElementKind::Driver => 0.5,
+                        _ => self.alpha_f,
+                    };
                     let mean = |k: usize| af * f0[k] + (1.0 - af) * f1[k];
                     let mut w = 0.0;
                     let nodes = el.nodes();

@@ -208,7 +208,7 @@ pub fn run(
             .map(|t| t.map_or("open".into(), |t| format!("{t:.4}")))
             .collect();
         say(format!(
-            "deployment, {gravity} g: {} unknowns, {} steps ({} rejected, {} retried to land on a lock), {} iterations ({:.2} per step, {} more in rejected steps), {:.2} s; locks at t = [{}] s; at t = {:.3} s the nodes are within {:.2e} m of the nominal deployed geometry (vibrating), the equilibrium of the locked structure within {:.2e} m ({} iterations); impacts dissipated {:.3e} J; largest latch moment {:.2} N·m; energy balance error {:.2e} J",
+            "deployment, {gravity} g: {} unknowns, {} steps ({} rejected, {} retried to land on a lock), {} iterations ({:.2} per step, {} more in rejected steps), {:.2} s; locks at t = [{}] s; at t = {:.3} s the nodes are within {:.2e} m of the nominal deployed geometry (vibrating), the equilibrium of the locked structure within {:.2e} m ({} iterations); impacts dissipated {:.3e} J; largest latch moment {:.2} N·m; work of the tape springs {:.4} J; energy balance error {:.2e} J",
             f.unknowns,
             f.steps,
             f.rejected,
@@ -224,6 +224,7 @@ pub fn run(
             f.equilibrium_iterations,
             f.impact_loss,
             f.peak_latch_moment,
+            f.hinge_law_work,
             f.balance_error,
         ));
         let completed = run.outcome.error.is_none();

@@ -620,7 +620,8 @@ impl DynamicAnalysis {
                 .as_ref()
                 .map_or_else(EnergyBalance::new, |c| {
                     EnergyBalance::continuing(&c.energies)
-                }),
+                })
+                .with_alpha_f(self.scheme.alpha_f),
             energies: Energies::default(),
             mass_scale: [0.0; 2],
             mass_system: MassSystem::default(),
@@ -2550,6 +2551,10 @@ impl Stepper for Dynamics<'_> {
         run.a_before_coordinates
             .clone_from(&run.accepted.coordinate_pseudo_accelerations);
         model.update_internal(&mut run.state);
+        // the work of dampers and hinge laws over the step, with their
+        // forces at the step's solution, before an impact changes the
+        // velocities (docs/theory.md D12a)
+        run.balance.close_step(model, &run.state);
         // latches reached lock: impact, then a restart (docs/theory.md §16)
         let locks = match impact::lock_latches(
             model,
@@ -2702,6 +2707,7 @@ impl Watch {
             (e.gravity - self.start.gravity).abs(),
             e.external_work.abs(),
             e.dissipated.abs(),
+            e.hinge_law_work.abs(),
         ]
         .into_iter()
         .fold(0.0, f64::max)

@@ -665,6 +665,21 @@ impl Element for Beam {
         v.dot(&(self.damping_matrix(&b, &q) * v))
     }
 
+    /// The Rayleigh damping force `C_R v` (I10), in dynamics.
+    fn nonconservative_forces(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
+        if self.section.damping.is_none() || !ctx.dynamics {
+            return;
+        }
+        let k = self.current(ctx, state);
+        let ops = Operators::new(&k.phi);
+        let q = self.offset_matrices();
+        let b = self.strain_matrix(&k, &ops);
+        let f = self.damping_matrix(&b, &q) * self.velocities(state);
+        for (o, f) in out.iter_mut().zip(f.iter()) {
+            *o += f;
+        }
+    }
+
     fn kinetic_energy(&self, state: &State) -> f64 {
         if !self.has_inertia {
             return 0.0;

@@ -384,6 +384,14 @@ pub trait Element: Send + Sync {
         0.0
     }
 
+    /// The element's forces that have no potential and are not inertia
+    /// forces, in dynamics: the dampers' forces (`Element::dissipated_power`
+    /// is their power) and the moment of a hinge law. Added to `out`
+    /// (length [`Element::n_local`]) as the residual carries them, so that
+    /// their work over a step of increments `δ` is `½ (f_n + f_{n+1})·δ`
+    /// (docs/theory.md D12a). None by default.
+    fn nonconservative_forces(&self, _ctx: &EvalContext, _state: &State, _out: &mut [f64]) {}
+
     /// Points of the element carried by its nodes (joint points), for
     /// drawing: each is drawn joined to its node, so that a rigid link is
     /// seen from its node to its joints. Appended to `out`.
@@ -427,6 +435,33 @@ pub(crate) fn add_scaled<const N: usize>(
         for (b, &v) in buf[base..base + N].iter_mut().zip(column) {
             *b += w * v;
         }
+    }
+}
+
+/// Adds to `out` the share of `element`'s residual that only dynamic
+/// evaluations carry: for an element without inertia whose dampers act in
+/// dynamics only (springs, joint springs, latches), the dampers' forces.
+pub(crate) fn damper_share(
+    element: &dyn Element,
+    ctx: &EvalContext,
+    state: &State,
+    out: &mut [f64],
+) {
+    let n = element.n_local();
+    let mut r = vec![0.0; 2 * n];
+    let (dynamic, quasi_static) = r.split_at_mut(n);
+    let ctx = EvalContext {
+        dynamics: true,
+        ..ctx.with_need(Need::RESIDUAL)
+    };
+    element.evaluate(&ctx, state, &mut ElementOutput::residual(dynamic));
+    let ctx = EvalContext {
+        dynamics: false,
+        ..ctx
+    };
+    element.evaluate(&ctx, state, &mut ElementOutput::residual(quasi_static));
+    for ((o, d), s) in out.iter_mut().zip(dynamic.iter()).zip(quasi_static.iter()) {
+        *o += d - s;
     }
 }
 

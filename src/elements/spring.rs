@@ -22,7 +22,9 @@
 //! the damping matrix, its derivative in `q` at fixed velocities enters the
 //! stiffness.
 
-use super::{add_block, add_vec, CellShape, Element, ElementKind, ElementOutput, EvalContext};
+use super::{
+    add_block, add_vec, damper_share, CellShape, Element, ElementKind, ElementOutput, EvalContext,
+};
 use crate::model::Id;
 use crate::so3::{self, Mat3, Operator, Rotation, SkewSeries, Vec3};
 use crate::state::State;
@@ -392,6 +394,15 @@ impl Element for Spring {
         }
         let (rate, f) = self.damper_rate_and_force(state);
         f.dot(&rate)
+    }
+
+    /// The damper's forces (S4): the residual in dynamics less the
+    /// residual in statics, where the damper is the only difference.
+    fn nonconservative_forces(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
+        if !(ctx.dynamics && self.has_damper()) {
+            return;
+        }
+        damper_share(self, ctx, state, out);
     }
 
     fn cell_shape(&self) -> CellShape {

@@ -1185,7 +1185,13 @@ impl Histories {
             ("spring", "springs"),
             ("external_work", "external work W"),
             ("dissipated", "dissipated D"),
+            ("hinge_law_work", "hinge-law work W_h"),
         ];
+        // the hinge-law work is absent from the files of earlier versions
+        let columns: Vec<_> = columns
+            .into_iter()
+            .filter(|c| c.0 != "hinge_law_work" || t.find(c.0).is_some())
+            .collect();
         let names: Vec<&str> = columns.iter().map(|c| c.0).collect();
         let time = t.column("time")?;
         let cols: Vec<usize> = names
@@ -1227,7 +1233,7 @@ impl Histories {
         }];
         if has_values(&error) {
             let chart = Chart::new(
-                "Energy balance error E = (T + V) − (T₀ + V₀) − W + D",
+                "Energy balance error E = (T + V) − (T₀ + V₀) − W − W_h + D",
                 x,
                 Axis::new("E", energy),
             )

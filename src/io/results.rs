@@ -941,7 +941,7 @@ impl ResultWriter {
                         )?,
                         energies: CsvFile::create(
                             dir.join("energies.csv"),
-                            "step,time,kinetic,strain,gravity,spring,external_work,dissipated,balance_error",
+                            "step,time,kinetic,strain,gravity,spring,external_work,dissipated,balance_error,hinge_law_work",
                         )?,
                         events: CsvFile::create(dir.join("events.csv"), EVENTS_HEADER)?,
                     })
@@ -1119,14 +1119,15 @@ impl ResultWriter {
                 (true, Some(e)) => {
                     let _ = writeln!(
                         m.energies.pending,
-                        "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e}",
+                        "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{:.12e}",
                         e.kinetic,
                         e.strain,
                         e.gravity,
                         e.spring,
                         e.external_work,
                         e.dissipated,
-                        e.balance_error
+                        e.balance_error,
+                        e.hinge_law_work
                     );
                 }
                 _ => {
@@ -1135,7 +1136,7 @@ impl ResultWriter {
                     let e = crate::analysis::energy::energies(model, state);
                     let _ = writeln!(
                         m.energies.pending,
-                        "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},,,",
+                        "{step},{t:.12e},{:.12e},{:.12e},{:.12e},{:.12e},,,,",
                         0.0, e.strain, e.gravity, e.spring
                     );
                 }

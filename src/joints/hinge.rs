@@ -428,6 +428,12 @@ impl Element for HingeLaw {
         };
         out[..3].copy_from_slice(&[c, r.moment, branch]);
     }
+    /// The law's moment, `M g`: the whole of its residual (a hinge law
+    /// has no potential).
+    fn nonconservative_forces(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
+        let ctx = ctx.with_need(crate::elements::Need::RESIDUAL);
+        self.evaluate(&ctx, state, &mut ElementOutput::residual(out));
+    }
     fn cell_shape(&self) -> CellShape {
         CellShape::None
     }

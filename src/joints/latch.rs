@@ -552,6 +552,15 @@ impl Element for Latch {
             _ => 0.0,
         }
     }
+    /// The force `d ċ g` of the dashpot of a latched spring latch.
+    fn nonconservative_forces(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
+        match &self.spring {
+            Some(s) if ctx.dynamics && self.is_locked(state) && s.damping > 0.0 => {
+                crate::elements::damper_share(self, ctx, state, out)
+            }
+            _ => {}
+        }
+    }
     fn cell_shape(&self) -> CellShape {
         CellShape::None
     }

@@ -236,6 +236,12 @@ impl Element for JointSpring {
         let (_, rate, _, fd) = self.forces(state);
         fd * rate
     }
+    /// The damper's force `f_d(ċ) g`.
+    fn nonconservative_forces(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
+        if ctx.dynamics && self.damper.is_some() {
+            crate::elements::damper_share(self, ctx, state, out);
+        }
+    }
     fn cell_shape(&self) -> CellShape {
         CellShape::None
     }

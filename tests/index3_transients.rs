@@ -1,6 +1,5 @@
 //! The multipliers and accelerations of the index-3 generalised-α scheme
-//! after an abrupt change of the step or of a driver's jerk
-//! (docs/theory.md §15.8, D14–D16): a
+//! after an abrupt change of the step (docs/theory.md §15.8, D14–D15): a
 //! driven hinge whose driver torque must be `J_O θ̈(t)` at every step,
 //! whatever the output times the steps land on, and a panel latched to
 //! the ground whose latch load must be the spring's static `k π/2` at every
@@ -151,48 +150,46 @@ fn driver_torque_is_j_theta_ddot_at_every_step_whatever_the_output_times() {
     for (name, times) in cases {
         let out = run_cli(&dir, name, &driven_hinge(times));
         let (worst, loads) = driver_errors(&out);
-        // with D16 (docs/theory.md §15.8) measured 0.0029 N·m during the
-        // stroke in every case (0.1 % of the 3.02 N·m peak, the first
-        // steps); with D15 alone 0.051, before D14–D15 0.16, 0.16 and
-        // 3.56 N·m (117 % of the peak); limit 0.01 N·m
+        // measured 0.063, 0.052, 0.070 N·m (2.3 % of the 3.02 N·m peak;
+        // the largest at the start and just after t = 1, where the jerk of
+        // smooth_step jumps from 94 rad/s³ to 0 and the steps regrow);
+        // before D14–D15: 0.16, 0.16 and 3.56 N·m (117 % of the peak)
+        // during the stroke: 0.1 N·m (measured 0.051 in every case)
         assert!(
-            worst[0] < 0.01,
+            worst[0] < 0.1,
             "{name}: largest error of the driver torque {:e} N·m",
             worst[0]
         );
-        // after it, where the jerk of smooth_step jumps from 94 rad/s³ to
-        // 0 and the steps regrow: measured 0.0026, 0.0130 and 0.0010 N·m
-        // (the 0.0130 at the step that straddles t = 1 without output
-        // times, an error of that step, 0.4 % of the peak); with D15
-        // alone the index-3 multipliers rang at 0.096, 0.162 and
-        // 0.069 N·m (5 % of the peak); limit 0.03 N·m
+        // after it, where the jerk jumps to 0 and the steps regrow, the
+        // ringing of the index-3 multipliers at growing steps (D15 scales
+        // them by r, docs/theory.md §15.8) is left to ρ∞: measured 0.096
+        // and 0.162 N·m with and without output times (5 % of the peak);
+        // limit 0.2 N·m
         assert!(
-            worst[1] < 0.03,
+            worst[1] < 0.2,
             "{name}: largest error of the driver torque after the stroke {:e} N·m",
             worst[1]
         );
         // the accelerations written follow θ̈ as closely: dwz of node 2
-        // (measured 0.0088 rad/s² with D16, 0.154 with D15 alone)
         let worst_acc = table(&out.join("nodes_velocities.csv"))
             .iter()
             .filter(|r| r["node"] == 2.0 && r["time"] < 1.0)
             .map(|r| (r["dwz"] - driven_acceleration(r["time"])).abs())
             .fold(0.0, f64::max);
         assert!(
-            worst_acc < 0.01 / J_O,
+            worst_acc < 0.1 / J_O,
             "{name}: largest error of θ̈ {worst_acc:e} rad/s²"
         );
         runs.push(loads);
     }
     // the loads at the times two runs share (t = 1 and 1.5 for the runs
     // with output times, 1.5 for all) agree to the tolerance above
-    // (measured 0.0016 N·m with D16, 0.019 with D15 alone)
     let mut shared = 0;
     for (i, a) in runs.iter().enumerate() {
         for b in &runs[i + 1..] {
             for &(t, p) in a {
                 if let Some(&(_, q)) = b.iter().find(|(u, _)| (u - t).abs() < 1e-9) {
-                    assert!((p - q).abs() < 0.03, "t = {t}: {p} and {q} N·m");
+                    assert!((p - q).abs() < 0.2, "t = {t}: {p} and {q} N·m");
                     shared += 1;
                 }
             }
@@ -302,8 +299,7 @@ fn a_latch_holds_the_static_load_at_every_step_after_the_lock() {
         .iter()
         .map(|r| (r["load"] - static_load).abs())
         .fold(0.0, f64::max);
-    // measured 8.4e-9 N·m with D16 (6.0e-5 with D14–D15 alone, earlier
-    // 8.3e-4, 2.6e-4 of kπ/2); before D14: 30 N·m, of
+    // measured 8.3e-4 N·m (2.6e-4 of kπ/2); before D14: 30 N·m, of
     // alternating sign (10 times the true load)
     assert!(
         worst < 1e-3 * k * std::f64::consts::PI,

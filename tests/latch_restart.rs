@@ -3,9 +3,13 @@
 //! (its spring engaged on either side, or within its dead band) or after
 //! it released goes on as the run that was never stopped, to round-off.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use common::spring_latch;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("unfold-lrs-{}-{name}", std::process::id()));
@@ -30,44 +34,13 @@ fn run(model: &Path, out: &Path, extra: &[&str]) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
-/// A panel (a body of 1 kg, J = 1/3 kg·m² about its hinge) on a hinge
-/// about z, in fixed steps of 5e-4 s, with `extra` entries.
+/// The panel of tests/common/spring_latch.rs (a body of 1 kg, J = 1/3
+/// kg·m² about its hinge) on a hinge about z, in fixed steps of 5e-4 s,
+/// with `extra` entries.
 fn panel(analysis: &str, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
-type = "dynamic"
-{analysis}
-time_step = 0.0005
-adaptive = false
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 1.0
-inertia = [0.08333333333333333, 0.08333333333333333, 0.08333333333333333]
-
-[[joints]]
-id = 10
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-{extra}
-"#
+    spring_latch::panel(
+        &format!("{analysis}\ntime_step = 0.0005\nadaptive = false"),
+        extra,
     )
 }
 

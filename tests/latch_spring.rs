@@ -9,16 +9,16 @@
 //! its centre at (0.5, 0, 0), hinged about z at the origin to a fixed
 //! node, so that its inertia about the hinge is `J = J_c + m/4 = 1/3` and
 //! its equation of motion, with the hinge angle `θ`, is linear:
-//! `J θ̈ = M(θ, t)`.
+//! `J θ̈ = M(θ, t)` (tests/common/spring_latch.rs).
+
+mod common;
 
 use std::path::PathBuf;
 use std::process::Command;
-use std::sync::Arc;
 
-use unfold::analysis::{
-    AnalysisSettings, DynamicAnalysis, DynamicOutcome, IncrementInfo, LatchEventKind, LockInfo,
-    Observer,
-};
+use common::events::run;
+use common::spring_latch::panel;
+use unfold::analysis::LatchEventKind;
 use unfold::elements::{ElementKind, Need};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
@@ -26,80 +26,6 @@ use unfold::state::State;
 
 /// The panel's inertia about the hinge.
 const J: f64 = 1.0 / 12.0 + 0.25;
-
-/// The model: the panel, `analysis` lines in `[analysis]` (a dynamic
-/// analysis), and `extra` entries.
-fn panel(analysis: &str, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
-type = "dynamic"
-{analysis}
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 1.0
-inertia = [0.08333333333333333, 0.08333333333333333, 0.08333333333333333]
-
-[[joints]]
-id = 10
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-{extra}
-"#
-    )
-}
-
-/// Every accepted state and every latch event.
-#[derive(Default)]
-struct Record {
-    steps: Vec<(IncrementInfo, State)>,
-    events: Vec<LockInfo>,
-}
-
-impl Observer for Record {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.steps.push((info.clone(), state.clone()));
-        Ok(())
-    }
-    fn lock(&mut self, info: &LockInfo) {
-        self.events.push(info.clone());
-    }
-}
-
-fn run(text: &str) -> (Arc<Model>, DynamicOutcome, Record) {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    let model = Arc::new(Model::from_input(&input).expect("valid model"));
-    let analyses: Vec<AnalysisSettings> = input.analyses().expect("valid analyses");
-    let settings = analyses[0].as_dynamic().unwrap().clone();
-    let mut a = DynamicAnalysis::new(model.clone(), settings);
-    let mut record = Record::default();
-    let out = a.run(model.initial_state(), &mut record);
-    assert!(out.error.is_none(), "{:?}", out.error);
-    (model, out, record)
-}
 
 /// The hinge angle: the panel's rotation about z (node 1 is fixed).
 fn angle(state: &State) -> f64 {
@@ -196,8 +122,8 @@ stiffness = {K_LATCH}
         ),
     );
     let (model, out, rec) = run(&text);
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let lock = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let lock = &rec.locks[0];
     assert_eq!(lock.kind, LatchEventKind::Lock);
     // the step lands on θ_L within the event tolerance, 1e-8 rad
     assert!((lock.coordinate - THETA_L).abs() <= 1e-8, "{lock:?}");
@@ -333,8 +259,8 @@ backlash = {BACKLASH}
         ),
     );
     let (model, out, rec) = run(&text);
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let lock = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let lock = &rec.locks[0];
     // the lock at θ_L/ω₀: the step landed on θ_L within 1e-8 rad; the
     // time within 1e-5 s, the integration error of the rotation about the
     // hinge (2.8e-6 rad measured) over ω₀
@@ -558,8 +484,8 @@ side = "behind"
         ),
     );
     let (model, _, rec) = run(&text);
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let lock = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let lock = &rec.locks[0];
     assert!((lock.coordinate - THETA_R).abs() <= 1e-8, "{lock:?}");
     let (i, s) = rec.steps.last().unwrap();
     // on at ω₀: θ = ω₀ t within 1e-6 rad, the rate within 1e-6
@@ -632,8 +558,8 @@ unlatch_load = {UNLATCH}
     }
     let t_u = 0.5 * (lo + hi);
     let load_rate = K_HOLD * held(t_u).1;
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let release = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let release = &rec.locks[0];
     assert_eq!(release.kind, LatchEventKind::Unlatch);
     // the angle while latched against the closed form: its error, δθ,
     // bounds the error of the load, k δθ
@@ -732,8 +658,8 @@ damping = {d}
         ),
     );
     let (model, out, rec) = run(&text);
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let lock = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let lock = &rec.locks[0];
     let (t_l, v) = (lock.time, lock.rate_before);
     let omega_d = omega * (1.0 - zeta * zeta).sqrt();
     let amplitude = v / omega_d;

@@ -7,14 +7,11 @@
 
 mod common;
 
-use std::sync::Arc;
-
+use common::events::{parse, run, Record};
 use common::quadrature::gauss_legendre;
 
 use unfold::analysis::energy::momenta;
-use unfold::analysis::{
-    AnalysisSettings, DynamicAnalysis, DynamicOutcome, IncrementInfo, LockInfo, Observer,
-};
+use unfold::analysis::DynamicAnalysis;
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::state::State;
@@ -181,45 +178,6 @@ impl Reduced {
         }
         0.5 * (lo + hi)
     }
-}
-
-/// Every accepted state and every lock.
-#[derive(Default)]
-struct Record {
-    steps: Vec<(IncrementInfo, State)>,
-    locks: Vec<LockInfo>,
-}
-
-impl Observer for Record {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.steps.push((info.clone(), state.clone()));
-        Ok(())
-    }
-    fn lock(&mut self, info: &LockInfo) {
-        self.locks.push(info.clone());
-    }
-}
-
-fn parse(text: &str) -> (Arc<Model>, Vec<AnalysisSettings>) {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    let model = Model::from_input(&input).expect("valid model");
-    (Arc::new(model), input.analyses().expect("valid analyses"))
-}
-
-fn run(text: &str) -> (Arc<Model>, DynamicOutcome, Record) {
-    let (model, analyses) = parse(text);
-    let settings = analyses[0].as_dynamic().unwrap().clone();
-    let mut a = DynamicAnalysis::new(model.clone(), settings);
-    let mut record = Record::default();
-    let out = a.run(model.initial_state(), &mut record);
-    assert!(out.error.is_none(), "{:?}", out.error);
-    (model, out, record)
 }
 
 /// θ: B's rotation relative to A about z, from the nodes' orientations

@@ -5,6 +5,7 @@ pub mod elliptic;
 pub mod events;
 pub mod quadrature;
 pub mod rigid_body;
+pub mod spring_latch;
 
 use std::sync::Arc;
 

@@ -9,6 +9,7 @@
 mod common;
 
 use common::events::{run, Record};
+use common::pendulum;
 use unfold::analysis::{ContactInfo, ContactKind};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
@@ -258,51 +259,15 @@ fn an_elastic_ball_shuttles_between_two_stops() {
 /// round-off.
 #[test]
 fn a_hinged_bar_rebounds_from_a_stop() {
-    let (m, d, j, e) = (MASS, 0.5, 0.1, 0.6);
-    let text = format!(
+    let (m, d, j, e) = (pendulum::MASS, pendulum::DISTANCE, pendulum::INERTIA, 0.6);
+    let text = pendulum::onto_a_stop(
         r#"
 [analysis]
 type = "dynamic"
 end_time = 0.8
 time_step = 0.005
-error_tolerance = 1e-6
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [{d}, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = {m}
-inertia = [{j}, {j}, {j}]
-
-[[joints]]
-id = 7
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[[stops]]
-id = 8
-joint = 7
-lower = -60.0
-unit = "deg"
-restitution = {e}
-
-[gravity]
-acceleration = [0.0, -{G}, 0.0]
-curve = "constant"
-"#
+error_tolerance = 1e-6"#,
+        e,
     );
     let (_, out, rec) = run(&text);
     let io = j + m * d * d;

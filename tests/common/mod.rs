@@ -3,6 +3,8 @@
 
 pub mod elliptic;
 pub mod events;
+pub mod hinged_panel;
+pub mod pendulum;
 pub mod quadrature;
 pub mod rigid_body;
 pub mod spring_latch;

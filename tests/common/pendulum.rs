@@ -1,0 +1,77 @@
+//! The rigid pendulum (tests/dynamics.rs, tests/iteration_matrix.rs,
+//! tests/cli_dynamics.rs, tests/cli_events.rs, tests/stops.rs): a body of
+//! mass `MASS` (id 1 on node 2) with inertia `INERTIA` about its centre
+//! on every axis, its centre at `(DISTANCE, 0, 0)`, on a revolute joint
+//! about z at the origin to node 1, which is fixed; released at rest from
+//! the horizontal under gravity `G` along −y. Its inertia about the hinge
+//! is `I_O = INERTIA + MASS · DISTANCE² = 0.6 kg·m²`.
+
+/// Mass of the body (kg).
+pub const MASS: f64 = 2.0;
+/// Distance of its centre from the hinge (m).
+pub const DISTANCE: f64 = 0.5;
+/// Inertia about its centre (kg·m²).
+pub const INERTIA: f64 = 0.1;
+/// Acceleration of gravity (m/s²).
+pub const G: f64 = 9.81;
+
+/// The pendulum's model text: `head` (a title and the analysis tables),
+/// the pendulum with its hinge of id `joint`, gravity following the curve
+/// `gravity_curve` (its default, `ramp` in a dynamic analysis, where
+/// `None`), then the tables `extra`.
+pub fn pendulum(head: &str, joint: u64, gravity_curve: Option<&str>, extra: &str) -> String {
+    let curve = gravity_curve.map_or(String::new(), |c| format!("curve = \"{c}\"\n"));
+    format!(
+        r#"{head}
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 2
+x = [{DISTANCE:?}, 0.0, 0.0]
+
+[[supports]]
+node = 1
+fixed = ["all"]
+
+[[rigid_bodies]]
+id = 1
+node = 2
+mass = {MASS:?}
+inertia = [{INERTIA:?}, {INERTIA:?}, {INERTIA:?}]
+
+[[joints]]
+id = {joint}
+type = "revolute"
+nodes = [1, 2]
+axis = [0.0, 0.0, 1.0]
+position = [0.0, 0.0, 0.0]
+
+[gravity]
+acceleration = [0.0, -{G:?}, 0.0]
+{curve}{extra}
+"#
+    )
+}
+
+/// The pendulum falling from the horizontal under constant gravity onto
+/// a stop (id 8) of its hinge (id 7) at −60° with restitution
+/// `restitution`; `head` a title and the analysis tables.
+pub fn onto_a_stop(head: &str, restitution: f64) -> String {
+    pendulum(
+        head,
+        7,
+        Some("constant"),
+        &format!(
+            r#"
+[[stops]]
+id = 8
+joint = 7
+lower = -60.0
+unit = "deg"
+restitution = {restitution:?}"#
+        ),
+    )
+}

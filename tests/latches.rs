@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::events::{parse, run, Record};
+use common::events::{error_of, parse, run, Record};
 use common::quadrature::gauss_legendre;
 
 use unfold::analysis::energy::momenta;
@@ -397,15 +397,6 @@ fn without_the_latch_the_panels_swing_past_the_locking_angle() {
         .map(|(_, s)| angle(s))
         .fold(f64::MIN, f64::max);
     assert!(largest > THETA_L + 0.1, "{largest}");
-}
-
-/// The message of a model that must not build.
-fn error_of(text: &str) -> String {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    match Model::from_input(&input) {
-        Ok(_) => panic!("the model was accepted"),
-        Err(e) => e.to_string(),
-    }
 }
 
 #[test]

@@ -8,28 +8,24 @@
 
 mod common;
 
-use common::events::{run, Record};
+use common::events::{error_of, run, Record};
 use common::pendulum;
 use unfold::analysis::{ContactInfo, ContactKind};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::state::State;
 
-const G: f64 = 9.81;
-const MASS: f64 = 2.0;
+const G: f64 = common::ball::G;
+const MASS: f64 = common::ball::MASS;
 
 /// A point mass on node 1 at the origin, on a prismatic joint to the
-/// ground along z (its `slide` is the height), under gravity −z, with
-/// the stop `stop` and the tables `extra`.
+/// ground along z (its `slide` is the height), under gravity −z
+/// (tests/common/ball.rs), with the stop `stop` and the tables `extra`.
 fn ball(end_time: f64, stop: &str, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
-type = "dynamic"
-end_time = {end_time}
-time_step = 0.01
-
-[[nodes]]
+    common::ball::dropped(
+        end_time,
+        &format!(
+            r#"[[nodes]]
 id = 1
 x = [0.0, 0.0, 0.0]
 
@@ -48,13 +44,9 @@ position = [0.0, 0.0, 0.0]
 [[stops]]
 id = 20
 joint = 10
-{stop}
-
-[gravity]
-acceleration = [0.0, 0.0, -{G}]
-curve = "constant"
-{extra}
-"#
+{stop}"#
+        ),
+        extra,
     )
 }
 
@@ -356,14 +348,6 @@ fn a_contact_is_released_when_its_load_vanishes() {
     let z = G * 0.2f64.powi(3) / 3.0;
     eprintln!("z(0.7) = {} (closed form {z})", s.x[0].z);
     assert!((s.x[0].z - z).abs() <= 1e-3 * z, "{} {z}", s.x[0].z);
-}
-
-fn error_of(text: &str) -> String {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    match Model::from_input(&input) {
-        Ok(_) => panic!("accepted"),
-        Err(e) => e.to_string(),
-    }
 }
 
 /// Input errors name the stop and say what is wrong; `unfold check`

@@ -58,3 +58,12 @@ pub fn run(text: &str) -> (Arc<Model>, DynamicOutcome, Record) {
     assert!(out.error.is_none(), "{:?}", out.error);
     (model, out, record)
 }
+
+/// The message of a model file's text that must not build.
+pub fn error_of(text: &str) -> String {
+    let input: ModelInput = toml::from_str(text).expect("valid toml");
+    match Model::from_input(&input) {
+        Ok(_) => panic!("the model was accepted"),
+        Err(e) => e.to_string(),
+    }
+}

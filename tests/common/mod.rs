@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod ball;
 pub mod elliptic;
 pub mod events;
 pub mod hinged_panel;

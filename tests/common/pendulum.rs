@@ -1,10 +1,18 @@
-//! The rigid pendulum (tests/dynamics.rs, tests/iteration_matrix.rs,
+//! Rigid pendulums on a revolute joint about z at the origin to node 1,
+//! which is fixed, swinging under gravity along −y.
+//!
+//! The pendulum (tests/dynamics.rs, tests/iteration_matrix.rs,
 //! tests/cli_dynamics.rs, tests/cli_events.rs, tests/stops.rs): a body of
-//! mass `MASS` (id 1 on node 2) with inertia `INERTIA` about its centre
-//! on every axis, its centre at `(DISTANCE, 0, 0)`, on a revolute joint
-//! about z at the origin to node 1, which is fixed; released at rest from
-//! the horizontal under gravity `G` along −y. Its inertia about the hinge
-//! is `I_O = INERTIA + MASS · DISTANCE² = 0.6 kg·m²`.
+//! mass `MASS` (id 1 on node 2) with inertia `INERTIA` about its centre on
+//! every axis, its centre at `(DISTANCE, 0, 0)`, released at rest from the
+//! horizontal under gravity `G`. Its inertia about the hinge is
+//! `I_O = INERTIA + MASS · DISTANCE² = 0.6 kg·m²`.
+//!
+//! The hanging pendulum (tests/output_interval.rs,
+//! tests/cli_start_checks.rs, tests/spurious_steps.rs): a body of 2 kg
+//! (id 1 on node 2) with inertia 0.01 kg·m² about its centre on every
+//! axis, its centre at (0, −0.5, 0) below the hinge (id 3), under gravity
+//! 9.81 m/s²: `J_O = 0.01 + 2 · 0.5² = 0.51 kg·m²`.
 
 /// Mass of the body (kg).
 pub const MASS: f64 = 2.0;
@@ -73,5 +81,46 @@ lower = -60.0
 unit = "deg"
 restitution = {restitution:?}"#
         ),
+    )
+}
+
+/// The hanging pendulum's model text: `head` (a title and the analysis
+/// tables), the pendulum, the keys `motion` added to its node 2 (an
+/// initial velocity), gravity on its default curve, then the tables
+/// `extra`.
+pub fn hanging(head: &str, motion: &str, extra: &str) -> String {
+    format!(
+        r#"{head}
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 2
+x = [0.0, -0.5, 0.0]
+{motion}
+
+[[supports]]
+node = 1
+fixed = ["all"]
+
+[[rigid_bodies]]
+id = 1
+node = 2
+mass = 2.0
+inertia = [0.01, 0.01, 0.01]
+
+[[joints]]
+id = 3
+type = "revolute"
+nodes = [1, 2]
+axis = [0.0, 0.0, 1.0]
+position = [0.0, 0.0, 0.0]
+
+[gravity]
+acceleration = [0.0, -9.81, 0.0]
+{extra}
+"#
     )
 }

@@ -991,7 +991,8 @@ fn a_step_accepted_at_round_off_is_noted_once() {
     let model = dir.join("falling_beam.toml");
     std::fs::write(
         &model,
-        r#"title = "falling spinning beam"
+        format!(
+            r#"title = "falling spinning beam"
 [analysis]
 type = "dynamic"
 end_time = 2.0
@@ -1000,16 +1001,7 @@ max_step = 0.01
 output_times = [0.5, 1.0, 1.5]
 output_every = 1000
 
-[[sections]]
-name = "rod"
-EA = 2.2e7
-GA2 = 7.35e6
-GA3 = 7.35e6
-GJ = 408.0
-EI2 = 550.0
-EI3 = 550.0
-mass_per_length = 0.848
-inertia_per_length = [4.24e-5, 2.12e-5, 2.12e-5]
+{rod}
 
 [[nodes]]
 id = 1
@@ -1035,6 +1027,8 @@ about = [1.0, 0.0, 0.0]
 [gravity]
 acceleration = [0.0, 0.0, -9.81]
 "#,
+            rod = common::flexible_hinge::rod_section("")
+        ),
     )
     .unwrap();
     let out = dir.join("out");

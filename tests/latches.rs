@@ -795,75 +795,17 @@ fn a_latch_at_its_value_at_the_start_is_locked() {
 /// ten-element model of the deployment example), the section of a 1 m rod,
 /// `step` the time step, `extra` lines appended to the analysis.
 fn flexible_hinge(step: f64, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
+    common::flexible_hinge::flexible_hinge(
+        &format!(
+            r#"[analysis]
 type = "dynamic"
 end_time = 0.42
 time_step = {step}
 output_times = [0.3]
-{extra}
-
-[[sections]]
-name = "rod"
-EA = 2.2e7
-GA2 = 7.35e6
-GA3 = 7.35e6
-GJ = 408.0
-EI2 = 550.0
-EI3 = 550.0
-mass_per_length = 0.848
-inertia_per_length = [4.24e-5, 2.12e-5, 2.12e-5]
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 11
-x = [1.0, 0.0, 0.0]
-[[nodes]]
-id = 12
-x = [1.0, 0.0, 0.0]
-[[nodes]]
-id = 22
-x = [2.0, 0.0, 0.0]
-
-[[beam_lines]]
-nodes = [1, 11]
-elements = 4
-section = "rod"
-orientation = [0.0, 1.0, 0.0]
-first_node = 2
-first_element = 101
-[[beam_lines]]
-nodes = [12, 22]
-elements = 4
-section = "rod"
-orientation = [0.0, 1.0, 0.0]
-first_node = 13
-first_element = 201
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[joints]]
-id = 1
-type = "revolute"
-nodes = [11, 12]
-axis = [0.0, 0.0, 1.0]
-
-[[joint_springs]]
-id = 2
-joint = 1
-stiffness = 2.0
-free_value = 3.141592653589793
-
-[[latches]]
-id = 3
-joint = 1
-value = 1.5707963267948966
-"#
+{extra}"#
+        ),
+        4,
+        "",
     )
 }
 

@@ -4,6 +4,7 @@
 pub mod ball;
 pub mod elliptic;
 pub mod events;
+pub mod flexible_hinge;
 pub mod hinged_panel;
 pub mod pendulum;
 pub mod quadrature;

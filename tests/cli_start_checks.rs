@@ -77,43 +77,19 @@ max_step = 0.01"#,
     )
 }
 
-/// An upright disc of radius 0.5 rolling along +y at 2 m/s
-/// (docs/model-format.md, `[[rolling_discs]]`), its spin `spin` about
-/// the global x axis: −4 rad/s rolls, other values slip.
+/// The upright disc of tests/common/rolling_disc.rs, of radius 0.5
+/// rolling along +y at 2 m/s (docs/model-format.md, `[[rolling_discs]]`),
+/// its spin `spin` about the global x axis: −4 rad/s rolls, other values
+/// slip.
 fn disc(spin: f64) -> String {
-    format!(
+    common::rolling_disc::upright_disc(
         r#"title = "rolling disc"
 [analysis]
 type = "dynamic"
 end_time = 0.1
 time_step = 0.01
-adaptive = false
-
-[gravity]
-acceleration = [0.0, 0.0, -9.81]
-curve = "constant"
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.5]
-rotation = [0.0, 90.0, 0.0]
-unit = "deg"
-velocity = [0.0, 2.0, 0.0]
-angular_velocity = [{spin}, 0.0, 0.0]
-
-[[rigid_bodies]]
-id = 1
-node = 1
-mass = 1.0
-inertia = [0.0625, 0.0625, 0.125]
-
-[[rolling_discs]]
-id = 2
-node = 1
-radius = 0.5
-axis = [0.0, 0.0, 1.0]
-normal = [0.0, 0.0, 1.0]
-"#
+adaptive = false"#,
+        spin,
     )
 }
 

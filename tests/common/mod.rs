@@ -9,6 +9,7 @@ pub mod hinged_panel;
 pub mod pendulum;
 pub mod quadrature;
 pub mod rigid_body;
+pub mod rolling_disc;
 pub mod spring_latch;
 
 use std::sync::Arc;

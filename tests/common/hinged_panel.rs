@@ -5,37 +5,25 @@
 //! about z at the origin, so that its inertia about the hinge is
 //! `J_O = 1/12 + 0.5² = 1/3 kg·m²`; no gravity.
 
+use super::hinged_body::HingedBody;
+
 /// The panel's model text: `title`, the analysis tables `analysis`, the
 /// panel, then the tables `rest` (acting on joint 3).
 fn hinged_panel(title: &str, analysis: &str, rest: &str) -> String {
+    let panel = HingedBody {
+        centre: [0.5, 0.0, 0.0],
+        motion: "",
+        body: 12,
+        mass: 1.0,
+        inertia: [0.001, 0.0833333333333333, 0.0833333333333333],
+        joint: 3,
+    };
+    let tables = panel.tables();
     format!(
         r#"title = "{title}"
 {analysis}
 
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 12
-node = 2
-mass = 1.0
-inertia = [0.001, 0.0833333333333333, 0.0833333333333333]
-
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
+{tables}
 
 {rest}
 "#

@@ -5,6 +5,7 @@ pub mod ball;
 pub mod elliptic;
 pub mod events;
 pub mod flexible_hinge;
+pub mod hinged_body;
 pub mod hinged_panel;
 pub mod pendulum;
 pub mod quadrature;

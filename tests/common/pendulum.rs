@@ -14,6 +14,8 @@
 //! axis, its centre at (0, −0.5, 0) below the hinge (id 3), under gravity
 //! 9.81 m/s²: `J_O = 0.01 + 2 · 0.5² = 0.51 kg·m²`.
 
+use super::hinged_body::HingedBody;
+
 /// Mass of the body (kg).
 pub const MASS: f64 = 2.0;
 /// Distance of its centre from the hinge (m).
@@ -28,40 +30,15 @@ pub const G: f64 = 9.81;
 /// `gravity_curve` (its default, `ramp` in a dynamic analysis, where
 /// `None`), then the tables `extra`.
 pub fn pendulum(head: &str, joint: u64, gravity_curve: Option<&str>, extra: &str) -> String {
-    let curve = gravity_curve.map_or(String::new(), |c| format!("curve = \"{c}\"\n"));
-    format!(
-        r#"{head}
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [{DISTANCE:?}, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = {MASS:?}
-inertia = [{INERTIA:?}, {INERTIA:?}, {INERTIA:?}]
-
-[[joints]]
-id = {joint}
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[gravity]
-acceleration = [0.0, -{G:?}, 0.0]
-{curve}{extra}
-"#
-    )
+    let pendulum = HingedBody {
+        centre: [DISTANCE, 0.0, 0.0],
+        motion: "",
+        body: 1,
+        mass: MASS,
+        inertia: [INERTIA; 3],
+        joint,
+    };
+    swinging(head, &pendulum, gravity_curve, extra)
 }
 
 /// The pendulum falling from the horizontal under constant gravity onto
@@ -89,38 +66,30 @@ restitution = {restitution:?}"#
 /// initial velocity), gravity on its default curve, then the tables
 /// `extra`.
 pub fn hanging(head: &str, motion: &str, extra: &str) -> String {
+    let pendulum = HingedBody {
+        centre: [0.0, -0.5, 0.0],
+        motion,
+        body: 1,
+        mass: 2.0,
+        inertia: [0.01; 3],
+        joint: 3,
+    };
+    swinging(head, &pendulum, None, extra)
+}
+
+/// `head`, the body on its hinge, gravity `G` along −y on the curve
+/// `gravity_curve` (the default where `None`), then the tables `extra`.
+fn swinging(head: &str, body: &HingedBody, gravity_curve: Option<&str>, extra: &str) -> String {
+    let tables = body.tables();
+    let curve = gravity_curve.map_or(String::new(), |c| format!("curve = \"{c}\"\n"));
     format!(
         r#"{head}
 
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.0, -0.5, 0.0]
-{motion}
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 2.0
-inertia = [0.01, 0.01, 0.01]
-
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
+{tables}
 
 [gravity]
-acceleration = [0.0, -9.81, 0.0]
-{extra}
+acceleration = [0.0, -{G:?}, 0.0]
+{curve}{extra}
 "#
     )
 }

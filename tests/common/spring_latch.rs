@@ -6,39 +6,27 @@
 //! of motion in the hinge angle `θ` is linear: `J θ̈ = M(θ, t)`; no
 //! gravity.
 
+use super::hinged_body::HingedBody;
+
 /// The model: the panel, `analysis` lines in `[analysis]` (a dynamic
 /// analysis), and `extra` entries.
 pub fn panel(analysis: &str, extra: &str) -> String {
+    let panel = HingedBody {
+        centre: [0.5, 0.0, 0.0],
+        motion: "",
+        body: 1,
+        mass: 1.0,
+        inertia: [0.08333333333333333; 3],
+        joint: 10,
+    };
+    let tables = panel.tables();
     format!(
         r#"
 [analysis]
 type = "dynamic"
 {analysis}
 
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 1.0
-inertia = [0.08333333333333333, 0.08333333333333333, 0.08333333333333333]
-
-[[joints]]
-id = 10
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
+{tables}
 
 {extra}
 "#

@@ -17,7 +17,10 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use common::events::run;
-use common::spring_latch::panel;
+use common::spring_latch::{
+    panel, ramp_release, spinning_into_latch, BACKLASH, K_HOLD, K_RATTLE, OMEGA_0, RAMP, THETA_R,
+    UNLATCH,
+};
 use unfold::analysis::LatchEventKind;
 use unfold::elements::{ElementKind, Need};
 use unfold::model::input::ModelInput;
@@ -221,11 +224,6 @@ stiffness = {K_LATCH}
 
 // ---------- (2) backlash: the rattle across the dead band ----------
 
-const K_RATTLE: f64 = 300.0;
-const BACKLASH: f64 = 0.1;
-const OMEGA_0: f64 = 2.0;
-const THETA_R: f64 = 0.5;
-
 /// Spinning freely at ω₀ = 2 rad/s (no spring, no load), the panel latches
 /// at θ_L = 0.5 rad with a dead band b = 0.1 rad: it flies across half the
 /// band, is turned back by the latch's spring in half a cycle of
@@ -240,23 +238,10 @@ const THETA_R: f64 = 0.5;
 /// for the same panel without latch started with a step of 1e-8 s).
 #[test]
 fn a_spring_latch_with_backlash_rattles_across_its_dead_band() {
-    let text = panel(
+    let text = spinning_into_latch(
         "end_time = 1.8\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
-        &format!(
-            r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, {OMEGA_0}]
-
-[[latches]]
-id = 20
-joint = 10
-value = {THETA_R}
-mode = "spring"
-stiffness = {K_RATTLE}
-backlash = {BACKLASH}
-"#
-        ),
+        &format!("backlash = {BACKLASH}"),
+        "",
     );
     let (model, out, rec) = run(&text);
     assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
@@ -377,23 +362,10 @@ backlash = {BACKLASH}
 /// and fixed steps of 5e-4 s, as for the rattle above.
 #[test]
 fn a_one_sided_spring_latch_turns_the_panel_back_and_lets_it_go() {
-    let text = panel(
+    let text = spinning_into_latch(
         "end_time = 0.6\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
-        &format!(
-            r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, {OMEGA_0}]
-
-[[latches]]
-id = 20
-joint = 10
-value = {THETA_R}
-mode = "spring"
-stiffness = {K_RATTLE}
-side = "beyond"
-"#
-        ),
+        "side = \"beyond\"",
+        "",
     );
     let (model, _, rec) = run(&text);
     let big_omega = (K_RATTLE / J).sqrt();
@@ -465,23 +437,10 @@ side = "beyond"
 /// at θ_L and goes on past it freely at ω₀, with no load on the latch.
 #[test]
 fn a_one_sided_spring_latch_lets_the_panel_go_on_past_it() {
-    let text = panel(
+    let text = spinning_into_latch(
         "end_time = 0.5\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
-        &format!(
-            r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, {OMEGA_0}]
-
-[[latches]]
-id = 20
-joint = 10
-value = {THETA_R}
-mode = "spring"
-stiffness = {K_RATTLE}
-side = "behind"
-"#
-        ),
+        "side = \"behind\"",
+        "",
     );
     let (model, _, rec) = run(&text);
     assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
@@ -498,10 +457,6 @@ side = "behind"
 }
 
 // ---------- (3) the release under a load ramp ----------
-
-const K_HOLD: f64 = 100.0;
-const RAMP: f64 = 2.0;
-const UNLATCH: f64 = 1.0;
 
 /// `θ(t)` of the latched panel under the moment `R t` from rest:
 /// `J θ̈ = R t − k θ`, `θ = (R/k)(t − sin ωt/ω)`, `ω = √(k/J)`; and its
@@ -522,25 +477,9 @@ fn held(t: f64) -> (f64, f64) {
 /// `J θ̈ = R t` from `θ(t_u)`, `θ̇(t_u)`.
 #[test]
 fn a_load_ramp_releases_a_spring_latch_at_its_unlatch_load() {
-    let text = panel(
+    let text = ramp_release(
         "end_time = 1.2\ntime_step = 0.001\nerror_tolerance = 1e-6",
-        &format!(
-            r#"
-[[loads]]
-node = 2
-moment = [0.0, 0.0, {RAMP}]
-curve = "ramp"
-
-[[latches]]
-id = 20
-joint = 10
-value = 0.0
-approach = "increasing"
-mode = "spring"
-stiffness = {K_HOLD}
-unlatch_load = {UNLATCH}
-"#
-        ),
+        "",
     );
     let (model, out, rec) = run(&text);
     // t_u: R (t − sin ωt/ω) = F_u, by bisection on [0.4, 0.7] where it is
@@ -639,23 +578,10 @@ fn a_spring_latch_with_a_dashpot_rings_down_as_a_damped_oscillator() {
     let zeta = 0.02;
     let omega = (K_RATTLE / J).sqrt();
     let d = 2.0 * zeta * (K_RATTLE * J).sqrt();
-    let text = panel(
+    let text = spinning_into_latch(
         "end_time = 1.25\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
-        &format!(
-            r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, {OMEGA_0}]
-
-[[latches]]
-id = 20
-joint = 10
-value = {THETA_R}
-mode = "spring"
-stiffness = {K_RATTLE}
-damping = {d}
-"#
-        ),
+        &format!("damping = {d}"),
+        "",
     );
     let (model, out, rec) = run(&text);
     assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
@@ -747,25 +673,9 @@ fn spring_latch_keys_in_degrees_are_converted_to_radians() {
 #[test]
 fn the_release_is_an_event_in_the_result_files() {
     let dir = scratch("release");
-    let text = panel(
+    let text = ramp_release(
         "end_time = 0.6\ntime_step = 0.001\nerror_tolerance = 1e-6",
-        &format!(
-            r#"
-[[loads]]
-node = 2
-moment = [0.0, 0.0, {RAMP}]
-curve = "ramp"
-
-[[latches]]
-id = 20
-joint = 10
-value = 0.0
-approach = "increasing"
-mode = "spring"
-stiffness = {K_HOLD}
-unlatch_load = {UNLATCH}
-"#
-        ),
+        "",
     );
     let model = dir.join("model.toml");
     std::fs::write(&model, text).unwrap();

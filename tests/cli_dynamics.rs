@@ -4,8 +4,13 @@
 //! that repeats the uninterrupted run, an interrupted run, and bad input
 //! (docs/results.md, docs/model-format.md).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+use common::hinged_panel::latched_panel;
+use common::pendulum;
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -98,49 +103,15 @@ fn same_steps(out: &Path) -> Vec<usize> {
 
 /// Mass (kg), distance of the centre of mass from the hinge (m), inertia
 /// about the centre (kg·m²) and gravity (m/s²) of the pendulum below.
-const M: f64 = 2.0;
-const D: f64 = 0.5;
-const J: f64 = 0.1;
-const G: f64 = 9.81;
+const M: f64 = pendulum::MASS;
+const D: f64 = pendulum::DISTANCE;
+const J: f64 = pendulum::INERTIA;
+const G: f64 = pendulum::G;
 
-/// A rigid body hinged to the ground about z at the origin, its centre
-/// of mass (node 2) at (0.5, 0, 0), released from the horizontal under
-/// gravity along −y; `analysis` and `extra` tables added.
+/// The pendulum of tests/common/pendulum.rs (hinge id 7, gravity on its
+/// default curve); `analysis` and `extra` tables added.
 fn pendulum(analysis: &str, extra: &str) -> String {
-    format!(
-        r#"title = "pendulum"
-{analysis}
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [{D}, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = {M}
-inertia = [{J}, {J}, {J}]
-
-[[joints]]
-id = 7
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[gravity]
-acceleration = [0.0, -{G}, 0.0]
-{extra}
-"#
-    )
+    pendulum::pendulum(&format!("title = \"pendulum\"\n{analysis}"), 7, None, extra)
 }
 
 /// Fixed steps of 5 ms over a quarter swing and more.
@@ -727,9 +698,9 @@ fn a_modal_analysis_with_no_mode_left_is_a_note() {
     let model = dir.join("panel.toml");
     std::fs::write(
         &model,
-        r#"
-title = "panel latched to the ground, then its modes"
-[[analysis]]
+        latched_panel(
+            "panel latched to the ground, then its modes",
+            r#"[[analysis]]
 type = "modal"
 modes = 3
 [[analysis]]
@@ -740,38 +711,10 @@ max_step = 0.01
 output_every = 10
 [[analysis]]
 type = "modal"
-modes = 3
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-[[supports]]
-node = 1
-fixed = ["all"]
-[[rigid_bodies]]
-id = 12
-node = 2
-mass = 1.0
-inertia = [0.001, 0.0833333333333333, 0.0833333333333333]
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-[[joint_springs]]
-id = 4
-joint = 3
-stiffness = 2.0
-free_value = 3.141592653589793
-[[latches]]
-id = 5
-joint = 3
-value = 90.0
-unit = "deg"
-"#,
+modes = 3"#,
+            90.0,
+            "",
+        ),
     )
     .unwrap();
     let out = dir.join("out");
@@ -1048,7 +991,8 @@ fn a_step_accepted_at_round_off_is_noted_once() {
     let model = dir.join("falling_beam.toml");
     std::fs::write(
         &model,
-        r#"title = "falling spinning beam"
+        format!(
+            r#"title = "falling spinning beam"
 [analysis]
 type = "dynamic"
 end_time = 2.0
@@ -1057,16 +1001,7 @@ max_step = 0.01
 output_times = [0.5, 1.0, 1.5]
 output_every = 1000
 
-[[sections]]
-name = "rod"
-EA = 2.2e7
-GA2 = 7.35e6
-GA3 = 7.35e6
-GJ = 408.0
-EI2 = 550.0
-EI3 = 550.0
-mass_per_length = 0.848
-inertia_per_length = [4.24e-5, 2.12e-5, 2.12e-5]
+{rod}
 
 [[nodes]]
 id = 1
@@ -1092,6 +1027,8 @@ about = [1.0, 0.0, 0.0]
 [gravity]
 acceleration = [0.0, 0.0, -9.81]
 "#,
+            rod = common::flexible_hinge::rod_section("")
+        ),
     )
     .unwrap();
     let out = dir.join("out");

@@ -6,9 +6,14 @@
 //! analysis passes (docs/joints.md §6.2); a note giving a joint spring's
 //! or hinge law's coefficient per degree in N·m/rad (docs/model-format.md).
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+use common::hinged_panel::latched_panel;
+use common::pendulum;
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -82,54 +87,12 @@ fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
-/// A 1 kg panel, its centre 0.5 m from a ground hinge about z (J_O =
-/// 1/12 + 0.5² = 1/3 kg·m²), opened from θ = 0 by a torsion spring of
-/// 2 N·m/rad unloaded at 180°, with a latch at `latch` degrees;
-/// `analysis` its analysis tables, `extra` more tables.
+/// The latched panel of tests/common/hinged_panel.rs (J_O = 1/3 kg·m²,
+/// a torsion spring of 2 N·m/rad unloaded at 180°, id 4) with its latch
+/// (id 5) at `latch` degrees; `analysis` its analysis tables, `extra`
+/// more tables.
 fn panel(analysis: &str, latch: f64, extra: &str) -> String {
-    format!(
-        r#"title = "panel latched to the ground"
-{analysis}
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 12
-node = 2
-mass = 1.0
-inertia = [0.001, 0.0833333333333333, 0.0833333333333333]
-
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[[joint_springs]]
-id = 4
-joint = 3
-stiffness = 2.0
-free_value = 3.141592653589793
-
-[[latches]]
-id = 5
-joint = 3
-value = {latch:.1}
-unit = "deg"
-{extra}
-"#
-    )
+    latched_panel("panel latched to the ground", analysis, latch, extra)
 }
 
 const DYNAMIC: &str = "[analysis]
@@ -223,48 +186,14 @@ fn the_impacts_of_a_stop_are_counted_with_their_loss() {
     let model = dir.join("pendulum.toml");
     std::fs::write(
         &model,
-        r#"title = "pendulum onto a stop"
+        pendulum::onto_a_stop(
+            r#"title = "pendulum onto a stop"
 [analysis]
 type = "dynamic"
 end_time = 3.0
-time_step = 0.01
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 2.0
-inertia = [0.1, 0.1, 0.1]
-
-[[joints]]
-id = 7
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[gravity]
-acceleration = [0.0, -9.81, 0.0]
-curve = "constant"
-
-[[stops]]
-id = 8
-joint = 7
-lower = -60.0
-unit = "deg"
-restitution = 0.5
-"#,
+time_step = 0.01"#,
+            0.5,
+        ),
     )
     .unwrap();
     let out = dir.join("out");

@@ -6,8 +6,12 @@
 //! messages about initial velocities name each node once
 //! (README.md, docs/results.md, docs/model-format.md).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use common::pendulum;
 
 /// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
@@ -57,86 +61,35 @@ fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
-/// A compound pendulum hinged to the ground about z at the origin, its
-/// body at (0, −0.5, 0), in a dynamic analysis; `extra` tables added.
+/// The hanging pendulum of tests/common/pendulum.rs, hinged to the ground
+/// about z at the origin, its body at (0, −0.5, 0), in a dynamic analysis;
+/// `extra` tables added.
 fn pendulum(extra: &str) -> String {
-    format!(
+    pendulum::hanging(
         r#"title = "compound pendulum"
 [analysis]
 type = "dynamic"
 end_time = 1.0
 time_step = 0.001
-max_step = 0.01
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.0, -0.5, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 2.0
-inertia = [0.01, 0.01, 0.01]
-
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[gravity]
-acceleration = [0.0, -9.81, 0.0]
-{extra}
-"#
+max_step = 0.01"#,
+        "",
+        extra,
     )
 }
 
-/// An upright disc of radius 0.5 rolling along +y at 2 m/s
-/// (docs/model-format.md, `[[rolling_discs]]`), its spin `spin` about
-/// the global x axis: −4 rad/s rolls, other values slip.
+/// The upright disc of tests/common/rolling_disc.rs, of radius 0.5
+/// rolling along +y at 2 m/s (docs/model-format.md, `[[rolling_discs]]`),
+/// its spin `spin` about the global x axis: −4 rad/s rolls, other values
+/// slip.
 fn disc(spin: f64) -> String {
-    format!(
+    common::rolling_disc::upright_disc(
         r#"title = "rolling disc"
 [analysis]
 type = "dynamic"
 end_time = 0.1
 time_step = 0.01
-adaptive = false
-
-[gravity]
-acceleration = [0.0, 0.0, -9.81]
-curve = "constant"
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.5]
-rotation = [0.0, 90.0, 0.0]
-unit = "deg"
-velocity = [0.0, 2.0, 0.0]
-angular_velocity = [{spin}, 0.0, 0.0]
-
-[[rigid_bodies]]
-id = 1
-node = 1
-mass = 1.0
-inertia = [0.0625, 0.0625, 0.125]
-
-[[rolling_discs]]
-id = 2
-node = 1
-radius = 0.5
-axis = [0.0, 0.0, 1.0]
-normal = [0.0, 0.0, 1.0]
-"#
+adaptive = false"#,
+        spin,
     )
 }
 

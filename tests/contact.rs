@@ -9,15 +9,15 @@
 
 mod common;
 
-use common::events::run;
+use common::events::{error_of, run};
 use unfold::analysis::{ContactInfo, ContactKind, IncrementInfo};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::so3::Vec3;
 use unfold::state::State;
 
-const G: f64 = 9.81;
-const MASS: f64 = 2.0;
+const G: f64 = common::ball::G;
+const MASS: f64 = common::ball::MASS;
 const RADIUS: f64 = 0.1;
 
 /// The event tolerance of a length in a model of one node (length scale
@@ -25,18 +25,15 @@ const RADIUS: f64 = 0.1;
 const GAP_TOLERANCE: f64 = 1e-8;
 
 /// A ball of radius 0.1 m and mass 2 kg (a rigid body, inertia
-/// 2/5 m r²) on the free node 1 at `x`, under gravity −z, with the
-/// contact `contact` and the tables `extra`.
+/// 2/5 m r²) on the free node 1 at `x`, under gravity −z
+/// (tests/common/ball.rs), with the contact `contact` and the tables
+/// `extra`.
 fn ball(end_time: f64, x: [f64; 3], contact: &str, extra: &str) -> String {
     let j = 0.4 * MASS * RADIUS * RADIUS;
-    format!(
-        r#"
-[analysis]
-type = "dynamic"
-end_time = {end_time}
-time_step = 0.01
-
-[[nodes]]
+    common::ball::dropped(
+        end_time,
+        &format!(
+            r#"[[nodes]]
 id = 1
 x = [{}, {}, {}]
 
@@ -48,14 +45,10 @@ inertia = [{j}, {j}, {j}]
 
 [[contacts]]
 id = 30
-{contact}
-
-[gravity]
-acceleration = [0.0, 0.0, -{G}]
-curve = "constant"
-{extra}
-"#,
-        x[0], x[1], x[2]
+{contact}"#,
+            x[0], x[1], x[2]
+        ),
+        extra,
     )
 }
 
@@ -535,14 +528,6 @@ fn two_spheres_stay_in_contact_when_pushed_together() {
         );
     }
     eprintln!("contact force within {worst:.2e} of m_b F/(m_a + m_b)");
-}
-
-fn error_of(text: &str) -> String {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    match Model::from_input(&input) {
-        Ok(_) => panic!("accepted"),
-        Err(e) => e.to_string(),
-    }
 }
 
 /// Input errors name the file, the contact and what is wrong; `unfold

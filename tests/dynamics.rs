@@ -42,43 +42,12 @@ fn parse(text: &str) -> (Arc<Model>, Vec<AnalysisSettings>) {
     (Arc::new(model), input.analyses().expect("valid analyses"))
 }
 
-/// A body of mass 2 kg, centre of mass at 0.5 m from a revolute joint
-/// about z at the origin, inertia 0.1 kg·m² about the centre, released
-/// from the horizontal under g = 9.81.
+/// The pendulum of tests/common/pendulum.rs: a body of mass 2 kg, centre
+/// of mass at 0.5 m from a revolute joint (id 2) about z at the origin,
+/// inertia 0.1 kg·m² about the centre, released from the horizontal under
+/// g = 9.81.
 fn pendulum(analysis: &str) -> String {
-    format!(
-        r#"
-{analysis}
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 2.0
-inertia = [0.1, 0.1, 0.1]
-
-[[joints]]
-id = 2
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[gravity]
-acceleration = [0.0, -9.81, 0.0]
-"#
-    )
+    common::pendulum::pendulum(analysis, 2, None, "")
 }
 
 /// The events of a run.

@@ -3,6 +3,8 @@
 //! whose highest modes the steps do not resolve, and a hysteretic hinge law
 //! cycled in dynamics.
 
+mod common;
+
 use std::sync::Arc;
 
 use unfold::analysis::energy::powers;
@@ -51,70 +53,17 @@ fn run(text: &str) -> (Vec<Energies>, f64) {
 /// `flex_latch`), with `rayleigh_beta = 1e-4` on the section: 0.5 s,
 /// the lock near 0.3975 s.
 fn flexible_hinge(rho_infinity: f64) -> String {
-    format!(
-        r#"
-[analysis]
+    common::flexible_hinge::flexible_hinge(
+        &format!(
+            r#"[analysis]
 type = "dynamic"
 end_time = 0.5
 time_step = 0.001
 max_step = 0.005
-rho_infinity = {rho_infinity:?}
-
-[[sections]]
-name = "rod"
-EA = 2.2e7
-GA2 = 7.35e6
-GA3 = 7.35e6
-GJ = 408.0
-EI2 = 550.0
-EI3 = 550.0
-mass_per_length = 0.848
-rayleigh_beta = 1e-4
-inertia_per_length = [4.24e-5, 2.12e-5, 2.12e-5]
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 11
-x = [1.0, 0.0, 0.0]
-[[nodes]]
-id = 12
-x = [1.0, 0.0, 0.0]
-[[nodes]]
-id = 22
-x = [2.0, 0.0, 0.0]
-[[beam_lines]]
-nodes = [1, 11]
-elements = 10
-section = "rod"
-orientation = [0.0, 1.0, 0.0]
-first_node = 2
-first_element = 101
-[[beam_lines]]
-nodes = [12, 22]
-elements = 10
-section = "rod"
-orientation = [0.0, 1.0, 0.0]
-first_node = 13
-first_element = 201
-[[supports]]
-node = 1
-fixed = ["all"]
-[[joints]]
-id = 1
-type = "revolute"
-nodes = [11, 12]
-axis = [0.0, 0.0, 1.0]
-[[joint_springs]]
-id = 2
-joint = 1
-stiffness = 2.0
-free_value = 3.141592653589793
-[[latches]]
-id = 3
-joint = 1
-value = 1.5707963267948966
-"#
+rho_infinity = {rho_infinity:?}"#
+        ),
+        10,
+        "rayleigh_beta = 1e-4\n",
     )
 }
 

@@ -5,11 +5,14 @@
 //! the ground whose latch load must be the spring's static `k π/2` at every
 //! step after the lock, without rejected steps while nothing moves.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Arc;
 
+use common::hinged_panel;
 use unfold::analysis::{
     AnalysisSettings, DynamicAnalysis, IncrementInfo, IterationInfo, LockInfo, Observer,
 };
@@ -65,46 +68,17 @@ fn table(path: &Path) -> Vec<HashMap<String, f64>> {
 // at τ = 0.2113). Every step is written.
 
 fn driven_hinge(output_times: &str) -> String {
-    format!(
-        r#"title = "driven hinge, dynamics"
-[analysis]
+    hinged_panel::driven_hinge(
+        "driven hinge, dynamics",
+        &format!(
+            r#"[analysis]
 type = "dynamic"
 end_time = 1.5
 time_step = 0.001
 max_step = 0.01
 output_every = 1
-{output_times}
-[[curves]]
-name = "stroke"
-function = "smooth_step"
-start = 0.0
-end = 1.0
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-[[supports]]
-node = 1
-fixed = ["all"]
-[[rigid_bodies]]
-id = 12
-node = 2
-mass = 1.0
-inertia = [0.001, 0.0833333333333333, 0.0833333333333333]
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-[[drivers]]
-id = 4
-joint = 3
-value = 90.0
-unit = "deg"
-curve = "stroke"
-"#
+{output_times}"#
+        ),
     )
 }
 
@@ -207,44 +181,19 @@ fn driver_torque_is_j_theta_ddot_at_every_step_whatever_the_output_times() {
 // ωt = π/3, t = 0.42752 s; then at rest, the latch holding the spring's
 // k(π − π/2) = kπ/2 = 3.1416 N·m (latch load −kπ/2).
 
-const LATCHED_PANEL: &str = r#"title = "panel latched to ground"
-[analysis]
-type = "dynamic"
+fn latched_panel() -> String {
+    hinged_panel::latched_panel(
+        "panel latched to ground",
+        "[analysis]
+type = \"dynamic\"
 end_time = 1.0
 time_step = 0.001
 max_step = 0.01
-output_every = 1
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-[[supports]]
-node = 1
-fixed = ["all"]
-[[rigid_bodies]]
-id = 12
-node = 2
-mass = 1.0
-inertia = [0.001, 0.0833333333333333, 0.0833333333333333]
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-[[joint_springs]]
-id = 4
-joint = 3
-stiffness = 2.0
-free_value = 3.141592653589793
-[[latches]]
-id = 5
-joint = 3
-value = 90.0
-unit = "deg"
-"#;
+output_every = 1",
+        90.0,
+        "",
+    )
+}
 
 /// The attempts of every step (a step with more than one attempt had
 /// its first ones rejected) and the locks.
@@ -285,7 +234,7 @@ fn a_latch_holds_the_static_load_at_every_step_after_the_lock() {
     let k = 2.0;
     let static_load = -k * std::f64::consts::FRAC_PI_2;
     let dir = scratch("latch");
-    let out = run_cli(&dir, "latch", LATCHED_PANEL);
+    let out = run_cli(&dir, "latch", &latched_panel());
     let rows = table(&out.join("latches.csv"));
     let locked: Vec<_> = rows.iter().filter(|r| r["locked"] != 0.0).collect();
     assert!(locked.len() > 50, "{} locked rows", locked.len());
@@ -308,7 +257,7 @@ fn a_latch_holds_the_static_load_at_every_step_after_the_lock() {
     let _ = std::fs::remove_dir_all(&dir);
 
     // the rejected steps after the lock, through the library
-    let input: ModelInput = toml::from_str(LATCHED_PANEL).unwrap();
+    let input: ModelInput = toml::from_str(&latched_panel()).unwrap();
     let model = Arc::new(Model::from_input(&input).unwrap());
     let analyses = input.analyses().unwrap();
     let AnalysisSettings::Dynamic(settings) = &analyses[0] else {

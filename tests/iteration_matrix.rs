@@ -4,6 +4,8 @@
 //! grow as the step shrinks; unscaled it grows as `h⁻⁴` (Bottasso, Bauchau
 //! & Cardona 2007).
 
+mod common;
+
 use std::sync::Arc;
 
 use unfold::analysis::{DynamicAnalysis, Observer};
@@ -66,37 +68,7 @@ type = "dynamic"
 end_time = 1.0
 time_step = 0.01
 "#;
-    let pendulum = format!(
-        r#"{analysis}
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 2.0
-inertia = [0.1, 0.1, 0.1]
-
-[[joints]]
-id = 2
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[gravity]
-acceleration = [0.0, -9.81, 0.0]
-"#
-    );
+    let pendulum = common::pendulum::pendulum(analysis, 2, None, "");
     let link = format!(
         r#"{analysis}
 [[nodes]]

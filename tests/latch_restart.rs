@@ -3,9 +3,13 @@
 //! (its spring engaged on either side, or within its dead band) or after
 //! it released goes on as the run that was never stopped, to round-off.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use common::spring_latch;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("unfold-lrs-{}-{name}", std::process::id()));
@@ -30,45 +34,11 @@ fn run(model: &Path, out: &Path, extra: &[&str]) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
-/// A panel (a body of 1 kg, J = 1/3 kg·m² about its hinge) on a hinge
-/// about z, in fixed steps of 5e-4 s, with `extra` entries.
-fn panel(analysis: &str, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
-type = "dynamic"
-{analysis}
-time_step = 0.0005
-adaptive = false
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 1.0
-inertia = [0.08333333333333333, 0.08333333333333333, 0.08333333333333333]
-
-[[joints]]
-id = 10
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-{extra}
-"#
-    )
+/// The analysis lines `analysis` of the panel of
+/// tests/common/spring_latch.rs (a body of 1 kg, J = 1/3 kg·m² about its
+/// hinge), in fixed steps of 5e-4 s.
+fn fixed_steps(analysis: &str) -> String {
+    format!("{analysis}\ntime_step = 0.0005\nadaptive = false")
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -196,24 +166,10 @@ fn whole_and_restarted(name: &str, text: &str, times: &[f64]) -> Vec<Vec<f64>> {
 /// the band (0.4) and engaged below (0.45): each goes on as the whole run.
 #[test]
 fn a_latched_spring_latch_goes_on_through_a_restart() {
-    let text = panel(
-        "end_time = 0.7\nrho_infinity = 1.0",
-        r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, 2.0]
-
-[[latches]]
-id = 20
-joint = 10
-value = 0.5
-mode = "spring"
-stiffness = 300.0
-backlash = 0.1
-
-[output]
-restart_times = [0.3, 0.4, 0.45]
-"#,
+    let text = spring_latch::spinning_into_latch(
+        &fixed_steps("end_time = 0.7\nrho_infinity = 1.0"),
+        &format!("backlash = {}", spring_latch::BACKLASH),
+        "[output]\nrestart_times = [0.3, 0.4, 0.45]",
     );
     let internals = whole_and_restarted("latched", &text, &[0.3, 0.4, 0.45]);
     // internal variables: the hinge's unwrapped angle, then the latch's
@@ -234,26 +190,9 @@ restart_times = [0.3, 0.4, 0.45]
 /// on as the whole run.
 #[test]
 fn a_released_spring_latch_goes_on_through_a_restart() {
-    let text = panel(
-        "end_time = 0.8",
-        r#"
-[[loads]]
-node = 2
-moment = [0.0, 0.0, 2.0]
-curve = "ramp"
-
-[[latches]]
-id = 20
-joint = 10
-value = 0.0
-approach = "increasing"
-mode = "spring"
-stiffness = 100.0
-unlatch_load = 1.0
-
-[output]
-restart_times = [0.3, 0.6]
-"#,
+    let text = spring_latch::ramp_release(
+        &fixed_steps("end_time = 0.8"),
+        "[output]\nrestart_times = [0.3, 0.6]",
     );
     let internals = whole_and_restarted("released", &text, &[0.3, 0.6]);
     // (the hinge's angle, then the latch's angle, lock flag and side)

@@ -9,16 +9,19 @@
 //! its centre at (0.5, 0, 0), hinged about z at the origin to a fixed
 //! node, so that its inertia about the hinge is `J = J_c + m/4 = 1/3` and
 //! its equation of motion, with the hinge angle `θ`, is linear:
-//! `J θ̈ = M(θ, t)`.
+//! `J θ̈ = M(θ, t)` (tests/common/spring_latch.rs).
+
+mod common;
 
 use std::path::PathBuf;
 use std::process::Command;
-use std::sync::Arc;
 
-use unfold::analysis::{
-    AnalysisSettings, DynamicAnalysis, DynamicOutcome, IncrementInfo, LatchEventKind, LockInfo,
-    Observer,
+use common::events::run;
+use common::spring_latch::{
+    panel, ramp_release, spinning_into_latch, BACKLASH, K_HOLD, K_RATTLE, OMEGA_0, RAMP, THETA_R,
+    UNLATCH,
 };
+use unfold::analysis::LatchEventKind;
 use unfold::elements::{ElementKind, Need};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
@@ -26,80 +29,6 @@ use unfold::state::State;
 
 /// The panel's inertia about the hinge.
 const J: f64 = 1.0 / 12.0 + 0.25;
-
-/// The model: the panel, `analysis` lines in `[analysis]` (a dynamic
-/// analysis), and `extra` entries.
-fn panel(analysis: &str, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
-type = "dynamic"
-{analysis}
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [0.5, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 1.0
-inertia = [0.08333333333333333, 0.08333333333333333, 0.08333333333333333]
-
-[[joints]]
-id = 10
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-{extra}
-"#
-    )
-}
-
-/// Every accepted state and every latch event.
-#[derive(Default)]
-struct Record {
-    steps: Vec<(IncrementInfo, State)>,
-    events: Vec<LockInfo>,
-}
-
-impl Observer for Record {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.steps.push((info.clone(), state.clone()));
-        Ok(())
-    }
-    fn lock(&mut self, info: &LockInfo) {
-        self.events.push(info.clone());
-    }
-}
-
-fn run(text: &str) -> (Arc<Model>, DynamicOutcome, Record) {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    let model = Arc::new(Model::from_input(&input).expect("valid model"));
-    let analyses: Vec<AnalysisSettings> = input.analyses().expect("valid analyses");
-    let settings = analyses[0].as_dynamic().unwrap().clone();
-    let mut a = DynamicAnalysis::new(model.clone(), settings);
-    let mut record = Record::default();
-    let out = a.run(model.initial_state(), &mut record);
-    assert!(out.error.is_none(), "{:?}", out.error);
-    (model, out, record)
-}
 
 /// The hinge angle: the panel's rotation about z (node 1 is fixed).
 fn angle(state: &State) -> f64 {
@@ -196,8 +125,8 @@ stiffness = {K_LATCH}
         ),
     );
     let (model, out, rec) = run(&text);
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let lock = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let lock = &rec.locks[0];
     assert_eq!(lock.kind, LatchEventKind::Lock);
     // the step lands on θ_L within the event tolerance, 1e-8 rad
     assert!((lock.coordinate - THETA_L).abs() <= 1e-8, "{lock:?}");
@@ -295,11 +224,6 @@ stiffness = {K_LATCH}
 
 // ---------- (2) backlash: the rattle across the dead band ----------
 
-const K_RATTLE: f64 = 300.0;
-const BACKLASH: f64 = 0.1;
-const OMEGA_0: f64 = 2.0;
-const THETA_R: f64 = 0.5;
-
 /// Spinning freely at ω₀ = 2 rad/s (no spring, no load), the panel latches
 /// at θ_L = 0.5 rad with a dead band b = 0.1 rad: it flies across half the
 /// band, is turned back by the latch's spring in half a cycle of
@@ -314,27 +238,14 @@ const THETA_R: f64 = 0.5;
 /// for the same panel without latch started with a step of 1e-8 s).
 #[test]
 fn a_spring_latch_with_backlash_rattles_across_its_dead_band() {
-    let text = panel(
+    let text = spinning_into_latch(
         "end_time = 1.8\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
-        &format!(
-            r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, {OMEGA_0}]
-
-[[latches]]
-id = 20
-joint = 10
-value = {THETA_R}
-mode = "spring"
-stiffness = {K_RATTLE}
-backlash = {BACKLASH}
-"#
-        ),
+        &format!("backlash = {BACKLASH}"),
+        "",
     );
     let (model, out, rec) = run(&text);
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let lock = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let lock = &rec.locks[0];
     // the lock at θ_L/ω₀: the step landed on θ_L within 1e-8 rad; the
     // time within 1e-5 s, the integration error of the rotation about the
     // hinge (2.8e-6 rad measured) over ω₀
@@ -451,23 +362,10 @@ backlash = {BACKLASH}
 /// and fixed steps of 5e-4 s, as for the rattle above.
 #[test]
 fn a_one_sided_spring_latch_turns_the_panel_back_and_lets_it_go() {
-    let text = panel(
+    let text = spinning_into_latch(
         "end_time = 0.6\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
-        &format!(
-            r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, {OMEGA_0}]
-
-[[latches]]
-id = 20
-joint = 10
-value = {THETA_R}
-mode = "spring"
-stiffness = {K_RATTLE}
-side = "beyond"
-"#
-        ),
+        "side = \"beyond\"",
+        "",
     );
     let (model, _, rec) = run(&text);
     let big_omega = (K_RATTLE / J).sqrt();
@@ -539,27 +437,14 @@ side = "beyond"
 /// at θ_L and goes on past it freely at ω₀, with no load on the latch.
 #[test]
 fn a_one_sided_spring_latch_lets_the_panel_go_on_past_it() {
-    let text = panel(
+    let text = spinning_into_latch(
         "end_time = 0.5\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
-        &format!(
-            r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, {OMEGA_0}]
-
-[[latches]]
-id = 20
-joint = 10
-value = {THETA_R}
-mode = "spring"
-stiffness = {K_RATTLE}
-side = "behind"
-"#
-        ),
+        "side = \"behind\"",
+        "",
     );
     let (model, _, rec) = run(&text);
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let lock = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let lock = &rec.locks[0];
     assert!((lock.coordinate - THETA_R).abs() <= 1e-8, "{lock:?}");
     let (i, s) = rec.steps.last().unwrap();
     // on at ω₀: θ = ω₀ t within 1e-6 rad, the rate within 1e-6
@@ -572,10 +457,6 @@ side = "behind"
 }
 
 // ---------- (3) the release under a load ramp ----------
-
-const K_HOLD: f64 = 100.0;
-const RAMP: f64 = 2.0;
-const UNLATCH: f64 = 1.0;
 
 /// `θ(t)` of the latched panel under the moment `R t` from rest:
 /// `J θ̈ = R t − k θ`, `θ = (R/k)(t − sin ωt/ω)`, `ω = √(k/J)`; and its
@@ -596,25 +477,9 @@ fn held(t: f64) -> (f64, f64) {
 /// `J θ̈ = R t` from `θ(t_u)`, `θ̇(t_u)`.
 #[test]
 fn a_load_ramp_releases_a_spring_latch_at_its_unlatch_load() {
-    let text = panel(
+    let text = ramp_release(
         "end_time = 1.2\ntime_step = 0.001\nerror_tolerance = 1e-6",
-        &format!(
-            r#"
-[[loads]]
-node = 2
-moment = [0.0, 0.0, {RAMP}]
-curve = "ramp"
-
-[[latches]]
-id = 20
-joint = 10
-value = 0.0
-approach = "increasing"
-mode = "spring"
-stiffness = {K_HOLD}
-unlatch_load = {UNLATCH}
-"#
-        ),
+        "",
     );
     let (model, out, rec) = run(&text);
     // t_u: R (t − sin ωt/ω) = F_u, by bisection on [0.4, 0.7] where it is
@@ -632,8 +497,8 @@ unlatch_load = {UNLATCH}
     }
     let t_u = 0.5 * (lo + hi);
     let load_rate = K_HOLD * held(t_u).1;
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let release = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let release = &rec.locks[0];
     assert_eq!(release.kind, LatchEventKind::Unlatch);
     // the angle while latched against the closed form: its error, δθ,
     // bounds the error of the load, k δθ
@@ -713,27 +578,14 @@ fn a_spring_latch_with_a_dashpot_rings_down_as_a_damped_oscillator() {
     let zeta = 0.02;
     let omega = (K_RATTLE / J).sqrt();
     let d = 2.0 * zeta * (K_RATTLE * J).sqrt();
-    let text = panel(
+    let text = spinning_into_latch(
         "end_time = 1.25\ntime_step = 0.0005\nadaptive = false\nrho_infinity = 1.0",
-        &format!(
-            r#"
-[[initial_motion]]
-nodes = [2]
-angular_velocity = [0.0, 0.0, {OMEGA_0}]
-
-[[latches]]
-id = 20
-joint = 10
-value = {THETA_R}
-mode = "spring"
-stiffness = {K_RATTLE}
-damping = {d}
-"#
-        ),
+        &format!("damping = {d}"),
+        "",
     );
     let (model, out, rec) = run(&text);
-    assert_eq!(rec.events.len(), 1, "{:?}", rec.events);
-    let lock = &rec.events[0];
+    assert_eq!(rec.locks.len(), 1, "{:?}", rec.locks);
+    let lock = &rec.locks[0];
     let (t_l, v) = (lock.time, lock.rate_before);
     let omega_d = omega * (1.0 - zeta * zeta).sqrt();
     let amplitude = v / omega_d;
@@ -821,25 +673,9 @@ fn spring_latch_keys_in_degrees_are_converted_to_radians() {
 #[test]
 fn the_release_is_an_event_in_the_result_files() {
     let dir = scratch("release");
-    let text = panel(
+    let text = ramp_release(
         "end_time = 0.6\ntime_step = 0.001\nerror_tolerance = 1e-6",
-        &format!(
-            r#"
-[[loads]]
-node = 2
-moment = [0.0, 0.0, {RAMP}]
-curve = "ramp"
-
-[[latches]]
-id = 20
-joint = 10
-value = 0.0
-approach = "increasing"
-mode = "spring"
-stiffness = {K_HOLD}
-unlatch_load = {UNLATCH}
-"#
-        ),
+        "",
     );
     let model = dir.join("model.toml");
     std::fs::write(&model, text).unwrap();

@@ -7,14 +7,11 @@
 
 mod common;
 
-use std::sync::Arc;
-
+use common::events::{error_of, parse, run, Record};
 use common::quadrature::gauss_legendre;
 
 use unfold::analysis::energy::momenta;
-use unfold::analysis::{
-    AnalysisSettings, DynamicAnalysis, DynamicOutcome, IncrementInfo, LockInfo, Observer,
-};
+use unfold::analysis::DynamicAnalysis;
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::state::State;
@@ -181,45 +178,6 @@ impl Reduced {
         }
         0.5 * (lo + hi)
     }
-}
-
-/// Every accepted state and every lock.
-#[derive(Default)]
-struct Record {
-    steps: Vec<(IncrementInfo, State)>,
-    locks: Vec<LockInfo>,
-}
-
-impl Observer for Record {
-    fn increment(
-        &mut self,
-        info: &IncrementInfo,
-        _: &Model,
-        state: &State,
-        _: &[f64],
-    ) -> std::io::Result<()> {
-        self.steps.push((info.clone(), state.clone()));
-        Ok(())
-    }
-    fn lock(&mut self, info: &LockInfo) {
-        self.locks.push(info.clone());
-    }
-}
-
-fn parse(text: &str) -> (Arc<Model>, Vec<AnalysisSettings>) {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    let model = Model::from_input(&input).expect("valid model");
-    (Arc::new(model), input.analyses().expect("valid analyses"))
-}
-
-fn run(text: &str) -> (Arc<Model>, DynamicOutcome, Record) {
-    let (model, analyses) = parse(text);
-    let settings = analyses[0].as_dynamic().unwrap().clone();
-    let mut a = DynamicAnalysis::new(model.clone(), settings);
-    let mut record = Record::default();
-    let out = a.run(model.initial_state(), &mut record);
-    assert!(out.error.is_none(), "{:?}", out.error);
-    (model, out, record)
 }
 
 /// θ: B's rotation relative to A about z, from the nodes' orientations
@@ -439,15 +397,6 @@ fn without_the_latch_the_panels_swing_past_the_locking_angle() {
         .map(|(_, s)| angle(s))
         .fold(f64::MIN, f64::max);
     assert!(largest > THETA_L + 0.1, "{largest}");
-}
-
-/// The message of a model that must not build.
-fn error_of(text: &str) -> String {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    match Model::from_input(&input) {
-        Ok(_) => panic!("the model was accepted"),
-        Err(e) => e.to_string(),
-    }
 }
 
 #[test]
@@ -846,75 +795,17 @@ fn a_latch_at_its_value_at_the_start_is_locked() {
 /// ten-element model of the deployment example), the section of a 1 m rod,
 /// `step` the time step, `extra` lines appended to the analysis.
 fn flexible_hinge(step: f64, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
+    common::flexible_hinge::flexible_hinge(
+        &format!(
+            r#"[analysis]
 type = "dynamic"
 end_time = 0.42
 time_step = {step}
 output_times = [0.3]
-{extra}
-
-[[sections]]
-name = "rod"
-EA = 2.2e7
-GA2 = 7.35e6
-GA3 = 7.35e6
-GJ = 408.0
-EI2 = 550.0
-EI3 = 550.0
-mass_per_length = 0.848
-inertia_per_length = [4.24e-5, 2.12e-5, 2.12e-5]
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 11
-x = [1.0, 0.0, 0.0]
-[[nodes]]
-id = 12
-x = [1.0, 0.0, 0.0]
-[[nodes]]
-id = 22
-x = [2.0, 0.0, 0.0]
-
-[[beam_lines]]
-nodes = [1, 11]
-elements = 4
-section = "rod"
-orientation = [0.0, 1.0, 0.0]
-first_node = 2
-first_element = 101
-[[beam_lines]]
-nodes = [12, 22]
-elements = 4
-section = "rod"
-orientation = [0.0, 1.0, 0.0]
-first_node = 13
-first_element = 201
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[joints]]
-id = 1
-type = "revolute"
-nodes = [11, 12]
-axis = [0.0, 0.0, 1.0]
-
-[[joint_springs]]
-id = 2
-joint = 1
-stiffness = 2.0
-free_value = 3.141592653589793
-
-[[latches]]
-id = 3
-joint = 1
-value = 1.5707963267948966
-"#
+{extra}"#
+        ),
+        4,
+        "",
     )
 }
 

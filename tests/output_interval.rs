@@ -4,9 +4,13 @@
 //! integrator's error; its checks and how it combines with `output_times`
 //! and `output_every`.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+use common::pendulum;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("unfold-oi-{}-{name}", std::process::id()));
@@ -57,43 +61,22 @@ fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
-/// A compound pendulum about a hinge on z: a body of m = 2 kg, J_c = 0.01
-/// kg·m² at d = 0.5 m below the hinge, launched from the bottom at
-/// θ̇0 = 4 rad/s (a swing of 0.95 rad: far from linear), over 2 s.
+/// The hanging pendulum of tests/common/pendulum.rs: a body of m = 2 kg,
+/// J_c = 0.01 kg·m² at d = 0.5 m below the hinge, launched from the bottom
+/// at θ̇0 = 4 rad/s (a swing of 0.95 rad: far from linear), over 2 s.
 fn pendulum(extra: &str) -> String {
-    format!(
-        r#"title = "compound pendulum"
+    pendulum::hanging(
+        &format!(
+            r#"title = "compound pendulum"
 [analysis]
 type = "dynamic"
 end_time = 2.0
 time_step = 0.001
 max_step = 0.01
-{extra}
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 2
-x = [0.0, -0.5, 0.0]
-angular_velocity = [0.0, 0.0, 4.0]
-velocity = [2.0, 0.0, 0.0]
-[[supports]]
-node = 1
-fixed = ["all"]
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 2.0
-inertia = [0.01, 0.01, 0.01]
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-[gravity]
-acceleration = [0.0, -9.81, 0.0]
-"#
+{extra}"#
+        ),
+        "angular_velocity = [0.0, 0.0, 4.0]\nvelocity = [2.0, 0.0, 0.0]",
+        "",
     )
 }
 

@@ -20,6 +20,8 @@
 //! rolling disc); for `R ≫ r` it is the classical `tan θ = (3/2) v²/(gR)`,
 //! `v = ΩR` (Greenwood; Goldstein, *Classical Mechanics*).
 
+mod common;
+
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -461,43 +463,21 @@ normal = [0.0, 0.0, 1.0]
     println!("{zero_radius}\n{normal}\n{apart}\n{flat}\n{e}");
 }
 
-/// The example of docs/model-format.md (`[[rolling_discs]]`): an upright
-/// disc rolling along +y at 2 m/s covers 2 m in 1 s (uniform motion,
-/// exact for the method up to Newton's tolerance: 1e-9).
+/// The example of docs/model-format.md (`[[rolling_discs]]`, the disc of
+/// tests/common/rolling_disc.rs): an upright disc rolling along +y at
+/// 2 m/s covers 2 m in 1 s (uniform motion, exact for the method up to
+/// Newton's tolerance: 1e-9).
 #[test]
 fn model_file_example_rolls() {
-    let text = r#"
+    let text = &common::rolling_disc::upright_disc(
+        r#"
 [analysis]
 type = "dynamic"
 end_time = 1.0
 time_step = 0.01
-adaptive = false
-
-[gravity]
-acceleration = [0.0, 0.0, -9.81]
-curve = "constant"
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.5]
-rotation = [0.0, 90.0, 0.0]
-unit = "deg"
-velocity = [0.0, 2.0, 0.0]
-angular_velocity = [-4.0, 0.0, 0.0]
-
-[[rigid_bodies]]
-id = 1
-node = 1
-mass = 1.0
-inertia = [0.0625, 0.0625, 0.125]
-
-[[rolling_discs]]
-id = 2
-node = 1
-radius = 0.5
-axis = [0.0, 0.0, 1.0]
-normal = [0.0, 0.0, 1.0]
-"#;
+adaptive = false"#,
+        -4.0,
+    );
     let input = parse_model(text, std::path::Path::new("disc.toml")).expect("parses");
     let model = Arc::new(Model::from_input(&input).expect("builds"));
     let settings = input.analyses().unwrap()[0].as_dynamic().unwrap().clone();

@@ -4,8 +4,11 @@
 //! turns by whole turns per step while every position looks right, is cut
 //! back instead of accepted; and fixed steps stay at `time_step`.
 
+mod common;
+
 use std::sync::Arc;
 
+use common::pendulum;
 use unfold::analysis::{
     CutbackInfo, DynamicAnalysis, DynamicSettings, Energies, IncrementInfo, NewtonFailure,
     Observer, WarningInfo,
@@ -156,46 +159,28 @@ fn fixed_steps_grow_back_to_time_step_and_no_further() {
         .any(|s| (s.step - h).abs() <= 1e-9 * h));
 }
 
-/// A compound pendulum (a body of m = 2 kg, J_c = 0.01 kg·m² at d = 0.5 m
-/// below a hinge on z, J_O = 0.51 kg·m²) launched from the bottom at
-/// `rate` rad/s, in fixed steps of `h` with ρ∞ = 0.5 over 10 s: steps
-/// far too long for the motion (a small swing has a period of 1.43 s),
-/// whose numerical dissipation takes energy out but never puts any in.
+/// The hanging pendulum of tests/common/pendulum.rs (a body of m = 2 kg,
+/// J_c = 0.01 kg·m² at d = 0.5 m below a hinge on z, J_O = 0.51 kg·m²)
+/// launched from the bottom at `rate` rad/s, in fixed steps of `h` with
+/// ρ∞ = 0.5 over 10 s: steps far too long for the motion (a small swing
+/// has a period of 1.43 s), whose numerical dissipation takes energy out
+/// but never puts any in.
 fn pendulum(rate: f64, h: f64) -> (Arc<Model>, DynamicSettings) {
-    let text = format!(
-        r#"title = "pendulum in long fixed steps"
+    let text = pendulum::hanging(
+        &format!(
+            r#"title = "pendulum in long fixed steps"
 [analysis]
 type = "dynamic"
 end_time = 10.0
 time_step = {h}
 adaptive = false
-rho_infinity = 0.5
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-[[nodes]]
-id = 2
-x = [0.0, -0.5, 0.0]
-angular_velocity = [0.0, 0.0, {rate}]
-velocity = [{v}, 0.0, 0.0]
-[[supports]]
-node = 1
-fixed = ["all"]
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = 2.0
-inertia = [0.01, 0.01, 0.01]
-[[joints]]
-id = 3
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-[gravity]
-acceleration = [0.0, -9.81, 0.0]
-"#,
-        v = 0.5 * rate
+rho_infinity = 0.5"#
+        ),
+        &format!(
+            "angular_velocity = [0.0, 0.0, {rate}]\nvelocity = [{v}, 0.0, 0.0]",
+            v = 0.5 * rate
+        ),
+        "",
     );
     let input =
         unfold::io::model_file::parse_model(&text, std::path::Path::new("pendulum.toml")).unwrap();

@@ -8,27 +8,24 @@
 
 mod common;
 
-use common::events::{run, Record};
+use common::events::{error_of, run, Record};
+use common::pendulum;
 use unfold::analysis::{ContactInfo, ContactKind};
 use unfold::model::input::ModelInput;
 use unfold::model::Model;
 use unfold::state::State;
 
-const G: f64 = 9.81;
-const MASS: f64 = 2.0;
+const G: f64 = common::ball::G;
+const MASS: f64 = common::ball::MASS;
 
 /// A point mass on node 1 at the origin, on a prismatic joint to the
-/// ground along z (its `slide` is the height), under gravity −z, with
-/// the stop `stop` and the tables `extra`.
+/// ground along z (its `slide` is the height), under gravity −z
+/// (tests/common/ball.rs), with the stop `stop` and the tables `extra`.
 fn ball(end_time: f64, stop: &str, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
-type = "dynamic"
-end_time = {end_time}
-time_step = 0.01
-
-[[nodes]]
+    common::ball::dropped(
+        end_time,
+        &format!(
+            r#"[[nodes]]
 id = 1
 x = [0.0, 0.0, 0.0]
 
@@ -47,13 +44,9 @@ position = [0.0, 0.0, 0.0]
 [[stops]]
 id = 20
 joint = 10
-{stop}
-
-[gravity]
-acceleration = [0.0, 0.0, -{G}]
-curve = "constant"
-{extra}
-"#
+{stop}"#
+        ),
+        extra,
     )
 }
 
@@ -258,51 +251,15 @@ fn an_elastic_ball_shuttles_between_two_stops() {
 /// round-off.
 #[test]
 fn a_hinged_bar_rebounds_from_a_stop() {
-    let (m, d, j, e) = (MASS, 0.5, 0.1, 0.6);
-    let text = format!(
+    let (m, d, j, e) = (pendulum::MASS, pendulum::DISTANCE, pendulum::INERTIA, 0.6);
+    let text = pendulum::onto_a_stop(
         r#"
 [analysis]
 type = "dynamic"
 end_time = 0.8
 time_step = 0.005
-error_tolerance = 1e-6
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 2
-x = [{d}, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[rigid_bodies]]
-id = 1
-node = 2
-mass = {m}
-inertia = [{j}, {j}, {j}]
-
-[[joints]]
-id = 7
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-position = [0.0, 0.0, 0.0]
-
-[[stops]]
-id = 8
-joint = 7
-lower = -60.0
-unit = "deg"
-restitution = {e}
-
-[gravity]
-acceleration = [0.0, -{G}, 0.0]
-curve = "constant"
-"#
+error_tolerance = 1e-6"#,
+        e,
     );
     let (_, out, rec) = run(&text);
     let io = j + m * d * d;
@@ -391,14 +348,6 @@ fn a_contact_is_released_when_its_load_vanishes() {
     let z = G * 0.2f64.powi(3) / 3.0;
     eprintln!("z(0.7) = {} (closed form {z})", s.x[0].z);
     assert!((s.x[0].z - z).abs() <= 1e-3 * z, "{} {z}", s.x[0].z);
-}
-
-fn error_of(text: &str) -> String {
-    let input: ModelInput = toml::from_str(text).expect("valid toml");
-    match Model::from_input(&input) {
-        Ok(_) => panic!("accepted"),
-        Err(e) => e.to_string(),
-    }
 }
 
 /// Input errors name the stop and say what is wrong; `unfold check`

@@ -1,10 +1,17 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod ball;
 pub mod elliptic;
 pub mod events;
+pub mod flexible_hinge;
+pub mod hinged_body;
+pub mod hinged_panel;
+pub mod pendulum;
 pub mod quadrature;
 pub mod rigid_body;
+pub mod rolling_disc;
+pub mod spring_latch;
 
 use std::sync::Arc;
 

@@ -2487,6 +2487,7 @@ impl Stepper for Dynamics<'_> {
         }
         run.balance.impact(springs.released, 0.0);
         locks.extend(springs.events);
+        let crossings = springs.crossings;
         // stops reached or released: impact, then a restart (§16.4)
         let contacts = self.stop_events(info)?;
         let run = &mut *self.run;
@@ -2499,6 +2500,9 @@ impl Stepper for Dynamics<'_> {
         observer.increment(info, model, &run.state, residual)?;
         for l in &locks {
             observer.lock(l);
+        }
+        for l in &crossings {
+            observer.band_crossing(l);
         }
         for c in &contacts {
             observer.contact(c);

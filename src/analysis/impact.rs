@@ -54,6 +54,15 @@ pub enum LatchEventKind {
     Lock,
     /// A spring latch's load reached its unlatch load: it released.
     Unlatch,
+    /// A latched spring latch's coordinate left its dead band across an
+    /// edge beyond which its spring acts ([`super::Observer::band_crossing`]).
+    Engage,
+    /// It came back into the dead band: the spring no longer acts.
+    Disengage,
+    /// A spring latch released beyond `c_L` came back to `c_L`: it may
+    /// lock again the next time it reaches it in the direction of
+    /// approach.
+    Rearm,
 }
 
 impl LatchEventKind {
@@ -62,12 +71,17 @@ impl LatchEventKind {
         match self {
             Self::Lock => "lock",
             Self::Unlatch => "unlatch",
+            Self::Engage => "engage",
+            Self::Disengage => "disengage",
+            Self::Rearm => "rearm",
         }
     }
 }
 
 /// A latch that locked (or a spring latch that released) during a dynamic
-/// analysis ([`super::Observer::lock`]).
+/// analysis ([`super::Observer::lock`]); or a spring latch's coordinate
+/// crossing an edge of its dead band, or coming back to `c_L` after a
+/// release beyond it ([`super::Observer::band_crossing`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LockInfo {
     /// What happened.
@@ -560,6 +574,11 @@ pub fn lock_latches(
 pub struct SpringLatching {
     /// The locks and releases, in the order of the latches.
     pub events: Vec<LockInfo>,
+    /// The crossings of the edges of the dead bands where a spring
+    /// engages or disengages, and the returns to `c_L` of latches released
+    /// beyond it, in the order of the latches (at the same state: the
+    /// steps land on them as on the locks).
+    pub crossings: Vec<LockInfo>,
     /// The energy the springs of the latches that released held.
     pub released: f64,
     /// Whether a load jumped (a release, or a lock with a dashpot moving):
@@ -611,27 +630,24 @@ pub fn spring_latch_events_at(
                     out.released += energy;
                     LatchEventKind::Unlatch
                 }
-                SpringEvent::Rearm | SpringEvent::Band => break,
+                SpringEvent::Engage | SpringEvent::Disengage | SpringEvent::Rearm => {
+                    let kind = match event {
+                        SpringEvent::Engage => LatchEventKind::Engage,
+                        SpringEvent::Disengage => LatchEventKind::Disengage,
+                        _ => LatchEventKind::Rearm,
+                    };
+                    out.crossings.push(spring_event(l, state, kind, increment));
+                    break;
+                }
+                SpringEvent::Band => break,
             };
-            // the velocities do not jump
-            let rate = l.rate(state).0;
             out.events.push(LockInfo {
-                kind,
-                increment,
-                time: state.time,
-                latch: l.id(),
-                joint: l.joint(),
-                coordinate: l.coordinate(state),
-                rate_before: rate,
-                rate_after: rate,
-                impulse: 0.0,
                 energy_lost: if kind == LatchEventKind::Unlatch {
                     energy
                 } else {
                     0.0
                 },
-                kinetic_energy_drop: 0.0,
-                velocity_correction: 0.0,
+                ..spring_event(l, state, kind, increment)
             });
             if kind == LatchEventKind::Unlatch || l.watch(state, tol) > 1.0 {
                 break;
@@ -642,6 +658,27 @@ pub fn spring_latch_events_at(
         l.flip_watch_sign(state);
     }
     out
+}
+
+/// The record of a spring latch's event `kind` at `state`: its coordinate
+/// and rate there (the velocities do not jump), no impulse, no energy
+/// lost.
+fn spring_event(l: &Latch, state: &State, kind: LatchEventKind, increment: usize) -> LockInfo {
+    let rate = l.rate(state).0;
+    LockInfo {
+        kind,
+        increment,
+        time: state.time,
+        latch: l.id(),
+        joint: l.joint(),
+        coordinate: l.coordinate(state),
+        rate_before: rate,
+        rate_after: rate,
+        impulse: 0.0,
+        energy_lost: 0.0,
+        kinetic_energy_drop: 0.0,
+        velocity_correction: 0.0,
+    }
 }
 
 // ---------- unilateral stops (docs/theory.md §16.4) ----------

@@ -132,6 +132,12 @@ pub trait Observer {
     /// post-event state, first).
     fn lock(&mut self, _info: &LockInfo) {}
 
+    /// After the step on which a spring latch's spring engaged or
+    /// disengaged at an edge of its dead band, or a spring latch released
+    /// beyond its value came back to it ([`LockInfo::kind`]: `Engage`,
+    /// `Disengage`, `Rearm`; after [`Observer::lock`] for the same step).
+    fn band_crossing(&mut self, _info: &LockInfo) {}
+
     /// After the step on which a stop was struck, closed or released
     /// (reported to [`Observer::increment`], with the post-event state,
     /// first).

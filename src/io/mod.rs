@@ -13,6 +13,8 @@
 //!   run continues;
 //! - [`vtk`]: the VTK unstructured-grid (`.vtu`) and collection (`.pvd`)
 //!   writers;
+//! - [`peaks`]: the largest loads of latches, stops and contacts over a
+//!   run, for `summary.json`;
 //! - [`plot`]: line charts of result histories, as SVG and PNG files;
 //! - [`histories`]: the charts of a run for a report (joint coordinates,
 //!   hinge moments, energies), drawn from its result files.
@@ -20,6 +22,7 @@
 pub mod histories;
 pub mod model_file;
 pub mod modes;
+pub mod peaks;
 pub mod plot;
 pub mod restart;
 pub mod results;

@@ -372,6 +372,16 @@ pub struct Summary {
     /// "Modes").
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub modes: Vec<super::modes::ModalRecord>,
+    /// The largest load of each latch over the run, and when it locked
+    /// (docs/results.md, "Peak loads").
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub latches: Vec<super::peaks::LatchPeak>,
+    /// The same for each stop, and when it first closed.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stops: Vec<super::peaks::StopPeak>,
+    /// The same for each contact between bodies.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<super::peaks::StopPeak>,
     /// Iterations of the initial equilibria, left out of the average.
     #[serde(skip)]
     initial_iterations: usize,
@@ -439,6 +449,9 @@ impl Summary {
             warnings: Vec::new(),
             increment_log: Vec::new(),
             modes: Vec::new(),
+            latches: Vec::new(),
+            stops: Vec::new(),
+            contacts: Vec::new(),
             initial_iterations: 0,
             unknowns: dofs,
         }

@@ -47,6 +47,7 @@ use std::sync::atomic::{AtomicI32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use super::modes::ModalFiles;
+use super::peaks::PeakLoads;
 use super::restart::RestartWriter;
 use super::results::{
     file_error, AnalysisEnd, DynamicRecord, EventRow, ResultWriter, RunStatus, Summary,
@@ -489,6 +490,8 @@ pub struct Recorder {
     latches: Vec<LatchWatch>,
     /// The stops and contacts over the running analysis.
     stops: Vec<StopWatch>,
+    /// The largest loads of the latches, stops and contacts over the run.
+    peaks: PeakLoads,
 }
 
 /// What the recorder follows of a stop or contact over a dynamic
@@ -785,6 +788,7 @@ impl Recorder {
             motion: None,
             latches: Vec::new(),
             stops: Vec::new(),
+            peaks: PeakLoads::of(model),
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -1062,6 +1066,9 @@ impl Recorder {
         let (element, on_joint, bare) = match row.kind {
             "lock" => ("latch", "locks joint", "locks"),
             "unlatch" => ("latch", "releases joint", "releases"),
+            "engage" => ("latch", "spring engages on joint", "spring engages"),
+            "disengage" => ("latch", "spring disengages on joint", "spring disengages"),
+            "rearm" => ("latch", "rearms on joint", "rearms"),
             "impact" => ("stop", "impact of joint", "impact"),
             "contact" => ("stop", "contact closed on joint", "contact closed"),
             _ => ("stop", "contact released on joint", "contact released"),
@@ -1143,6 +1150,9 @@ impl Recorder {
                 output_errors.push(e);
             }
         }
+        self.summary.latches = self.peaks.latches();
+        self.summary.stops = self.peaks.stops();
+        self.summary.contacts = self.peaks.contacts();
         self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
         // the initial equilibria's iterations are counted in the total,
@@ -1293,6 +1303,7 @@ impl Observer for Recorder {
             });
         }
         let info = &self.renumbered(info);
+        self.peaks.sample(model, state, info.increment);
         // a kinematic analysis has no loads: its residual is all constraint
         // violation, measured against the tolerance of each constraint
         let (what, values) = if self.current.kind == "kinematic" {
@@ -1383,6 +1394,8 @@ impl Observer for Recorder {
     }
 
     fn lock(&mut self, info: &LockInfo) {
+        self.peaks
+            .unlatched(info, info.increment + self.increment_offset);
         self.write_event(&EventRow {
             increment: info.increment + self.increment_offset,
             time: info.time,
@@ -1395,6 +1408,10 @@ impl Observer for Recorder {
             impulse: info.impulse,
             energy_lost: info.energy_lost,
         });
+    }
+
+    fn band_crossing(&mut self, info: &LockInfo) {
+        self.lock(info);
     }
 
     fn contact(&mut self, info: &ContactInfo) {

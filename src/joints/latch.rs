@@ -136,8 +136,15 @@ pub enum SpringEvent {
     /// The coordinate of a released latch came back to `c_L` from beyond
     /// it: it may lock again the next time it reaches it.
     Rearm,
-    /// An edge of the dead band: the spring engages or disengages (or the
-    /// coordinate grazes the edge and turns back).
+    /// The coordinate left the dead band across an edge beyond which the
+    /// spring acts: the spring engages.
+    Engage,
+    /// The coordinate came back into the dead band from beyond an edge
+    /// where the spring acted: the spring disengages.
+    Disengage,
+    /// An edge of the dead band where nothing changes: the coordinate
+    /// grazes the edge and turns back, or crosses an edge on the free side
+    /// of a one-sided latch.
     Band,
 }
 
@@ -345,15 +352,27 @@ impl Latch {
                 SpringEvent::Unlatch
             } else {
                 let side = self.side(state);
-                if side == 0.0 {
+                let next = if side == 0.0 {
                     let out = if x >= 0.0 { 1.0 } else { -1.0 };
                     if out * rate > 0.0 {
-                        state.internal[slot + SIDE] = out;
+                        out
+                    } else {
+                        side
                     }
                 } else if side * rate < 0.0 {
-                    state.internal[slot + SIDE] = 0.0;
+                    0.0
+                } else {
+                    side
+                };
+                state.internal[slot + SIDE] = next;
+                // the side's sign stands for x: whether the spring acts there
+                if next != side && next != 0.0 && s.acts_at(next) {
+                    SpringEvent::Engage
+                } else if next != side && next == 0.0 && s.acts_at(side) {
+                    SpringEvent::Disengage
+                } else {
+                    SpringEvent::Band
                 }
-                SpringEvent::Band
             }
         };
         Some(event)

@@ -1,0 +1,274 @@
+//! The largest load each latch, stop and contact carried over a run, for
+//! `summary.json` (docs/results.md, "Peak loads"): the load of the
+//! element's result file (`latches.csv`, `stops.csv`, `contacts.csv`) at
+//! every converged increment, output or not, of every analysis of the
+//! run.
+//!
+//! - a rigid latch: the reaction of its constraint `kλ − pΦ` (J8,
+//!   docs/joints.md §6.2), the moment or force that holds the lock;
+//! - a spring latch: its spring and dashpot, `−(f_s + d ċ)`;
+//! - a stop: its contact load `N`; a contact: its normal force.
+//!
+//! The loads are sampled at the converged increments: a peak between two
+//! of them is missed by the amount the load changes over a step, and an
+//! impact's impulse (an instantaneous load, `events.csv`) is not a load.
+//! A spring latch that releases carries its unlatch load on the step that
+//! landed on the release, whose state the analysis reports released: that
+//! load is taken from the event ([`PeakLoads::unlatched`]).
+
+use serde::Serialize;
+
+use crate::analysis::{LatchEventKind, LockInfo};
+use crate::elements::{Element, Need};
+use crate::joints::latch::SpringLatch;
+use crate::model::{Id, Model};
+use crate::state::State;
+
+/// The largest load of a latch over the run (`summary.json`, `latches`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LatchPeak {
+    /// The latch.
+    pub latch: Id,
+    /// The joint whose coordinate it locks.
+    pub joint: Id,
+    /// `rigid` or `spring`.
+    pub mode: &'static str,
+    /// `moment` (an angle's latch, model force × length) or `force`.
+    pub quantity: &'static str,
+    /// The time of the first converged increment at which it was locked
+    /// (`null`: never locked).
+    pub locked_at: Option<f64>,
+    /// Its load of largest magnitude, with its sign (positive pushing the
+    /// coordinate up, as `load` in `latches.csv`).
+    #[serde(flatten)]
+    pub peak: Peak,
+}
+
+/// The largest load of a stop or contact over the run (`summary.json`,
+/// `stops` and `contacts`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StopPeak {
+    /// The stop (absent for a contact).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stop: Option<Id>,
+    /// The contact (absent for a stop).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<Id>,
+    /// The joint whose coordinate the stop limits (absent for a contact).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub joint: Option<Id>,
+    /// `moment` (a stop on an angle) or `force`.
+    pub quantity: &'static str,
+    /// The time of the first converged increment at which it was closed
+    /// (`null`: never; an impact that rebounds does not close it).
+    pub closed_at: Option<f64>,
+    /// Its load of largest magnitude, with its sign (positive pushing the
+    /// coordinate back into its range, as `load` in `stops.csv`; for a
+    /// contact pushing the bodies apart, as `force` in `contacts.csv`).
+    #[serde(flatten)]
+    pub peak: Peak,
+}
+
+/// The load of largest magnitude over the converged increments so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Peak {
+    /// The load, with its sign; 0 if none was carried.
+    pub peak_load: f64,
+    /// The time of the increment at which it was carried (the first, if
+    /// several carried it; `null` if no load was).
+    pub peak_time: Option<f64>,
+    /// That increment, numbered across the run as in `steps.csv`.
+    pub peak_increment: Option<usize>,
+}
+
+impl Peak {
+    /// Keeps `load`, at `time` and `increment`, if its magnitude is above
+    /// the peak's.
+    fn take(&mut self, load: f64, time: f64, increment: usize) {
+        if load.abs() > self.peak_load.abs() {
+            *self = Self {
+                peak_load: load,
+                peak_time: Some(time),
+                peak_increment: Some(increment),
+            };
+        }
+    }
+}
+
+/// A peak being followed: the element's index, the place of its load and
+/// of its lock or contact flag among its results; for a spring latch, its
+/// spring and locking value (its load at a release).
+#[derive(Clone, Debug)]
+struct Followed {
+    element: usize,
+    load: usize,
+    flag: usize,
+    spring: Option<(SpringLatch, f64)>,
+}
+
+/// Follows the loads of a model's latches, stops and contacts over a run.
+#[derive(Clone, Debug, Default)]
+pub struct PeakLoads {
+    latches: Vec<(Followed, LatchPeak)>,
+    stops: Vec<(Followed, StopPeak)>,
+}
+
+impl PeakLoads {
+    /// The latches, stops and contacts of `model`, none loaded yet.
+    pub fn of(model: &Model) -> Self {
+        let place = |e: &dyn Element, name: &str| {
+            e.result_names()
+                .iter()
+                .position(|n| *n == name)
+                .unwrap_or(0)
+        };
+        let mut peaks = Self::default();
+        for (element, e) in model.elements.iter().enumerate() {
+            let e = e.as_ref();
+            if let Some(l) = e.as_latch() {
+                let followed = Followed {
+                    element,
+                    load: place(e, "load"),
+                    flag: place(e, "locked"),
+                    spring: l.spring().map(|s| (*s, l.value())),
+                };
+                peaks.latches.push((
+                    followed,
+                    LatchPeak {
+                        latch: e.id(),
+                        joint: l.joint(),
+                        mode: if l.spring().is_some() {
+                            "spring"
+                        } else {
+                            "rigid"
+                        },
+                        quantity: quantity(l.is_angle()),
+                        locked_at: None,
+                        peak: Peak::default(),
+                    },
+                ));
+            } else if let Some(s) = e.as_stop() {
+                let contact = s.joint().is_none();
+                let followed = if contact {
+                    Followed {
+                        element,
+                        load: place(e, "force"),
+                        flag: place(e, "closed"),
+                        spring: None,
+                    }
+                } else {
+                    Followed {
+                        element,
+                        load: place(e, "load"),
+                        flag: place(e, "contact"),
+                        spring: None,
+                    }
+                };
+                peaks.stops.push((
+                    followed,
+                    StopPeak {
+                        stop: (!contact).then(|| e.id()),
+                        contact: contact.then(|| e.id()),
+                        joint: s.joint(),
+                        quantity: quantity(s.is_angle()),
+                        closed_at: None,
+                        peak: Peak::default(),
+                    },
+                ));
+            }
+        }
+        // in increasing id, as the rows of the result files
+        peaks.latches.sort_by_key(|(_, p)| p.latch);
+        peaks.stops.sort_by_key(|(_, p)| p.stop.or(p.contact));
+        peaks
+    }
+
+    /// Whether the model has nothing to follow.
+    pub fn is_empty(&self) -> bool {
+        self.latches.is_empty() && self.stops.is_empty()
+    }
+
+    /// Takes the loads at the converged increment `increment` (numbered
+    /// across the run) of `model`, at `state`.
+    pub fn sample(&mut self, model: &Model, state: &State, increment: usize) {
+        if self.is_empty() {
+            return;
+        }
+        let ctx = model.context(state.time, Need::RESIDUAL);
+        let mut values = [0.0; 8];
+        let mut take = |f: &Followed| -> Option<(f64, bool)> {
+            let e = model.elements.get(f.element)?;
+            let n = e.result_names().len().min(values.len());
+            let v = &mut values[..n];
+            v.fill(0.0);
+            e.results(&ctx, state, v);
+            Some((v[f.load], v[f.flag] != 0.0))
+        };
+        let time = state.time;
+        for (f, p) in &mut self.latches {
+            if let Some((load, locked)) = take(f) {
+                if locked && p.locked_at.is_none() {
+                    p.locked_at = Some(time);
+                }
+                p.peak.take(load, time, increment);
+            }
+        }
+        for (f, p) in &mut self.stops {
+            if let Some((load, closed)) = take(f) {
+                if closed && p.closed_at.is_none() {
+                    p.closed_at = Some(time);
+                }
+                p.peak.take(load, time, increment);
+            }
+        }
+    }
+
+    /// A spring latch released at `event` (numbered across the run as
+    /// `increment`): the load it carried at the release, on the state the
+    /// step landed on, which [`Self::sample`] sees released (the latch
+    /// reached its unlatch load there), `−(f_s(x) + d ċ)`.
+    pub fn unlatched(&mut self, event: &LockInfo, increment: usize) {
+        if event.kind != LatchEventKind::Unlatch {
+            return;
+        }
+        for (f, p) in &mut self.latches {
+            if let (true, Some((spring, value))) = (p.latch == event.latch, f.spring) {
+                let x = event.coordinate - value;
+                let load = -(spring.spring_force(x).0 + spring.dashpot(x) * event.rate_before);
+                p.peak.take(load, event.time, increment);
+            }
+        }
+    }
+
+    /// The latches' peaks, in increasing id.
+    pub fn latches(&self) -> Vec<LatchPeak> {
+        self.latches.iter().map(|(_, p)| p.clone()).collect()
+    }
+
+    /// The stops' peaks (contacts excluded), in increasing id.
+    pub fn stops(&self) -> Vec<StopPeak> {
+        self.stops
+            .iter()
+            .filter(|(_, p)| p.stop.is_some())
+            .map(|(_, p)| p.clone())
+            .collect()
+    }
+
+    /// The contacts' peaks, in increasing id.
+    pub fn contacts(&self) -> Vec<StopPeak> {
+        self.stops
+            .iter()
+            .filter(|(_, p)| p.contact.is_some())
+            .map(|(_, p)| p.clone())
+            .collect()
+    }
+}
+
+/// The name of the load along an angle or a length.
+fn quantity(angle: bool) -> &'static str {
+    if angle {
+        "moment"
+    } else {
+        "force"
+    }
+}

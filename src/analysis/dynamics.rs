@@ -24,13 +24,15 @@
 //!   vibrations the step does not resolve (D11a) and measured node by
 //!   node in the metric of the mass (D11b);
 //! - the energy balance of every step ([`super::energy`], D12);
-//! - at `ρ∞ ≥ 0.99`, the projection of the converged velocities on the
-//!   velocity constraints, which keeps the undamped parasitic modes of the
-//!   index-3 constraints from growing (D13);
+//! - after every step, the projection of the converged velocities on the
+//!   velocity constraints (D13), with the accelerations and multipliers
+//!   along the method's relations below `ρ∞ = 0.99` (D13a): without it
+//!   the index-3 scheme is unstable on turning constraints once `hω`
+//!   exceeds a bound that vanishes as `ρ∞ → 1` (docs/theory.md §15.7);
 //! - the positions projected on the constraints before the restart after
-//!   an impact (D14), and the normal part of the velocities rescaled with
-//!   the step when its size changes (D15), so that neither kicks the
-//!   multipliers into the alternating transient of the index-3 scheme.
+//!   an impact (D14), and `a − v̇` not enlarged when the step grows (D15),
+//!   so that neither kicks the multipliers into the alternating transient
+//!   of the index-3 scheme.
 //!
 //! Node velocities are `(ẋ, Ω)`, `ẋ` global and `Ω` material, as in the
 //! inertia kernels (docs/theory.md §11.1). Multipliers are kept in the
@@ -1169,7 +1171,7 @@ fn constraint_name(model: &Model, solver: &NewtonSolver, dof: usize) -> String {
 }
 
 /// Weight of the unknowns without mass in the metric of the projections
-/// (D13–D15), relative to the largest mass of their kind: small enough that
+/// (D13–D14), relative to the largest mass of their kind: small enough that
 /// the projections move them rather than the unknowns with mass (with
 /// their stiffness rows as weight, a massless hinge node joined rigidly to
 /// a panel shared each correction with the panel: an energy error of
@@ -1186,7 +1188,7 @@ enum MasslessRows {
     /// nothing holds follow from their equilibrium.
     Stiffness,
     /// [`LIGHT_WEIGHT`] times the mass scale of their kind on the diagonal
-    /// (D13–D15): the `M`-orthogonal projections, whose metric `M` alone
+    /// (D13–D14): the `M`-orthogonal projections, whose metric `M` alone
     /// would be singular there, move them first.
     Light,
 }

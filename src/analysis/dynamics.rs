@@ -24,13 +24,15 @@
 //!   vibrations the step does not resolve (D11a) and measured node by
 //!   node in the metric of the mass (D11b);
 //! - the energy balance of every step ([`super::energy`], D12);
-//! - at `ρ∞ ≥ 0.99`, the projection of the converged velocities on the
-//!   velocity constraints, which keeps the undamped parasitic modes of the
-//!   index-3 constraints from growing (D13);
+//! - after every step, the projection of the converged velocities on the
+//!   velocity constraints (D13), with the accelerations and multipliers
+//!   along the method's relations below `ρ∞ = 0.99` (D13a): without it
+//!   the index-3 scheme is unstable on turning constraints once `hω`
+//!   exceeds a bound that vanishes as `ρ∞ → 1` (docs/theory.md §15.7);
 //! - the positions projected on the constraints before the restart after
-//!   an impact (D14), and the normal part of the velocities rescaled with
-//!   the step when its size changes (D15), so that neither kicks the
-//!   multipliers into the alternating transient of the index-3 scheme.
+//!   an impact (D14), and `a − v̇` not enlarged when the step grows (D15),
+//!   so that neither kicks the multipliers into the alternating transient
+//!   of the index-3 scheme.
 //!
 //! Node velocities are `(ẋ, Ω)`, `ẋ` global and `Ω` material, as in the
 //! inertia kernels (docs/theory.md §11.1). Multipliers are kept in the
@@ -90,11 +92,10 @@ const MOTION_STEP: f64 = 1e-3;
 /// `ε/1e-5` ~2e-11 of the velocities.
 const PROJECTION_STEP: f64 = 1e-5;
 
-/// The spectral radius from which the velocities are projected on the
-/// velocity constraints after each step (D13). Below it, the parasitic
-/// modes of the index-3 constraints decay as `ρ∞ⁿ` (their growth
-/// `n ρ∞ⁿ` peaks below 37 at `ρ∞ = 0.99`); at `ρ∞ = 1` they grow as `n`
-/// and stop the analysis.
+/// The spectral radius below which the projection of the velocities on
+/// the velocity constraints (D13) also corrects the pseudo-accelerations,
+/// the accelerations and the multipliers along the method's relations
+/// (D13a); from it up, the velocities alone.
 pub const PROJECTION_RHO: f64 = 0.99;
 
 /// Applications of the filter of the local error estimate (D11a): the
@@ -174,12 +175,22 @@ impl GeneralizedAlpha {
         (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * h * h)
     }
 
-    /// Whether the converged velocities of each step are projected on the
-    /// velocity constraints (D13): for `ρ∞ ≥` [`PROJECTION_RHO`], where the
-    /// parasitic modes of the index-3 constraints are not damped
-    /// (`ρ∞ = α_f/(1 − α_f)`).
-    pub fn projects_velocities(&self) -> bool {
+    /// Whether the projection of the velocities (D13) changes the
+    /// velocities alone: for `ρ∞ ≥` [`PROJECTION_RHO`]
+    /// (`ρ∞ = α_f/(1 − α_f)`). Below it, D13a.
+    pub fn projects_velocities_only(&self) -> bool {
         self.alpha_f / (1.0 - self.alpha_f) >= PROJECTION_RHO
+    }
+
+    /// `(1/(γh), c)`, `c = (1 − α_m)/((1 − α_f) γ h)`: a change `δv` of
+    /// the velocities made along the method's relations (D6 with
+    /// `x = (βh/γ) δv`, positions kept) changes `a` by `δv/(γh)` and `v̇`
+    /// by `c δv` (D13a).
+    pub fn velocity_to_accelerations(&self, h: f64) -> (f64, f64) {
+        (
+            1.0 / (self.gamma * h),
+            (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.gamma * h),
+        )
     }
 
     /// `γ′ = γ/(β h)`: `δv = γ′ x` (D6).
@@ -352,10 +363,6 @@ struct Run {
     mass_system: MassSystem,
     /// The span of the analysis, `end_time − t₀` (D13).
     span: f64,
-    /// The part of the accepted velocities normal to the velocity
-    /// constraints in the metric of the mass (D15), by node and by
-    /// coordinate, once a step of another size than the last needs it.
-    normal_velocity: Option<(Vec<[f64; 6]>, Vec<f64>)>,
     redundant: usize,
     /// The unknown with the largest residual at the last failed attempt.
     location: String,
@@ -592,7 +599,6 @@ impl DynamicAnalysis {
             // a continued run (a restart within the analysis) keeps the
             // span of the analysis, as the run never stopped did
             span: (s.end_time - if self.continued { s.start_time } else { t0 }).abs(),
-            normal_velocity: None,
             redundant: 0,
             location: String::new(),
             locks: Vec::new(),
@@ -1165,7 +1171,7 @@ fn constraint_name(model: &Model, solver: &NewtonSolver, dof: usize) -> String {
 }
 
 /// Weight of the unknowns without mass in the metric of the projections
-/// (D13–D15), relative to the largest mass of their kind: small enough that
+/// (D13–D14), relative to the largest mass of their kind: small enough that
 /// the projections move them rather than the unknowns with mass (with
 /// their stiffness rows as weight, a massless hinge node joined rigidly to
 /// a panel shared each correction with the panel: an energy error of
@@ -1182,7 +1188,7 @@ enum MasslessRows {
     /// nothing holds follow from their equilibrium.
     Stiffness,
     /// [`LIGHT_WEIGHT`] times the mass scale of their kind on the diagonal
-    /// (D13–D15): the `M`-orthogonal projections, whose metric `M` alone
+    /// (D13–D14): the `M`-orthogonal projections, whose metric `M` alone
     /// would be singular there, move them first.
     Light,
 }
@@ -1554,18 +1560,10 @@ impl Dynamics<'_> {
         s.clone_from(n);
         s.time = n.time + h;
         // a_n − v̇_n is O(h) (a is the acceleration at t_n + (α_m − α_f)h
-        // to first order): scaled with the step when its size changes
-        let ratio = run.last_step.map_or(1.0, |hp| h / hp);
-        // with constraints below PROJECTION_RHO, the normal part v_N of
-        // v_n with (v_N, h(a_n − v̇_n)) mapped by the similarity s = r² for
-        // r ≤ 1 and s = r for r > 1 (D15)
-        let (w, ratio_a, normal, normal_coordinates) = match &run.normal_velocity {
-            Some((v, c)) => {
-                let sim = if ratio <= 1.0 { ratio * ratio } else { ratio };
-                (sim - 1.0, sim / ratio, v.as_slice(), c.as_slice())
-            }
-            None => (0.0, ratio, &[][..], &[][..]),
-        };
+        // to first order): scaled with the step when it shrinks, kept when
+        // it grows, so that growing steps do not amplify the transient of
+        // the multipliers it also holds (D15)
+        let ratio_a = run.last_step.map_or(1.0, |hp| (h / hp).min(1.0));
         let predict = |vn: f64, vdn: f64, an: f64| -> (f64, f64, f64, f64) {
             let an = vdn + (an - vdn) * ratio_a;
             let a = (sc.alpha_f * vdn - sc.alpha_m * an) / (1.0 - sc.alpha_m);
@@ -1580,7 +1578,7 @@ impl Dynamics<'_> {
                     continue;
                 }
                 let (an, a, v, dq) = predict(
-                    n.velocity[node][c] + normal.get(node).map_or(0.0, |u| w * u[c]),
+                    n.velocity[node][c],
                     n.acceleration[node][c],
                     n.pseudo_acceleration[node][c],
                 );
@@ -1598,7 +1596,7 @@ impl Dynamics<'_> {
                 continue;
             }
             let (an, a, v, dq) = predict(
-                n.coordinate_rates[k] + normal_coordinates.get(k).map_or(0.0, |u| w * u),
+                n.coordinate_rates[k],
                 n.coordinate_accelerations[k],
                 n.coordinate_pseudo_accelerations[k],
             );
@@ -1680,7 +1678,7 @@ impl Dynamics<'_> {
     ///
     /// (the matrix of D9), then assembles the residual again at the
     /// projected state for the observer (reactions, energy balance).
-    fn project_velocities(&mut self) -> Result<(), NewtonFailure> {
+    fn project_velocities(&mut self, h: f64) -> Result<(), NewtonFailure> {
         let (model, run) = (self.model, &mut *self.run);
         let dofs = &self.solver.dofs;
         if dofs.first_multiplier() == dofs.n_dofs() {
@@ -1742,12 +1740,29 @@ impl Dynamics<'_> {
         }));
         solve_mass_system(model, self.solver, state, rhs)?;
         let dofs = &self.solver.dofs;
+        // D13a: below PROJECTION_RHO, a, v̇ and λ follow δv as a Newton
+        // correction would (D6), so that the next step starts from a
+        // state whose equations of motion hold and whose pseudo-
+        // acceleration matches the projected velocities
+        let (da, dvd) = if self.scheme.projects_velocities_only() {
+            (0.0, 0.0)
+        } else {
+            self.scheme.velocity_to_accelerations(h)
+        };
         for (eq, z) in rhs.iter().enumerate() {
             let d = dofs.dof(eq);
             if let Some((node, c)) = dofs.node_component(d) {
                 state.velocity[node][c] += z;
+                state.pseudo_acceleration[node][c] += da * z;
+                state.acceleration[node][c] += dvd * z;
             } else if d < dofs.first_multiplier() {
-                state.coordinate_rates[d - dofs.first_coordinate()] += z;
+                let k = d - dofs.first_coordinate();
+                state.coordinate_rates[k] += z;
+                state.coordinate_pseudo_accelerations[k] += da * z;
+                state.coordinate_accelerations[k] += dvd * z;
+            } else {
+                // M δv = kBᵀμ: M δv̇ = c kBᵀμ is balanced by δλ = c μ
+                state.multipliers[d - dofs.first_multiplier()] += dvd * z * s_eq[eq];
             }
         }
         let (_, assembler, _) = self.solver.system();
@@ -1756,78 +1771,6 @@ impl Dynamics<'_> {
             ..model.context(state.time, Need::RESIDUAL)
         };
         assembler.assemble(model, &ctx, state);
-        Ok(())
-    }
-
-    /// D15: before a step of size `h` different from the last, `h_{n−1}`,
-    /// the normal part of the accepted velocities (`v_N = −δv` of D13,
-    /// the `M`-orthogonal projection of `v_n` on the normals of the velocity
-    /// constraints) is found once per accepted step; [`Self::predict`] then
-    /// starts from `v_n + (s − 1) v_N` and `v̇_n + (s/r)(a_n − v̇_n)`,
-    /// `r = h/h_{n−1}`, `s = r²` for `r ≤ 1` and `r` for `r > 1`. Below
-    /// [`PROJECTION_RHO`] the velocities of the index-3 scheme leave the
-    /// velocity constraints by `B v_n = O(h²)` (docs/theory.md §15.8): the
-    /// step of size `h` carries `r²` times the violation of the last, and
-    /// without the rescaling the difference, `(1 − r²) v_N`, goes into
-    /// `a_{n+1}` through the position constraints (D2) divided by `βh`:
-    /// after a step shortened to land on an output time, the alternating
-    /// transient of `v̇` and of the multipliers. A longer step takes
-    /// `s = r` rather than `r²`, which would amplify a transient already
-    /// there as the steps grow. Nothing is done with
-    /// projected velocities (`v_N = 0`), without constraints, or with
-    /// velocity constraints (rolling: their rows hold the velocities).
-    fn rescale_normal_velocity(&mut self, h: f64) -> Result<(), NewtonFailure> {
-        let (model, run) = (self.model, &mut *self.run);
-        // every change, round-off included: with the steps the controller
-        // reports, which differ from the last by up to 4e-12 of h, this
-        // runs at almost every step (13 % of the instructions of a step of
-        // an 80-element beam pendulum); comparing within 1e-9 of h instead
-        // left the driver of a hysteresis loop cycled in dynamics
-        // (tests/energy_balance.rs) with 1.2 % more work and a balance
-        // error of 7.7e-3 J against 6.5e-4 J, not explained yet
-        let changed = run.last_step.is_some_and(|hp| h != hp);
-        let dofs = &self.solver.dofs;
-        if !changed
-            || run.normal_velocity.is_some()
-            || self.scheme.projects_velocities()
-            || dofs.first_multiplier() == dofs.n_dofs()
-            || has_velocity_constraints(model)
-        {
-            return Ok(());
-        }
-        let state = &run.accepted;
-        let rate = constraint_rate(model, self.solver, state, run.span);
-        let (_, s_eq) = constrained_mass_system(
-            model,
-            self.solver,
-            state,
-            &mut run.mass_system,
-            None,
-            MasslessRows::Light,
-        )?;
-        let dofs = &self.solver.dofs;
-        let mut rhs: Vec<f64> = (0..dofs.n_equations())
-            .map(|eq| {
-                if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
-                    -rate[dofs.dof(eq)] * s_eq[eq]
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        solve_mass_system(model, self.solver, state, &mut rhs)?;
-        let dofs = &self.solver.dofs;
-        let mut nodes = vec![[0.0; 6]; state.n_nodes()];
-        let mut coordinates = vec![0.0; state.coordinates.len()];
-        for (eq, z) in rhs.iter().enumerate() {
-            let d = dofs.dof(eq);
-            if let Some((node, c)) = dofs.node_component(d) {
-                nodes[node][c] = -z;
-            } else if d < dofs.first_multiplier() {
-                coordinates[d - dofs.first_coordinate()] = -z;
-            }
-        }
-        run.normal_velocity = Some((nodes, coordinates));
         Ok(())
     }
 
@@ -2012,7 +1955,6 @@ impl Dynamics<'_> {
     ) -> Result<(usize, Vec<f64>), NewtonFailure> {
         let model = self.model;
         let sc = self.scheme;
-        self.rescale_normal_velocity(h)?;
         self.predict(h);
         self.run.dq_predicted.clone_from(&self.run.dq);
         self.run.watch.round_off = None;
@@ -2396,11 +2338,7 @@ impl Stepper for Dynamics<'_> {
                 // note on a long step has been given
                 let error = (self.settings.adaptive || !self.run.watch.fixed_step_noted)
                     .then(|| self.error_estimate(size));
-                if self.scheme.projects_velocities() {
-                    self.project_velocities().map(|()| (converged, error))
-                } else {
-                    Ok((converged, error))
-                }
+                self.project_velocities(size).map(|()| (converged, error))
             }) {
             Ok(((iterations, residuals), error)) => {
                 if let Some(what) = self.spurious(size) {
@@ -2435,7 +2373,6 @@ impl Stepper for Dynamics<'_> {
         // the controller may snap t onto a landing time within round-off
         run.state.time = info.time;
         run.last_step = Some(info.step);
-        run.normal_velocity = None;
         run.a_before.clone_from(&run.accepted.pseudo_acceleration);
         run.a_before_coordinates
             .clone_from(&run.accepted.coordinate_pseudo_accelerations);

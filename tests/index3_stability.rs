@@ -27,7 +27,13 @@ struct Record {
 }
 
 impl Observer for Record {
-    fn increment(&mut self, _: &IncrementInfo, _: &Model, _: &State, _: &[f64]) -> std::io::Result<()> {
+    fn increment(
+        &mut self,
+        _: &IncrementInfo,
+        _: &Model,
+        _: &State,
+        _: &[f64],
+    ) -> std::io::Result<()> {
         self.steps += 1;
         Ok(())
     }
@@ -104,7 +110,8 @@ fn largest_deviation(r: &Record) -> f64 {
 /// not used there, docs/theory.md §15.7): tolerance 2e-3. At ρ∞ = 0.5 the scheme's own dissipation of the
 /// rotation (an oscillation of the Cartesian coordinates at h·ω = 0.15)
 /// takes 1.8 % over the 14 turns (4.14e-2 J, the same in the planar
-/// implementation): tolerance 3 %, and T never above T₀ (1e-9 relative).
+/// implementation): tolerance 3 %; below ρ∞ = 1, T never above T₀
+/// (1e-9 relative).
 #[test]
 fn a_body_spinning_on_a_hinge_keeps_its_energy_at_every_rho() {
     let t0 = 0.5 * 0.51 * 9.0;
@@ -119,8 +126,15 @@ fn a_body_spinning_on_a_hinge_keeps_its_energy_at_every_rho() {
         let worst = largest_deviation(&r);
         let top = r.energies.iter().map(|e| e.kinetic).fold(0.0, f64::max);
         println!("ρ∞ = {rho}, h = {h}: largest |ΔT| = {worst:.3e} J of {t0} J");
-        assert!(worst < tolerance * t0, "ρ∞ = {rho}, h = {h}: |ΔT| = {worst:e} J");
-        assert!(top <= t0 * (1.0 + 1e-9), "ρ∞ = {rho}, h = {h}: T = {top} J");
+        assert!(
+            worst < tolerance * t0,
+            "ρ∞ = {rho}, h = {h}: |ΔT| = {worst:e} J"
+        );
+        // below ρ∞ = 1 the scheme only takes energy out (at ρ∞ = 1, T
+        // swings about T₀ within the tolerance above: 2.29575 J at most)
+        if rho < 1.0 {
+            assert!(top <= t0 * (1.0 + 1e-9), "ρ∞ = {rho}, h = {h}: T = {top} J");
+        }
     }
 }
 

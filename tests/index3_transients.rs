@@ -97,7 +97,9 @@ fn driven_acceleration(t: f64) -> f64 {
 /// (time, load) of every row.
 fn driver_errors(out: &Path) -> ([f64; 2], Vec<(f64, f64)>) {
     let rows = table(&out.join("drivers.csv"));
-    assert!(rows.len() > 300, "{} rows", rows.len());
+    // every step written: 292 to 298 rows (over 300 before the projection
+    // of the velocities at every step, docs/theory.md §15.7)
+    assert!(rows.len() > 250, "{} rows", rows.len());
     // the largest error during the stroke (t < 1) and after it
     let mut worst = [0.0f64; 2];
     for r in &rows {
@@ -124,23 +126,22 @@ fn driver_torque_is_j_theta_ddot_at_every_step_whatever_the_output_times() {
     for (name, times) in cases {
         let out = run_cli(&dir, name, &driven_hinge(times));
         let (worst, loads) = driver_errors(&out);
-        // measured 0.063, 0.052, 0.070 N·m (2.3 % of the 3.02 N·m peak;
-        // the largest at the start and just after t = 1, where the jerk of
-        // smooth_step jumps from 94 rad/s³ to 0 and the steps regrow);
-        // before D14–D15: 0.16, 0.16 and 3.56 N·m (117 % of the peak)
-        // during the stroke: 0.1 N·m (measured 0.051 in every case)
+        // before D14–D15: 0.16, 0.16 and 3.56 N·m (117 % of the peak);
+        // with D14–D15 and the velocities of the index-3 scheme 0.051 N·m
+        // in every case; with the projection at every step (D13–D13a,
+        // docs/theory.md §15.7) 2.7e-3 N·m in every case (0.09 % of the
+        // 3.02 N·m peak, the largest at the start): limit 0.01 N·m
         assert!(
-            worst[0] < 0.1,
+            worst[0] < 0.01,
             "{name}: largest error of the driver torque {:e} N·m",
             worst[0]
         );
-        // after it, where the jerk jumps to 0 and the steps regrow, the
-        // ringing of the index-3 multipliers at growing steps (D15 scales
-        // them by r, docs/theory.md §15.8) is left to ρ∞: measured 0.096
-        // and 0.162 N·m with and without output times (5 % of the peak);
-        // limit 0.2 N·m
+        // after it, where the jerk jumps to 0 and the steps regrow: the
+        // ringing of the index-3 multipliers was 0.096 and 0.162 N·m with
+        // and without output times (5 % of the peak); with the projection
+        // at every step 6.8e-4, 6.8e-3 and 2.1e-4 N·m: limit 0.02 N·m
         assert!(
-            worst[1] < 0.2,
+            worst[1] < 0.02,
             "{name}: largest error of the driver torque after the stroke {:e} N·m",
             worst[1]
         );
@@ -163,7 +164,7 @@ fn driver_torque_is_j_theta_ddot_at_every_step_whatever_the_output_times() {
         for b in &runs[i + 1..] {
             for &(t, p) in a {
                 if let Some(&(_, q)) = b.iter().find(|(u, _)| (u - t).abs() < 1e-9) {
-                    assert!((p - q).abs() < 0.2, "t = {t}: {p} and {q} N·m");
+                    assert!((p - q).abs() < 0.02, "t = {t}: {p} and {q} N·m");
                     shared += 1;
                 }
             }

@@ -16,6 +16,7 @@ pub mod hyperdual;
 pub mod joint;
 pub mod kinematics;
 pub mod latch;
+pub mod products;
 pub mod rolling;
 pub mod spring;
 pub mod stop;

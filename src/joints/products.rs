@@ -1,0 +1,331 @@
+//! Joint constraints as dot products, differentiated in closed form.
+//!
+//! Every equation of the joint library but the helical joint's and the
+//! slider's is a dot product `Φ = V·W` of two vectors of the form
+//!
+//! ```text
+//! V = c + Σ_N (s_N x_N + R_N α_N)
+//! ```
+//!
+//! over the element's nodes `N` (at most two): a constant, node positions
+//! and material vectors carried by the nodes (joint points, joint axes;
+//! docs/joints.md §2). Along the update of the unknowns (`x ← x + Δx`,
+//! `R ← R exp(ΔΘ~)`, docs/theory.md §2):
+//!
+//! ```text
+//! ∂V/∂x_N = s_N I          ∂V/∂Θ_N,k = R_N (e_k × α_N)
+//! ∂²V/∂Θ_N,a ∂Θ_N,b = R_N (e_b × (e_a × α_N))      (zero between other pairs)
+//! ```
+//!
+//! so that `∂Φ/∂q_r = V_r·W + V·W_r` and
+//! `∂²Φ/∂q_r∂q_c = V_r·W_c + V_c·W_r + W·V_rc + V·W_rc`, where
+//! `W·V_rc = ŵ_a α_b − δ_ab ŵ·α` with `ŵ = R_Nᵀ W`. These are the
+//! derivatives the hyper-dual evaluation of [`super::kinematics::Local`]
+//! gives (same order of the rotation updates, the tangent the residual's
+//! finite differences see), without its one evaluation of the formula per
+//! pair of unknowns.
+
+use super::kinematics::{Local, Pair};
+use super::types::JointType;
+use crate::so3::Vec3;
+
+/// Most local nodes of a joint written as dot products.
+const NODES: usize = 2;
+/// Most local unknowns (6 per node).
+const DOFS: usize = 6 * NODES;
+
+/// A vector `c + Σ_N (s_N x_N + R_N α_N)` of the configuration of an
+/// element's local nodes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Affine {
+    /// Constant part (global).
+    pub c: Vec3,
+    /// Coefficient of each node's position.
+    pub s: [f64; NODES],
+    /// Material vector carried by each node.
+    pub alpha: [Vec3; NODES],
+}
+
+impl Affine {
+    fn constant(c: Vec3) -> Self {
+        Self {
+            c,
+            ..Self::default()
+        }
+    }
+
+    fn on(node: usize, s: f64, alpha: Vec3) -> Self {
+        let mut v = Self::default();
+        v.s[node] = s;
+        v.alpha[node] = alpha;
+        v
+    }
+
+    fn sub(&self, o: &Self) -> Self {
+        Self {
+            c: self.c - o.c,
+            s: [self.s[0] - o.s[0], self.s[1] - o.s[1]],
+            alpha: [self.alpha[0] - o.alpha[0], self.alpha[1] - o.alpha[1]],
+        }
+    }
+
+    /// Value and first derivatives (`cols[r] = ∂V/∂q_r`) at `local`.
+    fn evaluate(&self, local: &Local, cols: &mut [Vec3; DOFS]) -> Vec3 {
+        let mut v = self.c;
+        for (n, (x, r)) in local.x.iter().zip(&local.r).enumerate() {
+            let (s, a) = (self.s[n], &self.alpha[n]);
+            v += x * s + r * a;
+            for k in 0..3 {
+                cols[6 * n + k] = Vec3::ith(k, s);
+            }
+            // R (e_k × α): e₁ × α = (0, −α₃, α₂), e₂ × α = (α₃, 0, −α₁),
+            // e₃ × α = (−α₂, α₁, 0)
+            cols[6 * n + 3] = r * Vec3::new(0.0, -a.z, a.y);
+            cols[6 * n + 4] = r * Vec3::new(a.z, 0.0, -a.x);
+            cols[6 * n + 5] = r * Vec3::new(-a.y, a.x, 0.0);
+        }
+        v
+    }
+
+    /// Adds `w · o·∂²V/∂Θ_N,a∂Θ_N,b` (row `a`, column `b` of node `N`'s
+    /// rotations) to the column-major `tangent` of leading dimension `ld`:
+    /// `w (ô_a α_b − δ_ab ô·α)`, `ô = R_Nᵀ o`.
+    fn add_second(&self, local: &Local, o: &Vec3, w: f64, tangent: &mut [f64], ld: usize) {
+        for (n, r) in local.r.iter().enumerate() {
+            let a = &self.alpha[n];
+            if *a == Vec3::zeros() {
+                continue;
+            }
+            let oh: Vec3 = r.transpose() * o;
+            let d = oh.dot(a);
+            for col in 0..3 {
+                for row in 0..3 {
+                    let diag = if row == col { d } else { 0.0 };
+                    tangent[(6 * n + 3 + col) * ld + 6 * n + 3 + row] +=
+                        w * (oh[row] * a[col] - diag);
+                }
+            }
+        }
+    }
+}
+
+/// The constraint equations of a joint as dot products `V·W`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Products {
+    /// One `(V, W)` per equation, in the order of [`super::types::constraints`].
+    pub equations: Vec<(Affine, Affine)>,
+}
+
+impl Products {
+    /// The equations of a joint of type `t` placed by `pair`, in the order
+    /// of [`super::types::constraints`]; `None` for the helical joint (its
+    /// equation holds the joint angle) and the slider.
+    pub fn of(t: JointType, pair: &Pair, lock_rotations: bool) -> Option<Self> {
+        // joint points and axes: node A is local node 0 and B local node 1,
+        // or A the ground and B local node 0
+        let (pa, ea, nb): (Affine, [Affine; 3], usize) = match &pair.ground {
+            Some((p, e)) => (
+                Affine::constant(*p),
+                [0, 1, 2].map(|i| Affine::constant(e.column(i).into_owned())),
+                0,
+            ),
+            None => (
+                Affine::on(0, 1.0, pair.a),
+                [0, 1, 2].map(|i| Affine::on(0, 0.0, pair.ea.column(i).into_owned())),
+                1,
+            ),
+        };
+        let pb = Affine::on(nb, 1.0, pair.b);
+        let eb: [Affine; 3] =
+            [0, 1, 2].map(|i| Affine::on(nb, 0.0, pair.eb.column(i).into_owned()));
+        let d = pb.sub(&pa);
+        let unit = |k: usize| Affine::constant(Vec3::ith(k, 1.0));
+        let point = [(unit(0), d), (unit(1), d), (unit(2), d)];
+        let axis = [(ea[0], eb[2]), (ea[1], eb[2])];
+        let equations: Vec<(Affine, Affine)> = match t {
+            JointType::Spherical => point.to_vec(),
+            JointType::Revolute => [&point[..], &axis[..]].concat(),
+            JointType::Universal => [&point[..], &[(ea[0], eb[1])]].concat(),
+            JointType::Cylindrical => [&axis[..], &[(d, ea[0]), (d, ea[1])]].concat(),
+            JointType::Prismatic => [&axis[..], &[(d, ea[0]), (d, ea[1]), (ea[0], eb[1])]].concat(),
+            JointType::Planar => [&axis[..], &[(d, ea[2])]].concat(),
+            JointType::Rigid | JointType::Glue => {
+                if t == JointType::Rigid || lock_rotations {
+                    [
+                        &point[..],
+                        &[(ea[0], eb[1]), (ea[1], eb[2]), (ea[2], eb[0])],
+                    ]
+                    .concat()
+                } else {
+                    point.to_vec()
+                }
+            }
+            JointType::Helical | JointType::Slider => return None,
+        };
+        Some(Self { equations })
+    }
+
+    /// Number of equations.
+    pub fn len(&self) -> usize {
+        self.equations.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.equations.is_empty()
+    }
+
+    /// Values `Φᵢ` and gradients `grad[i·n + r] = ∂Φᵢ/∂q_r` at `local`
+    /// (`n = local.n()`, every unknown).
+    pub fn gradient(&self, local: &Local, value: &mut [f64], grad: &mut [f64]) {
+        let n = local.n();
+        debug_assert!(n <= DOFS && local.x.len() <= NODES);
+        let mut cv = [Vec3::zeros(); DOFS];
+        let mut cw = [Vec3::zeros(); DOFS];
+        for (i, (v, w)) in self.equations.iter().enumerate() {
+            let vv = v.evaluate(local, &mut cv);
+            let wv = w.evaluate(local, &mut cw);
+            value[i] = vv.dot(&wv);
+            for r in 0..n {
+                grad[i * n + r] = cv[r].dot(&wv) + cw[r].dot(&vv);
+            }
+        }
+    }
+
+    /// Adds `Σᵢ wᵢ ∂²Φᵢ/∂q_r∂q_c` to `tangent[c·ld + r]` for every pair of
+    /// unknowns (column-major, leading dimension `ld`).
+    pub fn add_weighted_hessian(&self, local: &Local, w: &[f64], tangent: &mut [f64], ld: usize) {
+        let n = local.n();
+        let mut cv = [Vec3::zeros(); DOFS];
+        let mut cw = [Vec3::zeros(); DOFS];
+        for (i, (v, wv)) in self.equations.iter().enumerate() {
+            let wi = w[i];
+            if wi == 0.0 {
+                continue;
+            }
+            let vv = v.evaluate(local, &mut cv);
+            let ww = wv.evaluate(local, &mut cw);
+            // V_r·W_c + V_c·W_r: zero unless both vectors move
+            let moves = |a: &Affine| {
+                a.s.iter().any(|&s| s != 0.0) || a.alpha.iter().any(|a| *a != Vec3::zeros())
+            };
+            if moves(v) && moves(wv) {
+                for c in 0..n {
+                    for r in 0..n {
+                        tangent[c * ld + r] += wi * (cv[r].dot(&cw[c]) + cv[c].dot(&cw[r]));
+                    }
+                }
+            }
+            v.add_second(local, &ww, wi, tangent, ld);
+            wv.add_second(local, &vv, wi, tangent, ld);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::joints::hyperdual::HyperDual;
+    use crate::joints::kinematics::Conf;
+    use crate::joints::types::{constraint_kinds, constraints, JointParameters};
+    use crate::so3::{self, Rotation};
+    use crate::state::State;
+
+    /// The closed-form values, gradients and weighted second derivatives
+    /// equal those of the hyper-dual evaluation of the same equations
+    /// (`types::constraints`), for every joint type written as dot
+    /// products, between two nodes and to the ground, on random
+    /// configurations. Both are exact: the tolerance, 1e-12 of the largest
+    /// entry, is round-off.
+    #[test]
+    fn closed_form_matches_hyper_dual_evaluation() {
+        let mut seed = 11u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        let vec = |s: f64, next: &mut dyn FnMut() -> f64| Vec3::new(next(), next(), next()) * s;
+        let types = [
+            JointType::Revolute,
+            JointType::Prismatic,
+            JointType::Cylindrical,
+            JointType::Spherical,
+            JointType::Planar,
+            JointType::Universal,
+            JointType::Rigid,
+            JointType::Glue,
+        ];
+        let mut compared = 0;
+        for t in types {
+            for grounded in [false, true] {
+                for lock_rotations in [true, false] {
+                    for _ in 0..8 {
+                        let x: Vec<Vec3> = (0..2).map(|_| vec(1.0, &mut next)).collect();
+                        let q: Vec<Rotation> =
+                            (0..2).map(|_| so3::exp(&vec(2.0, &mut next))).collect();
+                        let e = so3::matrix(&so3::exp(&vec(2.0, &mut next)));
+                        let p = vec(1.0, &mut next);
+                        let (ra, rb) = (so3::matrix(&q[0]), so3::matrix(&q[1]));
+                        let pair = Pair::from_reference(
+                            &p,
+                            &e,
+                            (&x[0], &ra),
+                            (!grounded).then_some((&x[1], &rb)),
+                        );
+                        let products = Products::of(t, &pair, lock_rotations).unwrap();
+                        let m = constraint_kinds(t, lock_rotations).len();
+                        assert_eq!(products.len(), m, "{}", t.name());
+                        let nn = if grounded { 1 } else { 2 };
+                        let xs = x[..nn].iter().map(|x| x + vec(0.3, &mut next)).collect();
+                        let qs = q[..nn]
+                            .iter()
+                            .map(|q| q * so3::exp(&vec(0.6, &mut next)))
+                            .collect();
+                        let state = State::at_rest(0.0, xs, qs);
+                        let nodes: Vec<usize> = (0..nn).collect();
+                        let mut local = Local::default();
+                        local.gather(&state, &nodes, 0..0);
+                        let n = local.n();
+                        let params = JointParameters {
+                            lead: 0.0,
+                            lock_rotations,
+                            curve: None,
+                        };
+                        let f = |c: &Conf, out: &mut [HyperDual]| {
+                            constraints(t, &pair.frames(c), HyperDual::default(), &params, out)
+                        };
+                        let w: Vec<f64> = (0..m).map(|_| next()).collect();
+                        let active: Vec<usize> = (0..n).collect();
+                        let (mut v1, mut g1, mut h1) =
+                            (vec![0.0; m], vec![0.0; m * n], vec![0.0; n * n]);
+                        local.gradient(m, &active, &f, &mut v1, &mut g1);
+                        local.add_weighted_hessian(m, &active, &f, &w, &g1, true, &mut h1, n);
+                        let (mut v2, mut g2, mut h2) =
+                            (vec![0.0; m], vec![0.0; m * n], vec![0.0; n * n]);
+                        products.gradient(&local, &mut v2, &mut g2);
+                        products.add_weighted_hessian(&local, &w, &mut h2, n);
+                        let err = |a: &[f64], b: &[f64]| {
+                            let scale = a.iter().fold(1.0f64, |s, v| s.max(v.abs()));
+                            a.iter()
+                                .zip(b)
+                                .fold(0.0f64, |e, (a, b)| e.max((a - b).abs()))
+                                / scale
+                        };
+                        let what = format!("{} grounded {grounded}", t.name());
+                        assert!(err(&v1, &v2) < 1e-12, "{what}: values {v1:?} {v2:?}");
+                        assert!(err(&g1, &g2) < 1e-12, "{what}: gradients");
+                        assert!(
+                            err(&h1, &h2) < 1e-12,
+                            "{what}: second derivatives {:.2e}",
+                            err(&h1, &h2)
+                        );
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(compared, 8 * 2 * 2 * 8);
+    }
+}

@@ -95,14 +95,14 @@ fn add_product_constraints(
 }
 
 /// Local unknowns `0, 1, …` of a joint between two nodes.
-const ALL_DOFS: [usize; 12] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11];
+pub(crate) const ALL_DOFS: [usize; 12] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11];
 
 /// The terms of [`add_constraints`] of the first derivatives, given the
 /// values `phi` and gradients `grad` (`m × nq`): the residual
 /// `Bᵀ(pΦ − kλ)`, `−kΦ` and the tangent `p BᵀB`, `−k B`, `−k Bᵀ`.
 /// Returns the weights `wᵢ = pΦᵢ − kλᵢ` of the second-derivative term.
 #[allow(clippy::too_many_arguments)]
-fn add_first_order(
+pub(crate) fn add_first_order(
     ctx: &EvalContext,
     nq: usize,
     active: &[usize],

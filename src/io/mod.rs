@@ -13,6 +13,7 @@
 //!   run continues;
 //! - [`vtk`]: the VTK unstructured-grid (`.vtu`) and collection (`.pvd`)
 //!   writers;
+//! - [`number`]: numbers in scientific notation for `log.txt`;
 //! - [`plot`]: line charts of result histories, as SVG and PNG files;
 //! - [`histories`]: the charts of a run for a report (joint coordinates,
 //!   hinge moments, energies), drawn from its result files.
@@ -20,6 +21,7 @@
 pub mod histories;
 pub mod model_file;
 pub mod modes;
+pub mod number;
 pub mod plot;
 pub mod restart;
 pub mod results;

@@ -68,6 +68,8 @@ use crate::state::State;
 
 mod modal;
 
+use super::number::Sci;
+
 /// What a person watching the run sees. Every method has an empty
 /// default.
 pub trait Console {
@@ -1267,7 +1269,7 @@ impl Observer for Recorder {
         self.violations.push(info.norms.residual_constraint);
         let n = &info.norms;
         self.log.write_line(format_args!(
-            "    {} {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+            "    {} {} iteration {}: |r_F| {} (flux {})  |r_M| {} (flux {})  |r_C| {}  relative {}  max|c| {}  max|dx| {}  max|dθ| {}",
             if self.current.kind == "dynamic" {
                 "step"
             } else {
@@ -1275,15 +1277,15 @@ impl Observer for Recorder {
             },
             info.increment + self.increment_offset,
             info.iteration,
-            n.residual_force,
-            n.flux_force,
-            n.residual_moment,
-            n.flux_moment,
-            n.residual_coordinate,
-            n.relative_residual,
-            n.residual_constraint,
-            n.displacement_correction,
-            n.rotation_correction
+            Sci::<3>(n.residual_force),
+            Sci::<3>(n.flux_force),
+            Sci::<3>(n.residual_moment),
+            Sci::<3>(n.flux_moment),
+            Sci::<3>(n.residual_coordinate),
+            Sci::<3>(n.relative_residual),
+            Sci::<3>(n.residual_constraint),
+            Sci::<3>(n.displacement_correction),
+            Sci::<3>(n.rotation_correction),
         ));
     }
 
@@ -1343,12 +1345,15 @@ impl Observer for Recorder {
         text.clear();
         let _ = write!(
             text,
-            "{word} {:4}  t = {:.6}  {size} = {:.3e}  iterations {:2}  {what}: ",
-            info.increment, info.time, info.step, info.iterations,
+            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  {what}: ",
+            info.increment,
+            info.time,
+            Sci::<3>(info.step),
+            info.iterations,
         );
         for (k, r) in values.iter().enumerate() {
             let sep = if k == 0 { "" } else { " " };
-            let _ = write!(text, "{sep}{r:.1e}");
+            let _ = write!(text, "{sep}{}", Sci::<1>(*r));
         }
         self.line(&text);
         self.text = text;

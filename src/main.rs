@@ -584,6 +584,10 @@ impl Console for Terminal {
     }
 
     fn progress(&mut self, info: &IncrementInfo) {
+        // nothing formatted for a bar no one sees (output not a terminal)
+        if self.bar.is_hidden() {
+            return;
+        }
         self.bar
             .set_position((1000.0 * info.time / self.end_time).round() as u64);
         self.bar.set_message(format!(

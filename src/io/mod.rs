@@ -15,6 +15,7 @@
 //!   writers;
 //! - [`peaks`]: the largest loads of latches, stops and contacts over a
 //!   run, for `summary.json`;
+//! - [`number`]: numbers in scientific notation for `log.txt`;
 //! - [`plot`]: line charts of result histories, as SVG and PNG files;
 //! - [`histories`]: the charts of a run for a report (joint coordinates,
 //!   hinge moments, energies), drawn from its result files.
@@ -22,6 +23,7 @@
 pub mod histories;
 pub mod model_file;
 pub mod modes;
+pub mod number;
 pub mod peaks;
 pub mod plot;
 pub mod restart;

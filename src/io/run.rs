@@ -40,11 +40,13 @@
 //! The library never prints: what a person should see goes to a
 //! [`Console`], which the caller provides.
 
+use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicI32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
 
 use super::modes::ModalFiles;
 use super::peaks::PeakLoads;
@@ -66,6 +68,8 @@ use crate::model::{Id, Model};
 use crate::state::State;
 
 mod modal;
+
+use super::number::Sci;
 
 /// What a person watching the run sees. Every method has an empty
 /// default.
@@ -391,7 +395,14 @@ struct LogFile {
     error: Option<io::Error>,
     /// The error was reported to the analysis already.
     reported: bool,
+    /// When the file was last flushed.
+    flushed: Instant,
 }
+
+/// How often `log.txt` is flushed between output steps: a person following
+/// the file sees it at most this late, and a run of short steps does not
+/// pay a write to the file at every step.
+const LOG_FLUSH_INTERVAL: Duration = Duration::from_millis(200);
 
 impl LogFile {
     fn create(path: PathBuf) -> io::Result<Self> {
@@ -401,12 +412,18 @@ impl LogFile {
             file: BufWriter::new(file),
             error: None,
             reported: false,
+            flushed: Instant::now(),
         })
     }
 
     fn line(&mut self, text: &str) {
+        self.write_line(format_args!("{text}"));
+    }
+
+    /// A line formatted straight into the file's buffer.
+    fn write_line(&mut self, line: std::fmt::Arguments<'_>) {
         if self.error.is_none() {
-            if let Err(e) = writeln!(self.file, "{text}") {
+            if let Err(e) = writeln!(self.file, "{line}") {
                 self.error = Some(file_error(&self.path, e));
             }
         }
@@ -414,11 +431,26 @@ impl LogFile {
 
     /// Flushes; the first error, once.
     fn flush(&mut self) -> io::Result<()> {
+        self.flushed = Instant::now();
         if self.error.is_none() {
             if let Err(e) = self.file.flush() {
                 self.error = Some(file_error(&self.path, e));
             }
         }
+        self.report()
+    }
+
+    /// At the end of an increment: flushes when `output` (a step written)
+    /// or after [`LOG_FLUSH_INTERVAL`]; the first error, once.
+    fn flush_at_increment(&mut self, output: bool) -> io::Result<()> {
+        if output || self.flushed.elapsed() >= LOG_FLUSH_INTERVAL {
+            return self.flush();
+        }
+        self.report()
+    }
+
+    /// The first error, once.
+    fn report(&mut self) -> io::Result<()> {
         match &self.error {
             Some(e) if !self.reported => {
                 self.reported = true;
@@ -492,6 +524,8 @@ pub struct Recorder {
     stops: Vec<StopWatch>,
     /// The largest loads of the latches, stops and contacts over the run.
     peaks: PeakLoads,
+    /// The line of an increment, its buffer kept from step to step.
+    text: String,
 }
 
 /// What the recorder follows of a stop or contact over a dynamic
@@ -789,6 +823,7 @@ impl Recorder {
             latches: Vec::new(),
             stops: Vec::new(),
             peaks: PeakLoads::of(model),
+            text: String::new(),
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -1243,8 +1278,8 @@ impl Observer for Recorder {
         }
         self.violations.push(info.norms.residual_constraint);
         let n = &info.norms;
-        self.log.line(&format!(
-            "    {} {} iteration {}: |r_F| {:.3e} (flux {:.3e})  |r_M| {:.3e} (flux {:.3e})  |r_C| {:.3e}  relative {:.3e}  max|c| {:.3e}  max|dx| {:.3e}  max|dθ| {:.3e}",
+        self.log.write_line(format_args!(
+            "    {} {} iteration {}: |r_F| {} (flux {})  |r_M| {} (flux {})  |r_C| {}  relative {}  max|c| {}  max|dx| {}  max|dθ| {}",
             if self.current.kind == "dynamic" {
                 "step"
             } else {
@@ -1252,15 +1287,15 @@ impl Observer for Recorder {
             },
             info.increment + self.increment_offset,
             info.iteration,
-            n.residual_force,
-            n.flux_force,
-            n.residual_moment,
-            n.flux_moment,
-            n.residual_coordinate,
-            n.relative_residual,
-            n.residual_constraint,
-            n.displacement_correction,
-            n.rotation_correction
+            Sci::<3>(n.residual_force),
+            Sci::<3>(n.flux_force),
+            Sci::<3>(n.residual_moment),
+            Sci::<3>(n.flux_moment),
+            Sci::<3>(n.residual_coordinate),
+            Sci::<3>(n.relative_residual),
+            Sci::<3>(n.residual_constraint),
+            Sci::<3>(n.displacement_correction),
+            Sci::<3>(n.rotation_correction),
         ));
     }
 
@@ -1311,20 +1346,28 @@ impl Observer for Recorder {
         } else {
             ("relative residuals", &info.residuals)
         };
-        let values: Vec<String> = values.iter().map(|r| format!("{r:.1e}")).collect();
         let (word, size) = if self.current.kind == "dynamic" {
             ("step", "h")
         } else {
             ("increment", "dt")
         };
-        self.line(&format!(
-            "{word} {:4}  t = {:.6}  {size} = {:.3e}  iterations {:2}  {what}: {}",
+        // the line in a buffer kept from step to step
+        let mut text = std::mem::take(&mut self.text);
+        text.clear();
+        let _ = write!(
+            text,
+            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  {what}: ",
             info.increment,
             info.time,
-            info.step,
+            Sci::<3>(info.step),
             info.iterations,
-            values.join(" ")
-        ));
+        );
+        for (k, r) in values.iter().enumerate() {
+            let sep = if k == 0 { "" } else { " " };
+            let _ = write!(text, "{sep}{}", Sci::<1>(*r));
+        }
+        self.line(&text);
+        self.text = text;
         self.console.progress(info);
         if restart {
             return self.log.flush();
@@ -1353,7 +1396,7 @@ impl Observer for Recorder {
                 )?;
             }
         }
-        self.log.flush()?;
+        self.log.flush_at_increment(info.output || stop.is_some())?;
         match stop {
             Some(i) => Err(io::Error::new(io::ErrorKind::Interrupted, i)),
             None => Ok(()),

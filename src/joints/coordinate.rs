@@ -3,7 +3,8 @@
 //! springs, dampers and drivers act on.
 
 use super::hyperdual::HyperDual;
-use super::kinematics::{with_scratch, Conf, Pair};
+use super::kinematics::{with_scratch, Conf, Local, Pair};
+use super::products::CoordinateForm;
 use super::types::Coordinate;
 use crate::state::State;
 
@@ -41,6 +42,32 @@ impl PairCoordinate {
             sc.local.value(1, &self.function(reference), &mut v);
             v[0]
         })
+    }
+
+    /// The coordinate at `local` (gathered from its nodes), angles on the
+    /// branch nearest `reference`, its gradient `grad` over every local
+    /// unknown and, with `hessian` (`n × n`, column-major), its second
+    /// derivatives added: in closed form ([`CoordinateForm`]), by
+    /// hyper-dual numbers for a slider's curve parameter.
+    pub fn derivatives(
+        &self,
+        local: &mut Local,
+        reference: f64,
+        grad: &mut [f64],
+        hessian: Option<&mut [f64]>,
+    ) -> f64 {
+        if let Some(form) = CoordinateForm::of(self.coordinate, &self.pair) {
+            return form.evaluate(local, reference, grad, hessian);
+        }
+        let n = local.n();
+        let active = self.active();
+        let f = self.function(reference);
+        let mut c = [0.0];
+        local.gradient(1, &active, &f, &mut c, grad);
+        if let Some(h) = hessian {
+            local.add_weighted_hessian(1, &active, &f, &[1.0], grad, true, h, n);
+        }
+        c[0]
     }
 
     /// Local unknowns it depends on (all of its nodes' components).

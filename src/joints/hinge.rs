@@ -304,7 +304,6 @@ pub struct HingeLaw {
     law: Hysteresis,
     /// Moment in the reference configuration, before any converged state.
     start: f64,
-    active: Vec<usize>,
     internal: usize,
 }
 
@@ -315,13 +314,11 @@ impl HingeLaw {
     /// `law` on `source`, starting at moment `start` in the reference
     /// configuration (`c = 0`).
     pub fn new(id: Id, source: PairCoordinate, law: Hysteresis, start: f64) -> Self {
-        let active = source.active();
         Self {
             id,
             source,
             law,
             start,
-            active,
             internal: 0,
         }
     }
@@ -378,24 +375,30 @@ impl Element for HingeLaw {
             local.gather(state, &self.source.nodes, 0..0);
             let n = local.n();
             let (c_n, m_n) = self.converged(state);
-            let f = self.source.function(self.reference(c_n));
-            let mut c = [0.0];
             let g = &mut sc.grad;
             g.clear();
             g.resize(n, 0.0);
-            local.gradient(1, &self.active, &f, &mut c, g);
-            let r = self.law.respond(c[0], c_n, m_n);
+            // H = ∂g/∂q, column-major n×n, when the stiffness is asked for
+            let h = &mut sc.hess;
+            h.clear();
+            let wants_h = out.stiffness.is_some();
+            if wants_h {
+                h.resize(n * n, 0.0);
+            }
+            let c = self.source.derivatives(
+                local,
+                self.reference(c_n),
+                g,
+                wants_h.then_some(&mut h[..]),
+            );
+            let r = self.law.respond(c, c_n, m_n);
             for i in 0..n {
                 out.residual[i] += r.moment * g[i];
             }
             let Some(stiffness) = out.stiffness.as_deref_mut() else {
                 return;
             };
-            // K = (dM/dc) g gᵀ + M ∂g/∂q, column-major n×n
-            let h = &mut sc.hess;
-            h.clear();
-            h.resize(n * n, 0.0);
-            local.add_weighted_hessian(1, &self.active, &f, &[1.0], g, true, h, n);
+            // K = (dM/dc) g gᵀ + M ∂g/∂q
             for col in 0..n {
                 for row in 0..n {
                     stiffness[col * n + row] +=

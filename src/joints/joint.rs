@@ -14,6 +14,7 @@
 
 use super::hyperdual::HyperDual;
 use super::kinematics::{with_scratch, Conf, Local, Pair, MAX_OUT};
+use super::products::Products;
 use super::types::{
     constraint_kinds, constraints, slider_constraints, Coordinate, Equation, JointParameters,
     JointType,
@@ -59,11 +60,60 @@ pub(crate) fn add_constraints<F>(
 {
     let m = kinds.len();
     let nq = local.n();
-    let n = nq + m;
     let mut phi = [0.0; MAX_OUT];
     grad.clear();
     grad.resize(m * nq, 0.0);
     local.gradient(m, active, f, &mut phi[..m], grad);
+    let w = add_first_order(ctx, nq, active, kinds, &phi[..m], grad, lambda, out);
+    if let Some(t) = out.stiffness.as_deref_mut() {
+        local.add_weighted_hessian(m, active, f, &w[..m], grad, affine, t, nq + m);
+    }
+}
+
+/// The same for constraints written as dot products (every unknown
+/// active), differentiated in closed form.
+fn add_product_constraints(
+    ctx: &EvalContext,
+    local: &Local,
+    grad: &mut Vec<f64>,
+    products: &Products,
+    kinds: &[Equation],
+    lambda: &[f64],
+    out: &mut ElementOutput,
+) {
+    let m = kinds.len();
+    let nq = local.n();
+    let mut phi = [0.0; MAX_OUT];
+    grad.clear();
+    grad.resize(m * nq, 0.0);
+    products.gradient(local, &mut phi[..m], grad);
+    let active = &ALL_DOFS[..nq];
+    let w = add_first_order(ctx, nq, active, kinds, &phi[..m], grad, lambda, out);
+    if let Some(t) = out.stiffness.as_deref_mut() {
+        products.add_weighted_hessian(local, &w[..m], t, nq + m);
+    }
+}
+
+/// Local unknowns `0, 1, …` of a joint between two nodes.
+pub(crate) const ALL_DOFS: [usize; 12] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11];
+
+/// The terms of [`add_constraints`] of the first derivatives, given the
+/// values `phi` and gradients `grad` (`m × nq`): the residual
+/// `Bᵀ(pΦ − kλ)`, `−kΦ` and the tangent `p BᵀB`, `−k B`, `−k Bᵀ`.
+/// Returns the weights `wᵢ = pΦᵢ − kλᵢ` of the second-derivative term.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn add_first_order(
+    ctx: &EvalContext,
+    nq: usize,
+    active: &[usize],
+    kinds: &[Equation],
+    phi: &[f64],
+    grad: &[f64],
+    lambda: &[f64],
+    out: &mut ElementOutput,
+) -> [f64; MAX_OUT] {
+    let m = kinds.len();
+    let n = nq + m;
     let mut w = [0.0; MAX_OUT];
     let mut kk = [0.0; MAX_OUT];
     let mut pp = [0.0; MAX_OUT];
@@ -78,7 +128,7 @@ pub(crate) fn add_constraints<F>(
         }
     }
     let Some(t) = out.stiffness.as_deref_mut() else {
-        return;
+        return w;
     };
     for i in 0..m {
         let g = &grad[i * nq..(i + 1) * nq];
@@ -94,7 +144,7 @@ pub(crate) fn add_constraints<F>(
             }
         }
     }
-    local.add_weighted_hessian(m, active, f, &w[..m], grad, affine, t, n);
+    w
 }
 
 /// A kinematic pair of the joint library.
@@ -115,6 +165,9 @@ pub struct Joint {
     offsets: Offsets,
     /// Reference value of the slider parameter.
     s0: f64,
+    /// The constraints as dot products, differentiated in closed form
+    /// (every type but the helical joint and the slider).
+    products: Option<Products>,
 }
 
 impl Joint {
@@ -135,6 +188,8 @@ impl Joint {
         nodes.extend(second);
         let active = (0..6 * nodes.len()).collect();
         let kinds = constraint_kinds(joint_type, parameters.lock_rotations);
+        let products = Products::of(joint_type, &pair, parameters.lock_rotations);
+        debug_assert!(products.as_ref().is_none_or(|p| p.len() == kinds.len()));
         Self {
             id,
             joint_type,
@@ -145,6 +200,7 @@ impl Joint {
             active,
             offsets: Offsets::default(),
             s0: 0.0,
+            products,
         }
     }
 
@@ -187,6 +243,7 @@ impl Joint {
             active,
             offsets: Offsets::default(),
             s0,
+            products: None,
         }
     }
 
@@ -335,6 +392,18 @@ impl Element for Joint {
         let refs = self.angle_references(state);
         with_scratch(|sc| {
             sc.local.gather(state, &self.nodes, c..c + self.n_coords());
+            if let Some(products) = &self.products {
+                add_product_constraints(
+                    ctx,
+                    &sc.local,
+                    &mut sc.grad,
+                    products,
+                    self.kinds,
+                    lambda,
+                    out,
+                );
+                return;
+            }
             add_constraints(
                 ctx,
                 &mut sc.local,

@@ -32,9 +32,8 @@
 //! the load `|f|` reaching `unlatch_load`, where the latch releases.
 
 use super::coordinate::PairCoordinate;
-use super::hyperdual::HyperDual;
-use super::joint::{add_constraints, constraint_kind, scale_of};
-use super::kinematics::{with_scratch, Conf};
+use super::joint::{add_first_order, constraint_kind, scale_of, ALL_DOFS};
+use super::kinematics::with_scratch;
 use super::types::Equation;
 use crate::elements::{
     CellShape, ConstraintKind, Element, ElementKind, ElementOutput, EvalContext, Offsets,
@@ -159,7 +158,6 @@ pub struct Latch {
     value: f64,
     /// `s`: +1 if it locks with `c` increasing, −1 decreasing.
     approach: f64,
-    active: Vec<usize>,
     /// Where its multiplier and internal variables are in the state.
     offsets: Offsets,
     /// The compliant lock; `None`: rigid.
@@ -170,14 +168,12 @@ impl Latch {
     /// Locks `source`, a coordinate of joint `joint`, at `value`, reached
     /// with the coordinate increasing (`approach > 0`) or decreasing.
     pub fn new(id: Id, joint: Id, source: PairCoordinate, value: f64, approach: f64) -> Self {
-        let active = source.active();
         Self {
             id,
             joint,
             source,
             value,
             approach: if approach < 0.0 { -1.0 } else { 1.0 },
-            active,
             offsets: Offsets::default(),
             spring: None,
         }
@@ -414,9 +410,8 @@ impl Latch {
         let mut grad = vec![0.0; n];
         with_scratch(|sc| {
             sc.local.gather(state, &self.source.nodes, 0..0);
-            let mut v = [0.0];
-            let f = self.source.function(self.reference(state));
-            sc.local.gradient(1, &self.active, &f, &mut v, &mut grad);
+            self.source
+                .derivatives(&mut sc.local, self.reference(state), &mut grad, None);
         });
         let mut rate = 0.0;
         for (k, &node) in self.source.nodes.iter().enumerate() {
@@ -494,27 +489,44 @@ impl Element for Latch {
             return;
         }
         // locked: Φ = c(q) − c_L
-        let c = self.source.function(self.reference(state));
-        let value = self.value;
-        let phi = |conf: &Conf, o: &mut [HyperDual]| {
-            c(conf, o);
-            o[0] = o[0] + (-value);
-        };
         let m = self.offsets.multipliers;
         let lambda = &state.multipliers[m..m + 1];
         with_scratch(|sc| {
             sc.local.gather(state, &self.source.nodes, 0..0);
-            add_constraints(
-                ctx,
+            let g = &mut sc.grad;
+            g.clear();
+            g.resize(nq, 0.0);
+            let h = &mut sc.hess;
+            h.clear();
+            let wants_h = out.stiffness.is_some();
+            if wants_h {
+                h.resize(nq * nq, 0.0);
+            }
+            let c = self.source.derivatives(
                 &mut sc.local,
-                &mut sc.grad,
-                &self.active,
-                true,
-                &[self.kind_of_equation()],
-                &phi,
+                self.reference(state),
+                g,
+                wants_h.then_some(&mut h[..]),
+            );
+            let kinds = [self.kind_of_equation()];
+            let w = add_first_order(
+                ctx,
+                nq,
+                &ALL_DOFS[..nq],
+                &kinds,
+                &[c - self.value],
+                g,
                 lambda,
                 out,
             );
+            if let Some(t) = out.stiffness.as_deref_mut() {
+                // w ∂²Φ/∂q², the second-derivative term of add_constraints
+                for col in 0..nq {
+                    for row in 0..nq {
+                        t[col * (nq + 1) + row] += w[0] * h[col * nq + row];
+                    }
+                }
+            }
         });
     }
     fn update_internal(&self, _ctx: &EvalContext, state: &State, internal: &mut [f64]) {
@@ -602,12 +614,22 @@ impl Latch {
             let local = &mut sc.local;
             local.gather(state, &self.source.nodes, 0..0);
             let n = local.n();
-            let f = self.source.function(self.reference(state));
-            let mut c = [0.0];
             let g = &mut sc.grad;
             g.clear();
             g.resize(n, 0.0);
-            local.gradient(1, &self.active, &f, &mut c, g);
+            // H = ∂g/∂q, column-major n×n, when the stiffness is asked for
+            let h = &mut sc.hess;
+            h.clear();
+            let wants_h = out.stiffness.is_some();
+            if wants_h {
+                h.resize(n * n, 0.0);
+            }
+            let c = [self.source.derivatives(
+                local,
+                self.reference(state),
+                g,
+                wants_h.then_some(&mut h[..]),
+            )];
             let v = &mut sc.vel;
             v.clear();
             for &node in &self.source.nodes {
@@ -638,11 +660,6 @@ impl Latch {
             let Some(stiffness) = out.stiffness.as_deref_mut() else {
                 return;
             };
-            // H = ∂g/∂q, column-major n×n
-            let h = &mut sc.hess;
-            h.clear();
-            h.resize(n * n, 0.0);
-            local.add_weighted_hessian(1, &self.active, &f, &[1.0], g, true, h, n);
             for col in 0..n {
                 // ∂ċ/∂q_col at fixed v: Σ_r v_r H[r, col]
                 let dc = if d != 0.0 {

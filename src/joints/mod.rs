@@ -7,7 +7,9 @@
 //! augmented Lagrangian of the reference paper (eqs. 17–18). Constraint
 //! formulas are written once over hyper-dual numbers ([`hyperdual`]), which
 //! gives the constraint gradient `B` and the second-derivative term
-//! `∂(Bᵀλ)/∂q` exactly ([`kinematics`]).
+//! `∂(Bᵀλ)/∂q` exactly ([`kinematics`]); those made of dot products (every
+//! joint type but the helical joint and the slider, and the coordinates)
+//! are differentiated in closed form ([`products`]).
 
 pub mod coordinate;
 pub mod driver;
@@ -16,6 +18,7 @@ pub mod hyperdual;
 pub mod joint;
 pub mod kinematics;
 pub mod latch;
+pub mod products;
 pub mod rolling;
 pub mod spring;
 pub mod stop;

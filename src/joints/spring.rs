@@ -163,12 +163,22 @@ impl Element for JointSpring {
             let local = &mut sc.local;
             local.gather(state, &self.source.nodes, 0..0);
             let n = local.n();
-            let f = self.source.function(self.reference(state));
-            let mut c = [0.0];
             let g = &mut sc.grad;
             g.clear();
             g.resize(n, 0.0);
-            local.gradient(1, &self.active, &f, &mut c, g);
+            // H = ∂g/∂q, column-major n×n, when the stiffness is asked for
+            let h = &mut sc.hess;
+            h.clear();
+            let wants_h = out.stiffness.is_some();
+            if wants_h {
+                h.resize(n * n, 0.0);
+            }
+            let c = [self.source.derivatives(
+                local,
+                self.reference(state),
+                g,
+                wants_h.then_some(&mut h[..]),
+            )];
             let v = &mut sc.vel;
             self.velocities(state, v);
             let rate: f64 = g.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
@@ -195,11 +205,6 @@ impl Element for JointSpring {
             let Some(stiffness) = out.stiffness.as_deref_mut() else {
                 return;
             };
-            // H = ∂g/∂q, column-major n×n
-            let h = &mut sc.hess;
-            h.clear();
-            h.resize(n * n, 0.0);
-            local.add_weighted_hessian(1, &self.active, &f, &[1.0], g, true, h, n);
             let kd = if ctx.dynamics { kd } else { 0.0 };
             for col in 0..n {
                 // ∂ċ/∂q_col at fixed v: Σ_r v_r H[r, col]

@@ -3,7 +3,7 @@
 //! springs, dampers and drivers act on.
 
 use super::hyperdual::HyperDual;
-use super::kinematics::{with_scratch, Conf, Local, Pair};
+use super::kinematics::{with_scratch, Conf, Local, Pair, Scratch};
 use super::products::CoordinateForm;
 use super::types::Coordinate;
 use crate::state::State;
@@ -42,6 +42,32 @@ impl PairCoordinate {
             sc.local.value(1, &self.function(reference), &mut v);
             v[0]
         })
+    }
+
+    /// Gathers the pair's nodes into `sc.local` and returns the coordinate,
+    /// with its gradient `g = ∂c/∂q` in `sc.grad` (`n`) and, if `hessian`,
+    /// `H = ∂g/∂q` in `sc.hess` (`n × n`, column-major); `n = sc.local.n()`.
+    pub fn evaluate_into(
+        &self,
+        sc: &mut Scratch,
+        state: &State,
+        reference: f64,
+        hessian: bool,
+    ) -> f64 {
+        sc.local.gather(state, &self.nodes, 0..0);
+        let n = sc.local.n();
+        sc.grad.clear();
+        sc.grad.resize(n, 0.0);
+        sc.hess.clear();
+        if hessian {
+            sc.hess.resize(n * n, 0.0);
+        }
+        self.derivatives(
+            &mut sc.local,
+            reference,
+            &mut sc.grad,
+            hessian.then_some(&mut sc.hess[..]),
+        )
     }
 
     /// The coordinate at `local` (gathered from its nodes), angles on the

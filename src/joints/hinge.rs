@@ -18,7 +18,7 @@
 //! the stiffness `(dM/dc) g gᵀ + M ∂g/∂q`.
 
 use super::coordinate::PairCoordinate;
-use super::kinematics::{with_scratch, Local};
+use super::kinematics::with_scratch;
 use crate::elements::{CellShape, Element, ElementKind, ElementOutput, EvalContext, Offsets};
 use crate::model::Id;
 use crate::state::State;
@@ -371,26 +371,12 @@ impl Element for HingeLaw {
     }
     fn evaluate(&self, _ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         with_scratch(|sc| {
-            let local: &mut Local = &mut sc.local;
-            local.gather(state, &self.source.nodes, 0..0);
-            let n = local.n();
             let (c_n, m_n) = self.converged(state);
-            let g = &mut sc.grad;
-            g.clear();
-            g.resize(n, 0.0);
-            // H = ∂g/∂q, column-major n×n, when the stiffness is asked for
-            let h = &mut sc.hess;
-            h.clear();
-            let wants_h = out.stiffness.is_some();
-            if wants_h {
-                h.resize(n * n, 0.0);
-            }
-            let c = self.source.derivatives(
-                local,
-                self.reference(c_n),
-                g,
-                wants_h.then_some(&mut h[..]),
-            );
+            // g = ∂c/∂q; H = ∂g/∂q when the stiffness is asked for
+            let c =
+                self.source
+                    .evaluate_into(sc, state, self.reference(c_n), out.stiffness.is_some());
+            let (n, g, h) = (sc.local.n(), &sc.grad, &sc.hess);
             let r = self.law.respond(c, c_n, m_n);
             for i in 0..n {
                 out.residual[i] += r.moment * g[i];

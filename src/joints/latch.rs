@@ -492,22 +492,14 @@ impl Element for Latch {
         let m = self.offsets.multipliers;
         let lambda = &state.multipliers[m..m + 1];
         with_scratch(|sc| {
-            sc.local.gather(state, &self.source.nodes, 0..0);
-            let g = &mut sc.grad;
-            g.clear();
-            g.resize(nq, 0.0);
-            let h = &mut sc.hess;
-            h.clear();
-            let wants_h = out.stiffness.is_some();
-            if wants_h {
-                h.resize(nq * nq, 0.0);
-            }
-            let c = self.source.derivatives(
-                &mut sc.local,
+            let c = self.source.evaluate_into(
+                sc,
+                state,
                 self.reference(state),
-                g,
-                wants_h.then_some(&mut h[..]),
+                out.stiffness.is_some(),
             );
+            debug_assert_eq!(sc.local.n(), nq);
+            let (g, h) = (&sc.grad, &sc.hess);
             let kinds = [self.kind_of_equation()];
             let w = add_first_order(
                 ctx,
@@ -611,26 +603,14 @@ impl Latch {
         out: &mut ElementOutput,
     ) {
         with_scratch(|sc| {
-            let local = &mut sc.local;
-            local.gather(state, &self.source.nodes, 0..0);
-            let n = local.n();
-            let g = &mut sc.grad;
-            g.clear();
-            g.resize(n, 0.0);
-            // H = ∂g/∂q, column-major n×n, when the stiffness is asked for
-            let h = &mut sc.hess;
-            h.clear();
-            let wants_h = out.stiffness.is_some();
-            if wants_h {
-                h.resize(n * n, 0.0);
-            }
-            let c = [self.source.derivatives(
-                local,
+            // g = ∂c/∂q; H = ∂g/∂q when the stiffness is asked for
+            let c = [self.source.evaluate_into(
+                sc,
+                state,
                 self.reference(state),
-                g,
-                wants_h.then_some(&mut h[..]),
+                out.stiffness.is_some(),
             )];
-            let v = &mut sc.vel;
+            let (n, g, h, v) = (sc.local.n(), &sc.grad, &sc.hess, &mut sc.vel);
             v.clear();
             for &node in &self.source.nodes {
                 v.extend_from_slice(&state.velocity[node]);

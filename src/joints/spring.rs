@@ -160,26 +160,14 @@ impl Element for JointSpring {
     }
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         with_scratch(|sc| {
-            let local = &mut sc.local;
-            local.gather(state, &self.source.nodes, 0..0);
-            let n = local.n();
-            let g = &mut sc.grad;
-            g.clear();
-            g.resize(n, 0.0);
-            // H = ∂g/∂q, column-major n×n, when the stiffness is asked for
-            let h = &mut sc.hess;
-            h.clear();
-            let wants_h = out.stiffness.is_some();
-            if wants_h {
-                h.resize(n * n, 0.0);
-            }
-            let c = [self.source.derivatives(
-                local,
+            // g = ∂c/∂q; H = ∂g/∂q when the stiffness is asked for
+            let c = [self.source.evaluate_into(
+                sc,
+                state,
                 self.reference(state),
-                g,
-                wants_h.then_some(&mut h[..]),
+                out.stiffness.is_some(),
             )];
-            let v = &mut sc.vel;
+            let (n, g, h, v) = (sc.local.n(), &sc.grad, &sc.hess, &mut sc.vel);
             self.velocities(state, v);
             let rate: f64 = g.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
             let (fs, ks) = self.spring.as_ref().map_or((0.0, 0.0), |l| l.eval(c[0]));

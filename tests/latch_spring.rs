@@ -665,6 +665,54 @@ fn spring_latch_keys_in_degrees_are_converted_to_radians() {
     assert_eq!(s_deg.unlatch_load, Some(3.0));
 }
 
+/// A spring latch's stiffness and damping given with `unit = "deg"` are
+/// noted in radians as a joint spring's are (10 N·m/deg = 10·180/π =
+/// 572.9578 N·m/rad); a backlash of half a turn or more (200° here: ±100°
+/// about the latch value) is warned of as a likely unit slip, one of 2°
+/// is not.
+#[test]
+fn spring_latch_coefficients_per_degree_are_noted_and_a_huge_backlash_warned() {
+    let model = |backlash: f64| {
+        let text = panel(
+            "end_time = 0.1",
+            &format!(
+                "[[latches]]\nid = 20\njoint = 10\nmode = \"spring\"\nvalue = 90.0\nunit = \"deg\"\nstiffness = 10.0\nbacklash = {backlash:?}\ndamping = 0.5\n"
+            ),
+        );
+        let input: ModelInput = toml::from_str(&text).unwrap();
+        Model::from_input(&input).unwrap()
+    };
+    let small = model(2.0);
+    let notes: Vec<&str> = small.notes.iter().map(|n| n.message.as_str()).collect();
+    assert!(
+        notes.iter().any(|n| n
+            .starts_with("stiffness = 10 with unit = \"deg\" is 10 N·m/deg = 5.729578e2 N·m/rad")),
+        "{notes:?}"
+    );
+    assert!(
+        notes.iter().any(|n| n.starts_with(
+            "damping = 0.5 with unit = \"deg\" is 0.5 N·m·s/deg = 2.864789e1 N·m·s/rad"
+        )),
+        "{notes:?}"
+    );
+    assert!(
+        !small
+            .warnings
+            .iter()
+            .any(|w| w.message.contains("backlash")),
+        "{:?}",
+        small.warnings
+    );
+    let huge = model(200.0);
+    assert!(
+        huge.warnings
+            .iter()
+            .any(|w| w.entity == "latch 20" && w.message.contains("dead band of 200.0°")),
+        "{:?}",
+        huge.warnings
+    );
+}
+
 /// The release through the command line: `events.csv` has one `unlatch`
 /// row (the latch, its joint, the coordinate at `F_u/k` within the event
 /// tolerance of the load, the energy released ½F_u²/k), `log.txt` a line

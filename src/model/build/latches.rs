@@ -145,6 +145,24 @@ fn spring(
         cx.ck
             .unitless_angle(entity, "backlash is", backlash, AngleLimit::FullTurn);
     }
+    if angle && ok {
+        cx.ck
+            .per_degree(entity, "stiffness", l.stiffness.unwrap_or(0.0), "N·m", unit);
+        cx.ck.per_degree(entity, "damping", damping, "N·m·s", unit);
+        // a dead band of half a turn or more (±90° about the latch value)
+        // is no latch's backlash: most likely radians written as degrees
+        let band = backlash * unit;
+        if band >= std::f64::consts::PI {
+            cx.ck.warn(
+                entity,
+                format!(
+                    "backlash {backlash} is a dead band of {:.1}° (±{:.1}° about the latch value), half a turn or more: a latch's backlash is usually a few degrees; check the unit",
+                    band.to_degrees(),
+                    0.5 * band.to_degrees()
+                ),
+            );
+        }
+    }
     ok.then(|| SpringLatch {
         stiffness,
         backlash: backlash * unit,

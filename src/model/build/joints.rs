@@ -482,7 +482,7 @@ pub(super) fn joint_coordinate(
         None => {
             let msg = if names.is_empty() {
                 format!(
-                    "joint {joint} ({}) has no coordinate that springs or drivers can act on",
+                    "joint {joint} ({}) has no coordinate that springs, drivers, hinge laws, latches or stops can act on",
                     b.joint_type.name()
                 )
             } else {

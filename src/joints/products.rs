@@ -346,6 +346,7 @@ mod tests {
     use super::*;
     use crate::joints::hyperdual::HyperDual;
     use crate::joints::kinematics::Conf;
+    use crate::joints::tests::Lcg;
     use crate::joints::types::{constraint_kinds, constraints, JointParameters};
     use crate::so3::{self, Rotation};
     use crate::state::State;
@@ -358,14 +359,7 @@ mod tests {
     /// entry, is round-off.
     #[test]
     fn closed_form_matches_hyper_dual_evaluation() {
-        let mut seed = 11u64;
-        let mut next = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
-        let vec = |s: f64, next: &mut dyn FnMut() -> f64| Vec3::new(next(), next(), next()) * s;
+        let mut rng = Lcg(11);
         let types = [
             JointType::Revolute,
             JointType::Prismatic,
@@ -381,11 +375,10 @@ mod tests {
             for grounded in [false, true] {
                 for lock_rotations in [true, false] {
                     for _ in 0..8 {
-                        let x: Vec<Vec3> = (0..2).map(|_| vec(1.0, &mut next)).collect();
-                        let q: Vec<Rotation> =
-                            (0..2).map(|_| so3::exp(&vec(2.0, &mut next))).collect();
-                        let e = so3::matrix(&so3::exp(&vec(2.0, &mut next)));
-                        let p = vec(1.0, &mut next);
+                        let x: Vec<Vec3> = (0..2).map(|_| rng.vec(1.0)).collect();
+                        let q: Vec<Rotation> = (0..2).map(|_| so3::exp(&rng.vec(2.0))).collect();
+                        let e = so3::matrix(&so3::exp(&rng.vec(2.0)));
+                        let p = rng.vec(1.0);
                         let (ra, rb) = (so3::matrix(&q[0]), so3::matrix(&q[1]));
                         let pair = Pair::from_reference(
                             &p,
@@ -397,10 +390,10 @@ mod tests {
                         let m = constraint_kinds(t, lock_rotations).len();
                         assert_eq!(products.len(), m, "{}", t.name());
                         let nn = if grounded { 1 } else { 2 };
-                        let xs = x[..nn].iter().map(|x| x + vec(0.3, &mut next)).collect();
+                        let xs = x[..nn].iter().map(|x| x + rng.vec(0.3)).collect();
                         let qs = q[..nn]
                             .iter()
-                            .map(|q| q * so3::exp(&vec(0.6, &mut next)))
+                            .map(|q| q * so3::exp(&rng.vec(0.6)))
                             .collect();
                         let state = State::at_rest(0.0, xs, qs);
                         let nodes: Vec<usize> = (0..nn).collect();
@@ -415,7 +408,7 @@ mod tests {
                         let f = |c: &Conf, out: &mut [HyperDual]| {
                             constraints(t, &pair.frames(c), HyperDual::default(), &params, out)
                         };
-                        let w: Vec<f64> = (0..m).map(|_| next()).collect();
+                        let w: Vec<f64> = (0..m).map(|_| rng.next()).collect();
                         let active: Vec<usize> = (0..n).collect();
                         let (mut v1, mut g1, mut h1) =
                             (vec![0.0; m], vec![0.0; m * n], vec![0.0; n * n]);
@@ -458,13 +451,7 @@ mod tests {
     #[test]
     fn closed_form_coordinates_match_hyper_dual_evaluation() {
         use crate::joints::coordinate::PairCoordinate;
-        let mut seed = 5u64;
-        let mut next = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rng = Lcg(5);
         let coordinates = [
             Coordinate::Angle,
             Coordinate::Slide1,
@@ -477,11 +464,10 @@ mod tests {
         for coordinate in coordinates {
             for grounded in [false, true] {
                 for k in 0..8 {
-                    let mut vec = || Vec3::new(next(), next(), next());
-                    let x: Vec<Vec3> = (0..2).map(|_| vec()).collect();
-                    let q: Vec<Rotation> = (0..2).map(|_| so3::exp(&(vec() * 2.0))).collect();
-                    let e = so3::matrix(&so3::exp(&(vec() * 2.0)));
-                    let p = vec();
+                    let x: Vec<Vec3> = (0..2).map(|_| rng.vec(1.0)).collect();
+                    let q: Vec<Rotation> = (0..2).map(|_| so3::exp(&rng.vec(2.0))).collect();
+                    let e = so3::matrix(&so3::exp(&rng.vec(2.0)));
+                    let p = rng.vec(1.0);
                     let (ra, rb) = (so3::matrix(&q[0]), so3::matrix(&q[1]));
                     let pair = Pair::from_reference(
                         &p,
@@ -490,10 +476,10 @@ mod tests {
                         (!grounded).then_some((&x[1], &rb)),
                     );
                     let nn = if grounded { 1 } else { 2 };
-                    let xs = x[..nn].iter().map(|x| x + vec() * 0.3).collect();
+                    let xs = x[..nn].iter().map(|x| x + rng.vec(0.3)).collect();
                     let qs = q[..nn]
                         .iter()
-                        .map(|q| q * so3::exp(&(vec() * 0.6)))
+                        .map(|q| q * so3::exp(&rng.vec(0.6)))
                         .collect();
                     let state = State::at_rest(0.0, xs, qs);
                     let source = PairCoordinate {

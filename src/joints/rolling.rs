@@ -445,20 +445,7 @@ mod tests {
     use super::*;
     use crate::elements::testing::{rate_errors, tangent_error};
     use crate::elements::{ConstraintScaling, Need};
-
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        }
-        fn vec(&mut self, s: f64) -> Vec3 {
-            Vec3::new(self.next(), self.next(), self.next()) * s
-        }
-    }
+    use crate::joints::tests::Lcg;
 
     fn ctx(dynamics: bool) -> EvalContext<'static> {
         EvalContext {

@@ -13,17 +13,18 @@ use crate::elements::{ConstraintScaling, Element, EvalContext};
 use crate::so3::{self, Mat3, Rotation, Vec3};
 use crate::state::State;
 
-/// Deterministic pseudo-random numbers in [−1, 1].
-struct Lcg(u64);
+/// Deterministic pseudo-random numbers in [−1, 1], for the tests of the
+/// joints.
+pub(super) struct Lcg(pub(super) u64);
 impl Lcg {
-    fn next(&mut self) -> f64 {
+    pub(super) fn next(&mut self) -> f64 {
         self.0 = self
             .0
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
         ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
     }
-    fn vec(&mut self, s: f64) -> Vec3 {
+    pub(super) fn vec(&mut self, s: f64) -> Vec3 {
         Vec3::new(self.next(), self.next(), self.next()) * s
     }
 }

@@ -136,6 +136,14 @@ pub const MAX_TRANSLATION_CORRECTION: f64 = 1.0;
 /// warning (docs/theory.md §15.6).
 pub const ENERGY_JUMP: f64 = 0.05;
 
+/// After a latch's lock, the steps grow back from the step that landed on
+/// it by at most this factor a step (docs/theory.md §16, "Restart"): the
+/// generalised-α method at `ρ∞ = 0.5` starting from consistent
+/// accelerations multiplies the energy of a mode displaced from its
+/// equilibrium by up to `0.004 (hω)²` in one step of `hω ≫ 1`, and by at most
+/// 1 when each step is at most 4 times the one before.
+pub const LOCK_REGROWTH: f64 = 4.0;
+
 /// With fixed steps, a local error estimate above this fraction of the
 /// step's motion is noted once (docs/theory.md §15.5).
 pub const FIXED_STEP_ERROR_NOTE: f64 = 1e-2;
@@ -377,6 +385,10 @@ struct Run {
     /// A stop closed at the last step: the steps resume with the size they
     /// had before landing on it (§16.4).
     closed: bool,
+    /// A latch locked at a step not yet followed by a step of the
+    /// controller's own size: the steps grow back by at most
+    /// [`LOCK_REGROWTH`] a step (§16).
+    regrowing: bool,
     started: Instant,
     finished: bool,
     error: Option<DynamicError>,
@@ -606,6 +618,7 @@ impl DynamicAnalysis {
             contacts: Vec::new(),
             rebound_step: None,
             closed: false,
+            regrowing: false,
             started,
             finished: false,
             error: None,
@@ -742,6 +755,15 @@ impl DynamicAnalysis {
             controller.set_size(size);
         } else if std::mem::take(&mut run.closed) {
             controller.resume_after_landing();
+        }
+        if let (true, Ok(Advance::Accepted(info))) = (run.regrowing, &result) {
+            // after a lock, at most LOCK_REGROWTH times the step accepted
+            let cap = LOCK_REGROWTH * info.step;
+            if controller.size() > cap {
+                controller.set_size(cap);
+            } else {
+                run.regrowing = false;
+            }
         }
         run.controller = Some(controller);
         if !matches!(result, Ok(Advance::Accepted(_))) {
@@ -2403,6 +2425,7 @@ impl Stepper for Dynamics<'_> {
                 run.a_before.clear();
                 run.a_before_coordinates.clear();
                 run.balance.impact(i.locks[0].energy_lost, i.work);
+                run.regrowing = true;
                 i.locks
             }
             None => Vec::new(),

@@ -16,8 +16,8 @@ use std::path::Path;
 use std::sync::Arc;
 
 use unfold::analysis::{
-    AnalysisSettings, CutbackInfo, DynamicAnalysis, DynamicOutcome, Energies, IncrementInfo,
-    IterationInfo, LockInfo, Observer,
+    AnalysisSettings, ContactInfo, CutbackInfo, DynamicAnalysis, DynamicOutcome, Energies,
+    EventInfo, IncrementInfo, IterationInfo, LockInfo, Observer, WarningInfo,
 };
 use unfold::io::results::AnalysisEnd;
 use unfold::io::run::{Recorder, Silent};
@@ -271,6 +271,33 @@ impl Observer for DeployObserver<'_> {
     fn note(&mut self, text: &str) {
         if let Some(r) = self.recorder.as_mut() {
             r.note(text);
+        }
+    }
+
+    fn event(&mut self, info: &EventInfo) {
+        if let Some(r) = self.recorder.as_mut() {
+            r.event(info);
+        }
+    }
+
+    fn band_crossing(&mut self, info: &LockInfo) {
+        if let Some(r) = self.recorder.as_mut() {
+            r.band_crossing(info);
+        }
+    }
+
+    fn contact(&mut self, info: &ContactInfo) {
+        if let Some(r) = self.recorder.as_mut() {
+            r.contact(info);
+        }
+    }
+
+    fn warning(&mut self, info: &WarningInfo) {
+        if self.log {
+            println!("  warning: {}", info.message);
+        }
+        if let Some(r) = self.recorder.as_mut() {
+            r.warning(info);
         }
     }
 

@@ -68,7 +68,8 @@
 //! saddle-point systems. The cut at 9 lies between them and the lattices.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
+use faer::linalg::lu::partial_pivoting::factor::{self as dense_lu, PartialPivLuParams};
+use faer::linalg::lu::partial_pivoting::solve as dense_lu_solve;
 use faer::perm::PermRef;
 use faer::sparse::linalg::lu::factorize_symbolic_lu;
 use faer::sparse::linalg::lu::simplicial::{self, SimplicialLu};
@@ -222,12 +223,15 @@ impl SparseMatrix {
         self.symbolic.row_idx()
     }
 
-    /// Every stored entry as `(row, col, value)`.
-    pub fn entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
-        let ptr = self.symbolic.col_ptr();
-        let rows = self.symbolic.row_idx();
-        (0..self.dim())
-            .flat_map(move |j| (ptr[j]..ptr[j + 1]).map(move |k| (rows[k], j, self.values[k])))
+    /// Every stored entry as `(row, col, value)`, column by column.
+    pub fn entries(&self) -> Entries<'_> {
+        Entries {
+            col_ptr: self.symbolic.col_ptr(),
+            rows: self.symbolic.row_idx(),
+            values: &self.values,
+            col: 0,
+            k: 0,
+        }
     }
 
     /// Largest absolute value in column `j`.
@@ -243,6 +247,41 @@ impl SparseMatrix {
     }
 }
 
+/// The stored entries of a [`SparseMatrix`] as `(row, col, value)`,
+/// column by column ([`SparseMatrix::entries`]): one position in the value
+/// array and the column it is in, advanced past empty columns.
+pub struct Entries<'a> {
+    col_ptr: &'a [usize],
+    rows: &'a [usize],
+    values: &'a [f64],
+    col: usize,
+    k: usize,
+}
+
+impl Iterator for Entries<'_> {
+    type Item = (usize, usize, f64);
+
+    #[inline]
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.k >= self.values.len() {
+            return None;
+        }
+        while self.col_ptr[self.col + 1] <= self.k {
+            self.col += 1;
+        }
+        let k = self.k;
+        self.k += 1;
+        Some((self.rows[k], self.col, self.values[k]))
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = self.values.len() - self.k;
+        (left, Some(left))
+    }
+}
+
+impl ExactSizeIterator for Entries<'_> {}
+
 /// The numeric kernel of the sparse LU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LuKernel {
@@ -252,7 +291,15 @@ pub enum LuKernel {
     /// By supernodes (columns with a common structure) with dense block
     /// kernels: pays off when the fronts are wide.
     Supernodal,
+    /// The matrix copied into a dense array and factored by the dense LU
+    /// with partial pivoting: no symbolic bookkeeping at all, cheapest for
+    /// the smallest systems (a rigid body on a joint, a few links).
+    Dense,
 }
+
+/// Number of unknowns up to which the dense kernel is chosen
+/// ([`LuKernel::Dense`]); the measurements are in the module header.
+pub const DENSE_UP_TO_UNKNOWNS: usize = 24;
 
 /// Predicted flops per factor entry above which the supernodal kernel is
 /// chosen: above the beams and chains of links (6.4–7.6, where neither
@@ -288,6 +335,9 @@ pub struct SparseLu {
 enum Factors {
     Simplicial(SimplicialLu<usize, f64>),
     Supernodal(Box<SupernodalFactors>),
+    /// `P A = L U` in one dense column-major array (`L` unit lower, below
+    /// the diagonal; `U` on and above it).
+    Dense(faer::Mat<f64>),
 }
 
 struct SupernodalFactors {
@@ -502,17 +552,22 @@ impl SparseLu {
             entries += hj + rj;
         }
         let flops_per_entry = if entries > 0.0 { flops / entries } else { 0.0 };
-        let kernel = kernel.unwrap_or(
-            if flops_per_entry > SUPERNODAL_FLOPS_PER_ENTRY || n < SUPERNODAL_BELOW_UNKNOWNS {
-                LuKernel::Supernodal
-            } else {
-                LuKernel::Simplicial
-            },
-        );
+        let kernel = kernel.unwrap_or(if n <= DENSE_UP_TO_UNKNOWNS {
+            LuKernel::Dense
+        } else if flops_per_entry > SUPERNODAL_FLOPS_PER_ENTRY || n < SUPERNODAL_BELOW_UNKNOWNS {
+            LuKernel::Supernodal
+        } else {
+            LuKernel::Simplicial
+        });
 
         let par = par_from_threads();
         let lu_params: Spec<PartialPivLuParams, f64> = Default::default();
         let (factors, factor_req, solve_req) = match kernel {
+            LuKernel::Dense => (
+                Factors::Dense(faer::Mat::zeros(n, n)),
+                dense_lu::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, lu_params),
+                dense_lu_solve::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
+            ),
             LuKernel::Simplicial => (
                 Factors::Simplicial(SimplicialLu::new()),
                 simplicial::factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n),
@@ -546,6 +601,12 @@ impl SparseLu {
                 )
             }
         };
+        // the dense kernel factors A itself: no column ordering
+        let (col_perm_fwd, col_perm_inv) = if kernel == LuKernel::Dense {
+            ((0..n).collect(), (0..n).collect())
+        } else {
+            (col_perm_fwd, col_perm_inv)
+        };
         Ok(Self {
             col_perm_fwd,
             col_perm_inv,
@@ -565,6 +626,7 @@ impl SparseLu {
         match self.factors {
             Factors::Simplicial(_) => LuKernel::Simplicial,
             Factors::Supernodal(_) => LuKernel::Supernodal,
+            Factors::Dense(_) => LuKernel::Dense,
         }
     }
 
@@ -616,6 +678,24 @@ impl SparseLu {
                     Default::default(),
                 )
             }
+            Factors::Dense(lu) => {
+                lu.fill(0.0);
+                let (ptr, rows) = (a.symbolic.col_ptr(), a.symbolic.row_idx());
+                for j in 0..n {
+                    for k in ptr[j]..ptr[j + 1] {
+                        lu[(rows[k], j)] = a.values[k];
+                    }
+                }
+                dense_lu::lu_in_place(
+                    lu.as_mut(),
+                    &mut self.row_perm_fwd,
+                    &mut self.row_perm_inv,
+                    Par::Seq,
+                    stack,
+                    Default::default(),
+                );
+                Ok(())
+            }
         };
         match result {
             Ok(()) => {}
@@ -648,6 +728,15 @@ impl SparseLu {
             Factors::Supernodal(f) => {
                 f.lu.solve_in_place_with_conj(row_perm, col_perm, Conj::No, x, self.par, stack)
             }
+            Factors::Dense(lu) => dense_lu_solve::solve_in_place_with_conj(
+                lu.as_ref(),
+                lu.as_ref(),
+                row_perm,
+                Conj::No,
+                x,
+                Par::Seq,
+                stack,
+            ),
         }
         if rhs.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NonFinite);
@@ -733,6 +822,15 @@ impl DeterminantSign {
                     return None;
                 }
                 Some(col * permutation_sign(&lu.row_perm_fwd) * simplicial_diagonal_sign(f))
+            }
+            Factors::Dense(f) => {
+                if !lu.factored {
+                    return None;
+                }
+                let diagonal: f64 = (0..n)
+                    .map(|j| f[(j, j)].signum() * f64::from(u8::from(f[(j, j)] != 0.0)))
+                    .product();
+                Some(permutation_sign(&lu.row_perm_fwd) * diagonal)
             }
             Factors::Supernodal(_) => {
                 if n >= SUPERNODAL_BELOW_UNKNOWNS || a.values.iter().any(|v| !v.is_finite()) {
@@ -858,7 +956,7 @@ mod tests {
             if det.abs() < 1e-8 {
                 continue;
             }
-            for kernel in [LuKernel::Simplicial, LuKernel::Supernodal] {
+            for kernel in [LuKernel::Simplicial, LuKernel::Supernodal, LuKernel::Dense] {
                 let mut lu = SparseLu::analyze_with(a, kernel).unwrap();
                 lu.factor(a).unwrap();
                 let sign = DeterminantSign::default().of(&lu, a);
@@ -908,7 +1006,7 @@ mod tests {
     #[test]
     fn lu_solves_saddle_point_systems_and_reuses_the_analysis() {
         let (a, b) = saddle(1.0);
-        for kernel in [LuKernel::Simplicial, LuKernel::Supernodal] {
+        for kernel in [LuKernel::Simplicial, LuKernel::Supernodal, LuKernel::Dense] {
             let mut lu = SparseLu::analyze_with(&a, kernel).unwrap();
             assert_eq!(lu.kernel(), kernel);
             solves_for_two_scales(&mut lu, &b);
@@ -979,13 +1077,23 @@ mod tests {
         assert!(lu.flops_per_entry() < 2.0, "{}", lu.flops_per_entry());
         let lu = SparseLu::analyze(&band(200)).unwrap();
         assert_eq!(lu.kernel(), LuKernel::Supernodal);
+        let lu = SparseLu::analyze(&band(DENSE_UP_TO_UNKNOWNS)).unwrap();
+        assert_eq!(lu.kernel(), LuKernel::Dense);
+        let lu = SparseLu::analyze(&band(DENSE_UP_TO_UNKNOWNS + 1)).unwrap();
+        assert_eq!(lu.kernel(), LuKernel::Supernodal);
         let lu = SparseLu::analyze(&blocks).unwrap();
         assert_eq!(lu.kernel(), LuKernel::Supernodal);
         assert!(lu.flops_per_entry() > 10.0, "{}", lu.flops_per_entry());
-        // both kernels solve both
-        for a in [&large_band, &blocks] {
+        // every kernel solves both, and a small one (the dense kernel only
+        // that: its work grows as the cube of the size)
+        let small = band(DENSE_UP_TO_UNKNOWNS);
+        for a in [&large_band, &blocks, &small] {
             let b: Vec<f64> = (0..a.dim()).map(|i| (i % 7) as f64 - 3.0).collect();
-            for kernel in [LuKernel::Simplicial, LuKernel::Supernodal] {
+            let kernels = [LuKernel::Simplicial, LuKernel::Supernodal, LuKernel::Dense];
+            for kernel in kernels
+                .into_iter()
+                .filter(|&k| k != LuKernel::Dense || a.dim() < 100)
+            {
                 let mut lu = SparseLu::analyze_with(a, kernel).unwrap();
                 lu.factor(a).unwrap();
                 let mut x = b.clone();
@@ -1067,6 +1175,13 @@ mod tests {
         let (eq, pivot) = smallest_relative_pivot(&a).unwrap();
         assert_eq!(eq, 2);
         assert!(pivot < 1e-12);
+        // the dense kernel of so small a system shows it as a non-finite
+        // solution, which the callers then locate as above
+        let mut lu = SparseLu::analyze(&a).unwrap();
+        assert_eq!(lu.kernel(), LuKernel::Dense);
+        lu.factor(&a).unwrap();
+        let mut x = vec![1.0, 1.0, 1.0];
+        assert_eq!(lu.solve_in_place(&mut x), Err(SolveError::NonFinite));
         // and a regular one is not flagged
         let p = a.position(2, 2).unwrap();
         a.values_mut()[p] = 5.0;

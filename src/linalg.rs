@@ -68,8 +68,7 @@
 //! saddle-point systems. The cut at 9 lies between them and the lattices.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::lu::partial_pivoting::factor::{self as dense_lu, PartialPivLuParams};
-use faer::linalg::lu::partial_pivoting::solve as dense_lu_solve;
+use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
 use faer::perm::PermRef;
 use faer::sparse::linalg::lu::factorize_symbolic_lu;
 use faer::sparse::linalg::lu::simplicial::{self, SimplicialLu};
@@ -299,7 +298,7 @@ pub enum LuKernel {
 
 /// Number of unknowns up to which the dense kernel is chosen
 /// ([`LuKernel::Dense`]); the measurements are in the module header.
-pub const DENSE_UP_TO_UNKNOWNS: usize = 24;
+pub const DENSE_UP_TO_UNKNOWNS: usize = 48;
 
 /// Predicted flops per factor entry above which the supernodal kernel is
 /// chosen: above the beams and chains of links (6.4–7.6, where neither
@@ -335,9 +334,123 @@ pub struct SparseLu {
 enum Factors {
     Simplicial(SimplicialLu<usize, f64>),
     Supernodal(Box<SupernodalFactors>),
-    /// `P A = L U` in one dense column-major array (`L` unit lower, below
-    /// the diagonal; `U` on and above it).
-    Dense(faer::Mat<f64>),
+    Dense(DenseLu),
+}
+
+/// `P A = L U` of a small matrix stored dense, by Gaussian elimination with
+/// partial (row) pivoting (Golub & Van Loan, *Matrix Computations*, 4th
+/// ed., algorithm 3.4.1, column-oriented): `L` unit lower, below the
+/// diagonal, and `U`, on and above it, in one column-major array; `P` as
+/// the row interchanges of each step. Written out rather than taken from
+/// faer's dense LU, whose blocked, recursive and vectorised kernel costs
+/// about 8,000 instructions for a factorisation of 11 unknowns and 3,600
+/// for a solve (the heavy top, bench/peer), several times the arithmetic.
+/// An exactly zero pivot is divided by like any other: its infinite or
+/// undefined entries come out of the solve, which reports them
+/// ([`SolveError::NonFinite`]), as the sparse kernels' do.
+struct DenseLu {
+    n: usize,
+    /// The factors, column-major `n × n`.
+    lu: Vec<f64>,
+    /// Row interchanged with row `k` at step `k`.
+    pivots: Vec<usize>,
+}
+
+impl DenseLu {
+    fn new(n: usize) -> Self {
+        Self {
+            n,
+            lu: vec![0.0; n * n],
+            pivots: vec![0; n],
+        }
+    }
+
+    fn factor(&mut self, a: &SparseMatrix) {
+        let n = self.n;
+        let lu = &mut self.lu;
+        lu.fill(0.0);
+        let (ptr, rows) = (a.symbolic.col_ptr(), a.symbolic.row_idx());
+        for j in 0..n {
+            for k in ptr[j]..ptr[j + 1] {
+                lu[j * n + rows[k]] = a.values[k];
+            }
+        }
+        for k in 0..n {
+            // pivot: the largest entry of column k on or below the diagonal
+            let column = &lu[k * n..(k + 1) * n];
+            let p = (k..n).fold(k, |p, i| {
+                if column[i].abs() > column[p].abs() {
+                    i
+                } else {
+                    p
+                }
+            });
+            self.pivots[k] = p;
+            if p != k {
+                for j in 0..n {
+                    lu.swap(j * n + k, j * n + p);
+                }
+            }
+            // multipliers l_ik = a_ik / a_kk, then the update of the
+            // trailing columns a_ij -= l_ik a_kj
+            let inv = 1.0 / lu[k * n + k];
+            for v in &mut lu[k * n + k + 1..(k + 1) * n] {
+                *v *= inv;
+            }
+            let (head, tail) = lu.split_at_mut((k + 1) * n);
+            let l = &head[k * n + k + 1..];
+            for column in tail.chunks_exact_mut(n) {
+                let u = column[k];
+                if u != 0.0 {
+                    for (c, &m) in column[k + 1..].iter_mut().zip(l) {
+                        *c -= m * u;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Solves `A x = b` in place with the factors.
+    fn solve(&self, b: &mut [f64]) {
+        let n = self.n;
+        for (k, &p) in self.pivots.iter().enumerate() {
+            b.swap(k, p);
+        }
+        // L y = P b (unit diagonal), then U x = y
+        for k in 0..n {
+            let bk = b[k];
+            for (v, &m) in b[k + 1..]
+                .iter_mut()
+                .zip(&self.lu[k * n + k + 1..(k + 1) * n])
+            {
+                *v -= m * bk;
+            }
+        }
+        for k in (0..n).rev() {
+            b[k] /= self.lu[k * n + k];
+            let bk = b[k];
+            for (v, &u) in b[..k].iter_mut().zip(&self.lu[k * n..k * n + k]) {
+                *v -= u * bk;
+            }
+        }
+    }
+
+    /// `sgn det A = sgn P · Π sgn uₖₖ` (0 if a pivot is zero).
+    fn determinant_sign(&self) -> f64 {
+        let n = self.n;
+        let swaps = self
+            .pivots
+            .iter()
+            .enumerate()
+            .filter(|&(k, &p)| p != k)
+            .count();
+        let mut sign = if swaps.is_multiple_of(2) { 1.0 } else { -1.0 };
+        for k in 0..n {
+            let d = self.lu[k * n + k];
+            sign *= d.signum() * f64::from(u8::from(d != 0.0));
+        }
+        sign
+    }
 }
 
 struct SupernodalFactors {
@@ -564,9 +677,9 @@ impl SparseLu {
         let lu_params: Spec<PartialPivLuParams, f64> = Default::default();
         let (factors, factor_req, solve_req) = match kernel {
             LuKernel::Dense => (
-                Factors::Dense(faer::Mat::zeros(n, n)),
-                dense_lu::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, lu_params),
-                dense_lu_solve::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
+                Factors::Dense(DenseLu::new(n)),
+                StackReq::EMPTY,
+                StackReq::EMPTY,
             ),
             LuKernel::Simplicial => (
                 Factors::Simplicial(SimplicialLu::new()),
@@ -679,21 +792,7 @@ impl SparseLu {
                 )
             }
             Factors::Dense(lu) => {
-                lu.fill(0.0);
-                let (ptr, rows) = (a.symbolic.col_ptr(), a.symbolic.row_idx());
-                for j in 0..n {
-                    for k in ptr[j]..ptr[j + 1] {
-                        lu[(rows[k], j)] = a.values[k];
-                    }
-                }
-                dense_lu::lu_in_place(
-                    lu.as_mut(),
-                    &mut self.row_perm_fwd,
-                    &mut self.row_perm_inv,
-                    Par::Seq,
-                    stack,
-                    Default::default(),
-                );
+                lu.factor(a);
                 Ok(())
             }
         };
@@ -717,26 +816,22 @@ impl SparseLu {
     pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), SolveError> {
         assert!(self.factored, "solve before a successful factorisation");
         let n = rhs.len();
-        let row_perm = PermRef::new_checked(&self.row_perm_fwd, &self.row_perm_inv, n);
-        let col_perm = PermRef::new_checked(&self.col_perm_fwd, &self.col_perm_inv, n);
-        let stack = MemStack::new(&mut self.solve_mem);
-        let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-        match &self.factors {
-            Factors::Simplicial(lu) => {
-                lu.solve_in_place_with_conj(row_perm, col_perm, Conj::No, x, self.par, stack)
+        if let Factors::Dense(lu) = &self.factors {
+            lu.solve(rhs);
+        } else {
+            let row_perm = PermRef::new_checked(&self.row_perm_fwd, &self.row_perm_inv, n);
+            let col_perm = PermRef::new_checked(&self.col_perm_fwd, &self.col_perm_inv, n);
+            let stack = MemStack::new(&mut self.solve_mem);
+            let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+            match &self.factors {
+                Factors::Simplicial(lu) => {
+                    lu.solve_in_place_with_conj(row_perm, col_perm, Conj::No, x, self.par, stack)
+                }
+                Factors::Supernodal(f) => {
+                    f.lu.solve_in_place_with_conj(row_perm, col_perm, Conj::No, x, self.par, stack)
+                }
+                Factors::Dense(_) => {} // solved above
             }
-            Factors::Supernodal(f) => {
-                f.lu.solve_in_place_with_conj(row_perm, col_perm, Conj::No, x, self.par, stack)
-            }
-            Factors::Dense(lu) => dense_lu_solve::solve_in_place_with_conj(
-                lu.as_ref(),
-                lu.as_ref(),
-                row_perm,
-                Conj::No,
-                x,
-                Par::Seq,
-                stack,
-            ),
         }
         if rhs.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NonFinite);
@@ -827,10 +922,7 @@ impl DeterminantSign {
                 if !lu.factored {
                     return None;
                 }
-                let diagonal: f64 = (0..n)
-                    .map(|j| f[(j, j)].signum() * f64::from(u8::from(f[(j, j)] != 0.0)))
-                    .product();
-                Some(permutation_sign(&lu.row_perm_fwd) * diagonal)
+                Some(f.determinant_sign())
             }
             Factors::Supernodal(_) => {
                 if n >= SUPERNODAL_BELOW_UNKNOWNS || a.values.iter().any(|v| !v.is_finite()) {

@@ -398,9 +398,10 @@ impl Beam {
             let blk = bbt * n_lmt;
             add_mat(kt, ri, 0, &(-blk));
             add_mat(kt, ri, 6, &blk);
+            let (bbt_n_dm, d_i) = (bbt * n_dm, d_beta[i] + d_phi[i]);
             for j in 0..2 {
                 let cj = 6 * j + 3;
-                let blk = bbt * n_dm * ops.bbeta[j] + (d_beta[i] + d_phi[i]) * ops.bphi[j];
+                let blk = bbt_n_dm * ops.bbeta[j] + d_i * ops.bphi[j];
                 add_mat(kt, ri, cj, &blk);
             }
         }

@@ -6,10 +6,13 @@
 //! - the lattice mast of `examples/lattice_mast.rs` (8 / 30 / 99 bays),
 //! - a square grid of beams (20², 40², 60² nodes),
 //!
-//! with the kernel the rule in `src/linalg.rs` picks. These are the
-//! measurements behind that rule.
+//! with the kernel the rule in `src/linalg.rs` picks; and, with `-- small`
+//! alone, small systems (cantilevers of 1 to 320 beams, chains of 1 to 20
+//! links) with the dense kernel besides. These are the measurements behind
+//! that rule.
 //!
-//! Run with `cargo bench --bench lu_kernel`.
+//! Run with `cargo bench --bench lu_kernel` (`-- small` for the small
+//! systems).
 
 #[allow(dead_code)]
 mod common;
@@ -46,18 +49,22 @@ fn deformed(model: &Model) -> State {
     state
 }
 
-/// Median times of factor + solve of `a` with the simplicial and the
-/// supernodal kernel, alternated repetition by repetition (so that a
-/// change of load on the machine weighs on both alike) for about a second
-/// (at least 5 repetitions each).
-fn factor_solve(a: &SparseMatrix) -> (f64, f64) {
-    let mut lu = [LuKernel::Simplicial, LuKernel::Supernodal]
-        .map(|k| SparseLu::analyze_with(a, k).expect("symbolic analysis"));
+/// Median times of factor + solve of `a` with each of `kernels`,
+/// alternated repetition by repetition (so that a change of load on the
+/// machine weighs on all alike) for about a second (at least 5
+/// repetitions each, at most `most`).
+fn factor_solve_with<const K: usize>(
+    a: &SparseMatrix,
+    kernels: [LuKernel; K],
+    most: usize,
+) -> [f64; K] {
+    let mut lu = kernels.map(|k| SparseLu::analyze_with(a, k).expect("symbolic analysis"));
     let b: Vec<f64> = (0..a.dim()).map(|i| 1.0 + (i % 5) as f64).collect();
     let mut x = b.clone();
-    let mut times = [Vec::new(), Vec::new()];
+    let mut times = [(); K].map(|_| Vec::new());
     let start = Instant::now();
-    while times[0].len() < 5 || (start.elapsed() < Duration::from_secs(1) && times[0].len() < 201) {
+    while times[0].len() < 5 || (start.elapsed() < Duration::from_secs(1) && times[0].len() < most)
+    {
         for (lu, t) in lu.iter_mut().zip(times.iter_mut()) {
             x.copy_from_slice(&b);
             let t0 = Instant::now();
@@ -66,8 +73,45 @@ fn factor_solve(a: &SparseMatrix) -> (f64, f64) {
             t.push(t0.elapsed().as_secs_f64());
         }
     }
-    let [s, p] = times;
-    (median(s), median(p))
+    times.map(median)
+}
+
+/// Median times of factor + solve of `a` with the simplicial and the
+/// supernodal kernel (see [`factor_solve_with`]).
+fn factor_solve(a: &SparseMatrix) -> (f64, f64) {
+    let [s, p] = factor_solve_with(a, [LuKernel::Simplicial, LuKernel::Supernodal], 201);
+    (s, p)
+}
+
+/// The small systems: factor + solve with the three kernels, in µs.
+fn small_systems() {
+    println!("factor + solve in µs (median of repetitions)");
+    println!(
+        "{:<22} {:>8} {:>10} {:>11} {:>11} {:>11} {:>11}",
+        "model", "unknowns", "nnz", "simplicial", "supernodal", "dense", "rule"
+    );
+    let models = [1, 2, 4, 10, 20, 80, 320]
+        .map(|n| (format!("cantilever {n}"), cantilever(n)))
+        .into_iter()
+        .chain([1, 2, 5, 20].map(|n| (format!("joint chain {n}"), chain(n))));
+    for (name, model) in models {
+        let mut solver = NewtonSolver::new(&model);
+        solver.assemble(&model, &deformed(&model), 1.0, true);
+        let a = solver.tangent();
+        let kernels = [LuKernel::Simplicial, LuKernel::Supernodal, LuKernel::Dense];
+        let [s, p, d] = factor_solve_with(a, kernels, 20_001);
+        let chosen = SparseLu::analyze(a).expect("symbolic analysis");
+        println!(
+            "{:<22} {:>8} {:>10} {:>11.2} {:>11.2} {:>11.2} {:>11}",
+            name,
+            a.dim(),
+            a.nnz(),
+            1e6 * s,
+            1e6 * p,
+            1e6 * d,
+            format!("{:?}", chosen.kernel()),
+        );
+    }
 }
 
 fn report(name: &str, solver: &NewtonSolver) {
@@ -88,6 +132,10 @@ fn report(name: &str, solver: &NewtonSolver) {
 }
 
 fn main() {
+    if std::env::args().any(|a| a == "small") {
+        small_systems();
+        return;
+    }
     println!(
         "threads: {}; factor + solve in ms (median of repetitions)",
         rayon::current_num_threads()

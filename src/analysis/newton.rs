@@ -1317,7 +1317,7 @@ impl NewtonSolver {
         let lu = self.lu.as_mut().expect("analysed above");
         self.newton_sign = None;
         lu.factor(&self.assembler.matrix)?;
-        if lu.kernel() == LuKernel::Simplicial {
+        if lu.kernel() != LuKernel::Supernodal {
             // read off the factors: a pass over them, no more
             self.newton_sign = self.determinant.of(lu, &self.assembler.matrix);
         }
@@ -1334,7 +1334,7 @@ impl NewtonSolver {
     pub fn tangent_sign(&mut self) -> Option<f64> {
         let lu = self.lu.as_ref()?;
         match lu.kernel() {
-            LuKernel::Simplicial => self.newton_sign,
+            LuKernel::Simplicial | LuKernel::Dense => self.newton_sign,
             LuKernel::Supernodal => self.determinant.of(lu, &self.assembler.matrix),
         }
     }

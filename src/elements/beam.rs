@@ -45,7 +45,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::inertia::{rayleigh_damping, BeamInertia};
 use super::{
-    add_scaled, add_vec, node_motion, CellShape, Element, ElementKind, ElementOutput, EvalContext,
+    add_block, add_scaled, add_vec, node_motion, CellShape, Element, ElementKind, ElementOutput,
+    EvalContext,
 };
 use crate::curves::{Curve, CurveIndex};
 use crate::model::Id;
@@ -129,6 +130,8 @@ pub struct Beam {
     section: BeamSection,
     /// Offsets `Qᵢ` from node frame to section frame.
     offsets: [Rotation; 2],
+    /// The offsets `Qᵢ` as matrices.
+    offset_matrices: [Mat3; 2],
     /// Strains of the reference configuration, `(Γ_ref, K_ref)`.
     reference_strain: Vec6,
     /// Strain added to the stress-free state.
@@ -221,6 +224,7 @@ impl Beam {
             length,
             section,
             offsets,
+            offset_matrices: offsets.map(|q| so3::matrix(&q)),
             reference_strain: Vec6::zeros(),
             initial,
             inertia,
@@ -394,9 +398,10 @@ impl Beam {
             let blk = bbt * n_lmt;
             add_mat(kt, ri, 0, &(-blk));
             add_mat(kt, ri, 6, &blk);
+            let (bbt_n_dm, d_i) = (bbt * n_dm, d_beta[i] + d_phi[i]);
             for j in 0..2 {
                 let cj = 6 * j + 3;
-                let blk = bbt * n_dm * ops.bbeta[j] + (d_beta[i] + d_phi[i]) * ops.bphi[j];
+                let blk = bbt_n_dm * ops.bbeta[j] + d_i * ops.bphi[j];
                 add_mat(kt, ri, cj, &blk);
             }
         }
@@ -404,7 +409,7 @@ impl Beam {
 
     /// The offsets `Qᵢ` as matrices.
     fn offset_matrices(&self) -> [Mat3; 2] {
-        self.offsets.map(|q| so3::matrix(&q))
+        self.offset_matrices
     }
 
     /// Node velocities `(ẋ₁, Ω₁, ẋ₂, Ω₂)` (`Ω` material).
@@ -533,6 +538,24 @@ fn add_mat(k: &mut Mat12, r: usize, c: usize, m: &Mat3) {
     v += m;
 }
 
+/// Adds `kt`, carried to the node variables as by [`in_node_frames`], into
+/// the column-major 12 × 12 buffer `buf`, block by block without an
+/// intermediate matrix.
+fn add_in_node_frames(buf: &mut [f64], kt: &Mat12, q: &[Mat3; 2]) {
+    for bj in 0..4 {
+        for bi in 0..4 {
+            let mut blk: Mat3 = kt.fixed_view::<3, 3>(3 * bi, 3 * bj).into();
+            if bi % 2 == 1 {
+                blk = q[bi / 2] * blk;
+            }
+            if bj % 2 == 1 {
+                blk *= q[bj / 2].transpose();
+            }
+            add_block(buf, 12, 3 * bi, 3 * bj, &blk);
+        }
+    }
+}
+
 /// A matrix in the section variables `(δx₁, δα₁, δx₂, δα₂)` carried to
 /// the node variables (`δαᵢ = Qᵢᵀ δΘᵢ`): `K_ΘΘ = Qᵢ K_αα Qⱼᵀ`,
 /// `K_xΘ = K_xα Qⱼᵀ`, `K_Θx = Qᵢ K_αx`.
@@ -602,7 +625,7 @@ impl Element for Beam {
             add_vec(out.residual, 6 * i + 3, &(q[i] * fa));
         }
         if let (Some(kt), Some(stiffness)) = (kt, out.stiffness.as_deref_mut()) {
-            add_scaled(stiffness, 12, 0, 1.0, &in_node_frames(&kt, &q));
+            add_in_node_frames(stiffness, &kt, &q);
         }
 
         // Rayleigh damping, I10–I12: forces and their q-derivatives in
@@ -619,21 +642,15 @@ impl Element for Beam {
         if !self.has_inertia || !(ctx.dynamics || weights.is_some()) {
             return;
         }
-        let motion = [
-            node_motion(state, self.nodes[0]),
-            node_motion(state, self.nodes[1]),
-        ];
-        if ctx.dynamics {
-            let r = self.inertia.residual(&motion);
-            for (o, v) in out.residual.iter_mut().zip(r.iter()) {
-                *o += v;
-            }
-        }
-        if let (Some(w), Some(d)) = (weights, out.inertia.as_deref_mut()) {
-            let blocks = self.inertia.evaluate(&motion);
-            add_scaled(d, 12, 0, w.mass, &blocks.mass);
-            add_scaled(d, 12, 0, w.damping, &blocks.gyroscopic);
-        }
+        let [a, b] = self.nodes;
+        self.inertia.add_to(
+            [&state.velocity[a], &state.velocity[b]],
+            [&state.acceleration[a], &state.acceleration[b]],
+            ctx.dynamics.then_some(&mut *out.residual),
+            weights
+                .zip(out.inertia.as_deref_mut())
+                .map(|(w, d)| (d, [w.mass, w.damping])),
+        );
     }
 
     fn result_names(&self) -> &'static [&'static str] {

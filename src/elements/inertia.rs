@@ -351,6 +351,62 @@ impl BeamInertia {
         f
     }
 
+    /// Adds what [`BeamInertia::residual`] and [`BeamInertia::evaluate`]
+    /// give, in one pass and only on their nonzero blocks: the residual
+    /// (I8) into `residual` when given, and `w_m M + w_d C` into the
+    /// column-major 12 × 12 buffer `matrix` when given (`weights =
+    /// (w_m, w_d)`). Per node the rotational blocks are those of a rigid
+    /// body with `c = 0`: `Mᵢ = Jᵢ`, `Cᵢ = Ωᵢ~ Jᵢ − (Jᵢ Ωᵢ)~` (I3–I4), no
+    /// rotation matrix needed; the translational mass is `Mᵢⱼ I₃` (I7). The
+    /// same arithmetic as the general kernels, entry by entry.
+    pub fn add_to(
+        &self,
+        velocity: [&[f64; 6]; 2],
+        acceleration: [&[f64; 6]; 2],
+        residual: Option<&mut [f64]>,
+        matrix: Option<(&mut [f64], [f64; 2])>,
+    ) {
+        let v3 = |a: &[f64; 6], k: usize| Vec3::new(a[k], a[k + 1], a[k + 2]);
+        if let Some(out) = residual {
+            for i in 0..2 {
+                let jo = self.rotary[i].inertia_at_node();
+                let (w, w_dot) = (v3(velocity[i], 3), v3(acceleration[i], 3));
+                // r_xᵢ = Σⱼ Mᵢⱼ ẍⱼ, r_Θᵢ = Jᵢ Ω̇ᵢ + Ωᵢ × Jᵢ Ωᵢ
+                let mut rx = Vec3::zeros();
+                for (j, a) in acceleration.iter().enumerate() {
+                    rx += v3(a, 0) * self.translational(i, j);
+                }
+                let rt = jo * w_dot + w.cross(&(jo * w));
+                for k in 0..3 {
+                    out[6 * i + k] += rx[k];
+                    out[6 * i + 3 + k] += rt[k];
+                }
+            }
+        }
+        let Some((d, [w_mass, w_damping])) = matrix else {
+            return;
+        };
+        for i in 0..2 {
+            let jo = self.rotary[i].inertia_at_node();
+            let w = v3(velocity[i], 3);
+            let c_tw = skew(&w) * jo - skew(&(jo * w));
+            let r = 6 * i + 3;
+            for col in 0..3 {
+                for row in 0..3 {
+                    let e = &mut d[(r + col) * 12 + r + row];
+                    *e += w_mass * jo[(row, col)];
+                    *e += w_damping * c_tw[(row, col)];
+                }
+            }
+            for j in 0..2 {
+                let m = w_mass * self.translational(i, j);
+                for k in 0..3 {
+                    d[(6 * j + k) * 12 + 6 * i + k] += m;
+                }
+            }
+        }
+    }
+
     /// Kinetic energy, eq. I7:
     /// `½ Σᵢⱼ Mᵢⱼ ẋᵢ·ẋⱼ + ½ Σᵢ Ωᵢ·Jᵢ Ωᵢ`.
     pub fn kinetic_energy(&self, n: &[NodeMotion; 2]) -> f64 {

@@ -2597,11 +2597,19 @@ impl Watch {
                 increment: info.increment,
                 from: info.time - info.step,
                 time: info.time,
-                message: format!(
-                    "the energy balance error changed by {:.3e} in one step (from {before:.3e} to {after:.3e}), more than {} % of the largest energy of the motion ({largest:.3e}): the step created or lost energy; its results are suspect (shorten time_step, or use adaptive steps)",
-                    after - before,
-                    ENERGY_JUMP * 100.0,
-                ),
+                message: if after > before {
+                    format!(
+                        "the energy balance error changed by {:.3e} in one step (from {before:.3e} to {after:.3e}), more than {} % of the largest energy of the motion ({largest:.3e}): the step created energy; its results are suspect (shorten time_step, or use adaptive steps)",
+                        after - before,
+                        ENERGY_JUMP * 100.0,
+                    )
+                } else {
+                    format!(
+                        "the energy balance error changed by {:.3e} in one step (from {before:.3e} to {after:.3e}), more than {} % of the largest energy of the motion ({largest:.3e}): the step lost energy, through the numerical damping of vibrations faster than the step (rho_infinity < 1; after a lock or an impact, the structure's ringing) or a step far too long for the motion; the loads of the vibrations it damped are not in the results (shorten time_step, or raise rho_infinity, to follow them)",
+                        after - before,
+                        ENERGY_JUMP * 100.0,
+                    )
+                },
             })
             .collect()
     }
@@ -2756,6 +2764,25 @@ mod tests {
         let message = &warnings[0].message;
         assert!(message.contains("changed by 1.665e2"), "{message}");
         assert!(message.contains("more than 5 %"), "{message}");
+        assert!(message.contains("the step created energy"), "{message}");
+        // the same jump downwards, numerical damping of the ringing: said
+        // to be a loss, with the way to follow it
+        let mut watch = Watch {
+            start: at(0.0, 0.0, 9.869604401089, 0.0),
+            ..Watch::default()
+        };
+        let step25 = Energies {
+            balance_error: -1.664721e2,
+            ..step25
+        };
+        watch.energy_jump(&step(24), &start, &step24);
+        watch.energy_jump(&step(25), &step24, &step25);
+        let warnings = watch.warnings();
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        let message = &warnings[0].message;
+        assert!(message.contains("changed by -1.665e2"), "{message}");
+        assert!(message.contains("the step lost energy"), "{message}");
+        assert!(message.contains("raise rho_infinity"), "{message}");
     }
 
     /// From rest, the first steps' balance errors are large next to the

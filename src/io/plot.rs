@@ -1058,6 +1058,33 @@ mod tests {
         assert!(svg.contains("stage (b)"));
     }
 
+    /// Labels crowded at one instant and spread over the range, of
+    /// events and of ticks: whatever the width, no two boxes overlap,
+    /// each lies in one of the rows, and those that find no room are left
+    /// out rather than drawn over another.
+    #[test]
+    fn event_labels_never_overlap() {
+        let mut chart = sample();
+        for k in 0..30 {
+            let x = if k < 15 { 2.0 } else { 0.17 * k as f64 - 2.5 };
+            chart = chart
+                .event(x, format!("latch {k} locks"))
+                .tick(x + 0.01, format!("latch {k}: 3 engages, 2 disengages"));
+        }
+        for width in [60, 200, 790, 3000] {
+            let boxes = chart.label_boxes(width).unwrap();
+            assert!(!boxes.is_empty());
+            assert!(boxes.len() < 60, "{} at {width}", boxes.len());
+            for (i, a) in boxes.iter().enumerate() {
+                assert!(a.row < EVENT_ROWS && a.left >= 0, "{a:?}");
+                for b in &boxes[i + 1..] {
+                    assert!(!a.overlaps(b), "at {width} px: {a:?} {b:?}");
+                }
+            }
+        }
+        assert!(chart.to_svg().unwrap().contains("latch 0 locks"));
+    }
+
     /// The isometric view draws the three unit axes with the same length
     /// `√(2/3)` at 120° to one another, `z` straight up.
     #[test]

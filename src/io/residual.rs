@@ -73,13 +73,13 @@ impl Reported {
         if !moments_round_off {
             others = others.max(ratio(n.residual_moment, n.flux_moment));
         }
-        if others >= relative {
-            // the measure comes from a group above round-off
-            Self::Ratio(relative)
-        } else if others <= ROUND_OFF_FACTOR * f64::EPSILON {
+        // the measure if it comes from a group above round-off, else the
+        // bound of those groups
+        let value = relative.min(others);
+        if value <= ROUND_OFF_FACTOR * f64::EPSILON {
             Self::RoundOff
         } else {
-            Self::Ratio(others)
+            Self::Ratio(value)
         }
     }
 

@@ -135,14 +135,26 @@ mod tests {
     /// (the moments' own ratio, 1e-16, is round-off as well).
     #[test]
     fn round_off_over_round_off_is_reported_as_round_off() {
-        let n = norms(1.136e-16, 1.606e-16, 8.882e-16, 8.886, 0.7071);
+        let n = norms(
+            1.136e-16,
+            1.606e-16,
+            8.882e-16,
+            8.886,
+            std::f64::consts::FRAC_1_SQRT_2,
+        );
         assert_eq!(Reported::of(&n, 0.5), Reported::RoundOff);
         assert_eq!(
             format!("{}", Shown::<1>(Reported::of(&n, 0.5))),
             "round-off"
         );
         // in other units (mm, N·mm): the same report
-        let mm = norms(1.136e-16, 1.606e-16, 8.882e-13, 8.886e3, 0.7071);
+        let mm = norms(
+            1.136e-16,
+            1.606e-16,
+            8.882e-13,
+            8.886e3,
+            std::f64::consts::FRAC_1_SQRT_2,
+        );
         assert_eq!(Reported::of(&mm, 500.0), Reported::RoundOff);
     }
 
@@ -152,10 +164,22 @@ mod tests {
     /// moments: 2e-8 of the loads, far above 1024 ε = 2.3e-13).
     #[test]
     fn residuals_above_round_off_keep_the_measure() {
-        let moving = norms(22.54, 31.88, 0.5559, 6.532, 0.7071);
-        assert_eq!(Reported::of(&moving, 0.5), Reported::Ratio(0.7071));
-        let small = norms(3.689e-7, 5.217e-7, 5.341e-7, 8.886, 0.7071);
-        assert_eq!(Reported::of(&small, 0.5), Reported::Ratio(0.7071));
+        let moving = norms(22.54, 31.88, 0.5559, 6.532, std::f64::consts::FRAC_1_SQRT_2);
+        assert_eq!(
+            Reported::of(&moving, 0.5),
+            Reported::Ratio(std::f64::consts::FRAC_1_SQRT_2)
+        );
+        let small = norms(
+            3.689e-7,
+            5.217e-7,
+            5.341e-7,
+            8.886,
+            std::f64::consts::FRAC_1_SQRT_2,
+        );
+        assert_eq!(
+            Reported::of(&small, 0.5),
+            Reported::Ratio(std::f64::consts::FRAC_1_SQRT_2)
+        );
     }
 
     /// Forces at round-off, moments not converged: the moments' ratio

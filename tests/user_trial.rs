@@ -161,16 +161,13 @@ fn residuals_at_round_off_after_a_rigid_lock_are_reported_as_round_off() {
     assert!(both >= 100, "{both} iterations at round-off");
     let steps: Vec<&&str> = after
         .iter()
-        .filter(|l| l.starts_with("step ") && l.contains("relative residuals: "))
+        .filter(|l| l.starts_with("step ") && l.contains("relative residuals"))
         .collect();
     assert!(steps.len() >= 300, "{}", steps.len());
     let mut stopped = 0;
     for line in &steps {
-        let values = line.split("relative residuals: ").nth(1).unwrap();
-        let (values, marked) = match values.strip_suffix(" (stopped at round-off)") {
-            Some(v) => (v, true),
-            None => (values, false),
-        };
+        let marked = line.contains("relative residuals (stopped at round-off): ");
+        let values = line.rsplit_once(": ").unwrap().1;
         let last = values.split(' ').next_back().unwrap();
         match last.parse::<f64>() {
             // above the tolerance only if marked, marked only if above
@@ -296,7 +293,7 @@ fn summary_counts_add_up_to_the_rows_of_events_csv() {
     assert!(count("engage") >= 8, "{}", count("engage"));
     let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
     let counted = format!(
-        "1 lock, {} engages, {} disengages, energy lost in impacts",
+        "1 lock, energy lost in impacts 0.000e0; spring latches' band crossings: {} engages, {} disengages",
         count("engage"),
         count("disengage")
     );

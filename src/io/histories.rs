@@ -793,7 +793,9 @@ impl Histories {
     /// events closer to the one before than [`EVENT_GROUP`] of the chart's
     /// time range are labelled once as a group ("10 impacts at joint 2,
     /// 1.242–1.354 s, 0.6131 J lost"), so that a run of rebounds does not
-    /// pile up its labels.
+    /// pile up its labels; a spring latch's band crossings are ticks, one
+    /// label per rattle ("latch 20: 10 engages, 10 disengages, 0.275–1.772
+    /// s").
     fn with_events(&self, mut chart: Chart, joint: Option<Id>, units: UnitLabels) -> Chart {
         let (mut minor, mut events): (Vec<&Event>, Vec<&Event>) =
             self.events_of(joint).partition(|e| e.is_minor());

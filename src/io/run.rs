@@ -346,6 +346,11 @@ fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
             "contact released",
             "contacts released",
         ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let crossings: Vec<String> = [
         plural(sum(|d| d.engages), "engage", "engages"),
         plural(sum(|d| d.disengages), "disengage", "disengages"),
         plural(sum(|d| d.rearms), "rearm", "rearms"),
@@ -353,8 +358,10 @@ fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
     .into_iter()
     .flatten()
     .collect();
+    let crossings = (!crossings.is_empty())
+        .then(|| format!("spring latches' band crossings: {}", crossings.join(", ")));
     if parts.is_empty() {
-        return None;
+        return crossings;
     }
     let lost: f64 = records.iter().map(|d| d.impact_energy_lost).sum();
     // a spring latch that releases drops the energy its spring held
@@ -363,10 +370,11 @@ fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
     } else {
         "in impacts"
     };
-    Some(format!(
-        "{}, energy lost {how} {lost:.3e}",
-        parts.join(", ")
-    ))
+    let events = format!("{}, energy lost {how} {lost:.3e}", parts.join(", "));
+    Some(match crossings {
+        Some(c) => format!("{events}; {c}"),
+        None => events,
+    })
 }
 
 /// The size of a model in one line: nodes and elements of each kind.
@@ -1382,18 +1390,37 @@ impl Observer for Recorder {
         } else {
             ("increment", "dt")
         };
+        let kinematic = self.current.kind == "kinematic";
+        // converged above the tolerance: accepted at the round-off
+        // plateau of the residual (docs/theory.md §7.1)
+        let last = values
+            .len()
+            .checked_sub(1)
+            .and_then(|k| self.reported.get(k));
+        let stopped = match (kinematic, last, values.last()) {
+            (false, Some(&(value, Reported::Ratio(r))), Some(v)) => {
+                value.to_bits() == v.to_bits()
+                    && info.iterations > 0
+                    && r > self.current.residual_tolerance
+            }
+            _ => false,
+        };
         // the line in a buffer kept from step to step
         let mut text = std::mem::take(&mut self.text);
         text.clear();
         let _ = write!(
             text,
-            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  {what}: ",
+            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  {what}{}: ",
             info.increment,
             info.time,
             Sci::<3>(info.step),
             info.iterations,
+            if stopped {
+                " (stopped at round-off)"
+            } else {
+                ""
+            },
         );
-        let kinematic = self.current.kind == "kinematic";
         for (k, r) in values.iter().enumerate() {
             let sep = if k == 0 { "" } else { " " };
             // the report of the iteration that gave this residual (the
@@ -1405,22 +1432,6 @@ impl Observer for Recorder {
                 _ => {
                     let _ = write!(text, "{sep}{}", Sci::<1>(*r));
                 }
-            }
-        }
-        // converged above the tolerance: accepted at the round-off
-        // plateau of the residual (docs/theory.md §7.1)
-        let last = values
-            .len()
-            .checked_sub(1)
-            .and_then(|k| self.reported.get(k));
-        if let (false, Some(&(value, Reported::Ratio(r))), Some(v)) =
-            (kinematic, last, values.last())
-        {
-            if value.to_bits() == v.to_bits()
-                && info.iterations > 0
-                && r > self.current.residual_tolerance
-            {
-                text.push_str(" (stopped at round-off)");
             }
         }
         self.line(&text);

@@ -322,9 +322,10 @@ pub fn dynamic_error_message(model: &Model, state: &State, error: &DynamicError)
 }
 
 /// The events of dynamic analyses in a few words (`1 lock, 3 impacts,
-/// 1 contact closed, energy lost in impacts 7.401e0`), or `None` if they
-/// had none: the counts of `events.csv`'s rows of each kind and the energy
-/// their impacts dissipated.
+/// 1 contact closed, energy lost in impacts 7.401e0`, then `; spring
+/// latches' band crossings: 6 engages, 5 disengages` if any), or `None`
+/// if they had none: the counts of `events.csv`'s rows of each kind and
+/// the energy their impacts dissipated.
 fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
     let sum = |f: fn(&DynamicRecord) -> usize| records.iter().map(|d| f(d)).sum::<usize>();
     let plural = |n: usize, one: &str, many: &str| match n {

@@ -441,6 +441,23 @@ struct Event {
     kind: Option<String>,
     /// Energy lost at the event (`events.csv`), in the model's units.
     lost: Option<f64>,
+    /// The element (latch, stop, contact) of an `events.csv` row, if the
+    /// file names it.
+    element: Option<Id>,
+}
+
+/// Kinds of `events.csv` rows drawn as ticks rather than labelled lines:
+/// a spring latch's band crossings, which come by the dozen when it
+/// rattles across its dead band.
+const MINOR_EVENTS: [&str; 3] = ["engage", "disengage", "rearm"];
+
+impl Event {
+    /// Whether it is drawn as a tick ([`MINOR_EVENTS`]).
+    fn is_minor(&self) -> bool {
+        self.kind
+            .as_deref()
+            .is_some_and(|k| MINOR_EVENTS.contains(&k))
+    }
 }
 
 /// The result files of one run, read.
@@ -561,6 +578,7 @@ impl Histories {
                         label: format!("latch {id} locks"),
                         kind: None,
                         lost: None,
+                        element: Some(id),
                     });
                 }
             }
@@ -571,8 +589,13 @@ impl Histories {
             let time = t.column("time")?;
             let joint = t.find("joint");
             let lost = t.find("energy_lost");
+            let element = t.find("element");
             let kind = ["event", "kind", "type"].iter().find_map(|c| t.find(c));
             for r in 0..t.rows.len() {
+                let element = match element {
+                    Some(c) if !t.rows[r].1[c].is_empty() => Some(t.id(r, c)?),
+                    _ => None,
+                };
                 let at = t.number(r, time)?;
                 let joint = match joint {
                     Some(c) if !t.rows[r].1[c].is_empty() => Some(t.id(r, c)?),
@@ -594,6 +617,18 @@ impl Histories {
                 // (and joint, where both are known) takes the energy lost
                 // instead of a second line
                 let tol = 1e-9 * at.abs().max(1.0);
+                let minor = kind.as_str();
+                if MINOR_EVENTS.contains(&minor) {
+                    events.push(Event {
+                        time: at,
+                        joint,
+                        label,
+                        kind: Some(kind),
+                        lost,
+                        element,
+                    });
+                    continue;
+                }
                 if let Some(e) = events.iter_mut().find(|e: &&mut Event| {
                     (e.time - at).abs() <= tol
                         && (e.joint == joint || joint.is_none() || e.joint.is_none())
@@ -607,6 +642,7 @@ impl Histories {
                     label,
                     kind: Some(kind),
                     lost,
+                    element,
                 });
             }
         }
@@ -757,10 +793,14 @@ impl Histories {
     /// events closer to the one before than [`EVENT_GROUP`] of the chart's
     /// time range are labelled once as a group ("10 impacts at joint 2,
     /// 1.242–1.354 s, 0.6131 J lost"), so that a run of rebounds does not
-    /// pile up its labels.
+    /// pile up its labels; a spring latch's band crossings are ticks, one
+    /// label per rattle ("latch 20: 10 engages, 10 disengages, 0.275–1.772
+    /// s").
     fn with_events(&self, mut chart: Chart, joint: Option<Id>, units: UnitLabels) -> Chart {
-        let mut events: Vec<&Event> = self.events_of(joint).collect();
+        let (mut minor, mut events): (Vec<&Event>, Vec<&Event>) =
+            self.events_of(joint).partition(|e| e.is_minor());
         events.sort_by(|a, b| a.time.total_cmp(&b.time));
+        minor.sort_by(|a, b| a.time.total_cmp(&b.time));
         let (lo, hi) = chart
             .series
             .iter()
@@ -775,25 +815,105 @@ impl Histories {
         } else {
             0.0
         };
-        let mut groups: Vec<Vec<&Event>> = Vec::new();
-        for e in events {
-            match groups.last_mut() {
-                Some(g) if e.time - g[g.len() - 1].time <= close => g.push(e),
-                _ => groups.push(vec![e]),
+        // events closer than `close` to the one before join its group
+        fn groups(events: Vec<&Event>, close: f64) -> Vec<Vec<&Event>> {
+            let mut groups: Vec<Vec<&Event>> = Vec::new();
+            for e in events {
+                match groups.last_mut() {
+                    Some(g) if e.time - g[g.len() - 1].time <= close => g.push(e),
+                    _ => groups.push(vec![e]),
+                }
             }
+            groups
         }
         let time_unit = match chart.x.unit.as_str() {
             "–" => String::new(),
             u => format!(" {u}"),
         };
-        for group in groups {
+        for group in groups(events, close) {
             let label = Self::group_label(&group, units, &time_unit);
             chart = chart.event(group[0].time, label);
             for e in &group[1..] {
                 chart = chart.event(e.time, "");
             }
         }
+        // band crossings: a tick each, one label per latch between its
+        // locks and unlatches (a rattle)
+        for cluster in Self::rattles(minor, &self.events) {
+            let label = Self::cluster_label(&cluster, &time_unit);
+            chart = chart.tick(cluster[0].time, label);
+            for e in &cluster[1..] {
+                chart = chart.tick(e.time, "");
+            }
+        }
         chart
+    }
+
+    /// The band crossings `minor` (in order of time) in clusters: those of
+    /// one latch (or joint, for files that name no latch) between two of
+    /// its other events (locks, unlatches) among `all`.
+    fn rattles<'a>(minor: Vec<&'a Event>, all: &[Event]) -> Vec<Vec<&'a Event>> {
+        let key = |e: &Event| (e.element, e.joint);
+        let mut clusters: Vec<Vec<&Event>> = Vec::new();
+        for e in minor {
+            let open = clusters.iter_mut().rev().find(|c| key(c[0]) == key(e));
+            match open {
+                // the same rattle unless a lock or unlatch of the latch
+                // came between
+                Some(c)
+                    if !all.iter().any(|m| {
+                        !m.is_minor()
+                            && m.time > c[c.len() - 1].time
+                            && m.time < e.time
+                            && match (m.element, e.element) {
+                                (Some(a), Some(b)) => a == b,
+                                _ => m.joint == e.joint,
+                            }
+                    }) =>
+                {
+                    c.push(e)
+                }
+                _ => clusters.push(vec![e]),
+            }
+        }
+        clusters.sort_by(|a, b| a[0].time.total_cmp(&b[0].time));
+        clusters
+    }
+
+    /// The label of a cluster of band crossings: the latch (or the joint)
+    /// if they share one, how many of each kind and their interval of
+    /// time (`latch 5: 6 engages, 5 disengages, 0.4277–0.532 s`).
+    fn cluster_label(cluster: &[&Event], time_unit: &str) -> String {
+        let shared = |f: fn(&Event) -> Option<Id>| {
+            f(cluster[0]).filter(|id| cluster.iter().all(|e| f(e) == Some(*id)))
+        };
+        let whose = match (shared(|e| e.element), shared(|e| e.joint)) {
+            (Some(latch), _) => format!("latch {latch}: "),
+            (None, Some(joint)) => format!("joint {joint}: "),
+            (None, None) => String::new(),
+        };
+        let mut counts: Vec<(&str, usize)> = Vec::new();
+        for e in cluster {
+            let kind = e.kind.as_deref().unwrap_or("event");
+            match counts.iter_mut().find(|c| c.0 == kind) {
+                Some(c) => c.1 += 1,
+                None => counts.push((kind, 1)),
+            }
+        }
+        let what: Vec<String> = counts
+            .iter()
+            .map(|(kind, n)| match n {
+                1 => format!("1 {kind}"),
+                _ => format!("{n} {kind}s"),
+            })
+            .collect();
+        let (first, last) = (cluster[0].time, cluster[cluster.len() - 1].time);
+        let when = if cluster.len() == 1 {
+            format!("at {}{time_unit}", significant(first))
+        } else {
+            format!("{}–{}{time_unit}", significant(first), significant(last))
+        };
+        format!("{whose}{}, {when}", what.join(", "))
     }
 
     /// The label of a group of events: the event's own for one event;

@@ -16,6 +16,8 @@
 //! - [`peaks`]: the largest loads of latches, stops and contacts over a
 //!   run, for `summary.json`;
 //! - [`number`]: numbers in scientific notation for `log.txt`;
+//! - [`residual`]: the relative residual as `log.txt` reports it, with
+//!   groups at round-off told apart;
 //! - [`plot`]: line charts of result histories, as SVG and PNG files;
 //! - [`histories`]: the charts of a run for a report (joint coordinates,
 //!   hinge moments, energies), drawn from its result files.
@@ -26,6 +28,7 @@ pub mod modes;
 pub mod number;
 pub mod peaks;
 pub mod plot;
+pub mod residual;
 pub mod restart;
 pub mod results;
 pub mod run;

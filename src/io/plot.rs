@@ -8,7 +8,10 @@
 //! square), so that curves that coincide stay visible — the later ones
 //! are drawn with gaps, their markers shifted along the curve. Events
 //! such as a change of stage are vertical lines with a label
-//! ([`Chart::event`]).
+//! ([`Chart::event`]); dense minor events (a spring latch rattling across
+//! its dead band) are short ticks in a row at the top of the plot area,
+//! a cluster of them labelled once ([`Chart::tick`]). Labels are placed
+//! in rows so that no two of them overlap ([`Chart::label_boxes`]).
 //!
 //! Line drawings of configurations ([`Wireframe`]): the members of a
 //! structure as lines in a parallel projection (isometric by default),
@@ -85,8 +88,17 @@ const EVENT_FONT: u32 = 13;
 const EVENT_ROW: i32 = 16;
 
 /// Rows of event labels at the top of a chart, at most: a label that
-/// finds no free room in them goes into the row that frees first.
+/// finds no free room in them is left out (its line or tick stays), so
+/// that no label covers another.
 const EVENT_ROWS: usize = 4;
+
+/// Height of the ticks of minor events, pixels, and of their row with
+/// its margin.
+const TICK: i32 = 8;
+const TICK_ROW: i32 = 12;
+
+/// Free space kept between two labels of a row, pixels.
+const LABEL_GAP: i32 = 4;
 
 /// Width of the plotting area of a chart (its size less the margins and
 /// the label area of the vertical axis), pixels, to place event labels
@@ -156,6 +168,37 @@ pub struct Chart {
     /// Vertical lines at `x` with a label (a change of stage); an empty
     /// label draws the line alone.
     pub events: Vec<(f64, String)>,
+    /// Minor events at `x`: short ticks in a row at the top of the plot
+    /// area; a non-empty label labels a cluster of them (placed after the
+    /// labels of `events`).
+    pub ticks: Vec<(f64, String)>,
+}
+
+/// Where an event label is drawn: its row at the top of the chart (0 the
+/// highest), its left end from the left of the plot area and its width,
+/// pixels; `event` its index in [`Chart::events`], or in [`Chart::ticks`]
+/// for a tick's label.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelBox {
+    /// Index of the event (or tick) labelled.
+    pub event: usize,
+    /// Whether it labels a tick (a cluster of minor events).
+    pub tick: bool,
+    /// Row, from the top.
+    pub row: usize,
+    /// Left end, pixels from the left of the plot area.
+    pub left: i32,
+    /// Width, pixels (with a space on either side of the text).
+    pub width: i32,
+}
+
+impl LabelBox {
+    /// Whether the two boxes share a row and overlap along it.
+    pub fn overlaps(&self, other: &LabelBox) -> bool {
+        self.row == other.row
+            && self.left < other.left + other.width
+            && other.left < self.left + self.width
+    }
 }
 
 /// Why a chart could not be drawn.
@@ -285,6 +328,7 @@ impl Chart {
             y,
             series: Vec::new(),
             events: Vec::new(),
+            ticks: Vec::new(),
         }
     }
 
@@ -300,6 +344,110 @@ impl Chart {
     pub fn event(mut self, x: f64, label: impl Into<String>) -> Self {
         self.events.push((x, label.into()));
         self
+    }
+
+    /// Adds a tick at `x` in the row of minor events at the top of the
+    /// plot area (a spring latch's spring engaging); a non-empty `label`
+    /// labels the cluster of ticks it starts, an empty one draws the tick
+    /// alone.
+    pub fn tick(mut self, x: f64, label: impl Into<String>) -> Self {
+        self.ticks.push((x, label.into()));
+        self
+    }
+
+    /// The horizontal range of the chart: that of the curves, widened to
+    /// the events and ticks outside it.
+    fn x_range(&self) -> Option<(f64, f64)> {
+        let xs = self
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(finite).map(|p| p.0));
+        let lo = xs.clone().fold(f64::INFINITY, f64::min);
+        let hi = xs.fold(f64::NEG_INFINITY, f64::max);
+        if lo > hi {
+            return None;
+        }
+        let (mut x0, mut x1) = padded(lo, hi);
+        // an event outside the curves' range is still drawn
+        for x in self.events.iter().chain(&self.ticks).map(|e| e.0) {
+            if x.is_finite() && (x < x0 || x > x1) {
+                (x0, x1) = padded(x0.min(x), x1.max(x));
+            }
+        }
+        Some((x0, x1))
+    }
+
+    /// Where the event labels go on a plot area `plot_width` pixels wide
+    /// (the charts' is about [`SIZE`]`.0 − 110`): in rows at the top, each
+    /// at its event's line (to the left of it at the right edge), in the
+    /// first row where it keeps [`LABEL_GAP`] from every other label; the
+    /// labels of events first, in order of time, then those of clusters
+    /// of ticks. A label that finds no room in [`EVENT_ROWS`] rows is left
+    /// out. No two boxes overlap, whatever the width.
+    pub fn label_boxes(&self, plot_width: u32) -> Result<Vec<LabelBox>, PlotError> {
+        register()?;
+        let mut svg = String::new();
+        let root = SVGBackend::with_string(&mut svg, (1, 1)).into_drawing_area();
+        let range = self.x_range().ok_or(PlotError::Empty)?;
+        self.place_labels(&root, range, plot_width as i32)
+    }
+
+    /// [`Chart::label_boxes`] with the text measured on `root`, over the
+    /// horizontal range `x_range`.
+    fn place_labels<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        x_range: (f64, f64),
+        plot_width: i32,
+    ) -> Result<Vec<LabelBox>, PlotError> {
+        let font: TextStyle = ("sans-serif", EVENT_FONT).into();
+        let span = (x_range.1 - x_range.0).max(f64::MIN_POSITIVE);
+        let labelled = |list: &[(f64, String)], tick: bool| {
+            let mut order: Vec<(usize, bool)> = (0..list.len())
+                .filter(|&k| !list[k].1.is_empty() && list[k].0.is_finite())
+                .map(|k| (k, tick))
+                .collect();
+            order.sort_by(|a, b| list[a.0].0.total_cmp(&list[b.0].0));
+            order
+        };
+        let mut order = labelled(&self.events, false);
+        order.extend(labelled(&self.ticks, true));
+        let mut placed: Vec<LabelBox> = Vec::with_capacity(order.len());
+        for (k, tick) in order {
+            let (x, label) = if tick {
+                &self.ticks[k]
+            } else {
+                &self.events[k]
+            };
+            let (w, _) = root
+                .estimate_text_size(&format!(" {label} "), &font)
+                .map_err(|e| drawing_error(&e))?;
+            let width = w as i32;
+            let px = ((x - x_range.0) / span * f64::from(plot_width)).round() as i32;
+            // to the right of its line, or to the left at the right edge
+            let left = if px + width > plot_width {
+                (px - width).max(0)
+            } else {
+                px
+            };
+            let mut candidate = LabelBox {
+                event: k,
+                tick,
+                row: 0,
+                left,
+                width: width + LABEL_GAP,
+            };
+            let free = (0..EVENT_ROWS).find(|&row| {
+                candidate.row = row;
+                placed.iter().all(|b| !b.overlaps(&candidate))
+            });
+            if let Some(row) = free {
+                candidate.row = row;
+                candidate.width = width;
+                placed.push(candidate);
+            }
+        }
+        Ok(placed)
     }
 
     /// Draws the chart on `root`: linear axes with their labels, the
@@ -328,17 +476,12 @@ impl Chart {
             let hi = all.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
             padded(lo, hi)
         };
-        let (mut x0, mut x1) = range(|p| p.0);
-        // an event outside the curves' range is still drawn
-        for (x, _) in self.events.iter().filter(|e| e.0.is_finite()) {
-            if *x < x0 || *x > x1 {
-                (x0, x1) = padded(x0.min(*x), x1.max(*x));
-            }
-        }
+        let (x0, x1) = self.x_range().ok_or(PlotError::Empty)?;
         let (y0, mut y1) = range(|p| p.1);
         register()?;
-        let labels = self.event_rows(root, (x0, x1))?;
-        let label_rows = labels.iter().map(|l| l.1 + 1).max().unwrap_or(0);
+        let labels = self.place_labels(root, (x0, x1), PLOT_WIDTH)?;
+        let label_rows = labels.iter().map(|l| l.row + 1).max().unwrap_or(0);
+        let tick_row = if self.ticks.is_empty() { 0 } else { TICK_ROW };
         // headroom for the legend in the upper right corner, about 22 px
         // per line of a plot area about 450 px high, and for the rows of
         // event labels, so that they cover no curve
@@ -348,7 +491,7 @@ impl Chart {
         } else {
             0
         };
-        let headroom = legend + EVENT_ROW as usize * label_rows;
+        let headroom = legend + EVENT_ROW as usize * label_rows + tick_row as usize;
         if headroom > 0 {
             let f = (headroom as f64 / 450.0).min(0.6);
             y1 += (y1 - y0) * f / (1.0 - f);
@@ -385,24 +528,30 @@ impl Chart {
                 )))
                 .map_err(|e| drawing_error(&e))?;
         }
-        let (left, right) = (
-            chart.backend_coord(&(x0, y1)),
-            chart.backend_coord(&(x1, y1)),
-        );
+        // labels placed on PLOT_WIDTH from the left of the plot area
+        let left = chart.backend_coord(&(x0, y1));
         let font = ("sans-serif", EVENT_FONT).into_font().color(&grey);
-        for (k, row, width) in labels {
-            let (x, label) = &self.events[k];
-            let (px, top) = chart.backend_coord(&(*x, y1));
-            // to the right of its line, or to the left at the right edge
-            let px = if px + width > right.0 {
-                (px - width).max(left.0)
+        let top = left.1 + legend as i32 + 2;
+        for b in &labels {
+            let label = if b.tick {
+                &self.ticks[b.event].1
             } else {
-                px
+                &self.events[b.event].1
             };
             root.draw(&Text::new(
                 format!(" {label} "),
-                (px, top + legend as i32 + 2 + EVENT_ROW * row as i32),
+                (left.0 + b.left, top + EVENT_ROW * b.row as i32),
                 font.clone(),
+            ))
+            .map_err(|e| drawing_error(&e))?;
+        }
+        // minor events: ticks in a row below the labels
+        let tick_top = top + EVENT_ROW * label_rows as i32;
+        for (x, _) in self.ticks.iter().filter(|t| t.0.is_finite()) {
+            let (px, _) = chart.backend_coord(&(*x, y1));
+            root.draw(&PathElement::new(
+                vec![(px, tick_top), (px, tick_top + TICK)],
+                grey.stroke_width(1),
             ))
             .map_err(|e| drawing_error(&e))?;
         }
@@ -456,50 +605,6 @@ impl Chart {
         }
         root.present().map_err(|e| drawing_error(&e))?;
         Ok(())
-    }
-
-    /// The labelled events (index in `events`), each with its row at the
-    /// top of the chart and its width in pixels: a label goes into the
-    /// first row where it covers no other (horizontal range `x_range`
-    /// over about [`PLOT_WIDTH`] pixels).
-    fn event_rows<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, Shift>,
-        x_range: (f64, f64),
-    ) -> Result<Vec<(usize, usize, i32)>, PlotError> {
-        let font: TextStyle = ("sans-serif", EVENT_FONT).into();
-        let span = (x_range.1 - x_range.0).max(f64::MIN_POSITIVE);
-        let mut order: Vec<usize> = (0..self.events.len())
-            .filter(|&k| !self.events[k].1.is_empty() && self.events[k].0.is_finite())
-            .collect();
-        order.sort_by(|&a, &b| self.events[a].0.total_cmp(&self.events[b].0));
-        // the right end of the last label in each row
-        let mut ends: Vec<i32> = Vec::new();
-        let mut placed = Vec::with_capacity(order.len());
-        for k in order {
-            let (x, label) = &self.events[k];
-            let (w, _) = root
-                .estimate_text_size(&format!(" {label} "), &font)
-                .map_err(|e| drawing_error(&e))?;
-            let w = w as i32;
-            let px = ((x - x_range.0) / span * f64::from(PLOT_WIDTH)).round() as i32;
-            let px = if px + w > PLOT_WIDTH {
-                (px - w).max(0)
-            } else {
-                px
-            };
-            let row = match ends.iter().position(|&end| end < px) {
-                Some(r) => r,
-                None if ends.len() < EVENT_ROWS => {
-                    ends.push(i32::MIN);
-                    ends.len() - 1
-                }
-                None => (0..ends.len()).min_by_key(|&r| ends[r]).unwrap_or(0),
-            };
-            ends[row] = px + w;
-            placed.push((k, row, w));
-        }
-        Ok(placed)
     }
 
     /// The chart as SVG text.
@@ -951,6 +1056,33 @@ mod tests {
         assert!(matches!(bare.to_svg(), Err(PlotError::Axis(_))));
         let svg = sample().event(1.0, "stage (b)").to_svg().unwrap();
         assert!(svg.contains("stage (b)"));
+    }
+
+    /// Labels crowded at one instant and spread over the range, of
+    /// events and of ticks: whatever the width, no two boxes overlap,
+    /// each lies in one of the rows, and those that find no room are left
+    /// out rather than drawn over another.
+    #[test]
+    fn event_labels_never_overlap() {
+        let mut chart = sample();
+        for k in 0..30 {
+            let x = if k < 15 { 2.0 } else { 0.17 * k as f64 - 2.5 };
+            chart = chart
+                .event(x, format!("latch {k} locks"))
+                .tick(x + 0.01, format!("latch {k}: 3 engages, 2 disengages"));
+        }
+        for width in [60, 200, 790, 3000] {
+            let boxes = chart.label_boxes(width).unwrap();
+            assert!(!boxes.is_empty());
+            assert!(boxes.len() < 60, "{} at {width}", boxes.len());
+            for (i, a) in boxes.iter().enumerate() {
+                assert!(a.row < EVENT_ROWS && a.left >= 0, "{a:?}");
+                for b in &boxes[i + 1..] {
+                    assert!(!a.overlaps(b), "at {width} px: {a:?} {b:?}");
+                }
+            }
+        }
+        assert!(chart.to_svg().unwrap().contains("latch 0 locks"));
     }
 
     /// The isometric view draws the three unit axes with the same length

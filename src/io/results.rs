@@ -162,6 +162,15 @@ pub struct DynamicRecord {
     pub contacts_closed: usize,
     /// See [`Self::locks`].
     pub contacts_released: usize,
+    /// Spring latches' band crossings written to `events.csv`: the
+    /// coordinate leaving the dead band across an edge (`engage`), coming
+    /// back into it (`disengage`), and a latch released beyond `c_L`
+    /// coming back to it (`rearm`).
+    pub engages: usize,
+    /// See [`Self::engages`].
+    pub disengages: usize,
+    /// See [`Self::engages`].
+    pub rearms: usize,
     /// Energy dissipated by the impacts of these events, and dropped by
     /// the spring latches that released (the sum of `energy_lost` of
     /// `events.csv`, each impact counted once: latches that lock in one
@@ -191,6 +200,11 @@ impl DynamicRecord {
             impacts: count(ContactKind::Impact),
             contacts_closed: count(ContactKind::Close),
             contacts_released: count(ContactKind::Release),
+            // reported to the observer (Observer::band_crossing), not kept
+            // in the outcome: counted by the recorder that writes them
+            engages: latch_events(LatchEventKind::Engage),
+            disengages: latch_events(LatchEventKind::Disengage),
+            rearms: latch_events(LatchEventKind::Rearm),
             impact_energy_lost: impact_energy_lost(outcome),
         }
     }

@@ -55,7 +55,7 @@ use super::results::{
     file_error, AnalysisEnd, DynamicRecord, EventRow, ResultWriter, RunStatus, Summary,
 };
 use super::vtk::Encoding;
-use crate::analysis::impact;
+use crate::analysis::impact::{self, LatchEventKind};
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
     AnalysisSettings, ContactInfo, Continuation, CutbackInfo, DynamicAnalysis, DynamicError,
@@ -70,6 +70,7 @@ use crate::state::State;
 mod modal;
 
 use super::number::Sci;
+use super::residual::{Reported, Shown};
 
 /// What a person watching the run sees. Every method has an empty
 /// default.
@@ -321,9 +322,10 @@ pub fn dynamic_error_message(model: &Model, state: &State, error: &DynamicError)
 }
 
 /// The events of dynamic analyses in a few words (`1 lock, 3 impacts,
-/// 1 contact closed, energy lost in impacts 7.401e0`), or `None` if they
-/// had none: the counts of `events.csv`'s rows of each kind and the energy
-/// their impacts dissipated.
+/// 1 contact closed, energy lost in impacts 7.401e0`, then `; spring
+/// latches' band crossings: 6 engages, 5 disengages` if any), or `None`
+/// if they had none: the counts of `events.csv`'s rows of each kind and
+/// the energy their impacts dissipated.
 fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
     let sum = |f: fn(&DynamicRecord) -> usize| records.iter().map(|d| f(d)).sum::<usize>();
     let plural = |n: usize, one: &str, many: &str| match n {
@@ -349,8 +351,18 @@ fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
     .into_iter()
     .flatten()
     .collect();
+    let crossings: Vec<String> = [
+        plural(sum(|d| d.engages), "engage", "engages"),
+        plural(sum(|d| d.disengages), "disengage", "disengages"),
+        plural(sum(|d| d.rearms), "rearm", "rearms"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let crossings = (!crossings.is_empty())
+        .then(|| format!("spring latches' band crossings: {}", crossings.join(", ")));
     if parts.is_empty() {
-        return None;
+        return crossings;
     }
     let lost: f64 = records.iter().map(|d| d.impact_energy_lost).sum();
     // a spring latch that releases drops the energy its spring held
@@ -359,10 +371,11 @@ fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
     } else {
         "in impacts"
     };
-    Some(format!(
-        "{}, energy lost {how} {lost:.3e}",
-        parts.join(", ")
-    ))
+    let events = format!("{}, energy lost {how} {lost:.3e}", parts.join(", "));
+    Some(match crossings {
+        Some(c) => format!("{events}; {c}"),
+        None => events,
+    })
 }
 
 /// The size of a model in one line: nodes and elements of each kind.
@@ -507,6 +520,12 @@ pub struct Recorder {
     /// Largest constraint violation (relative to its tolerance) at each
     /// iteration of the increment being solved.
     violations: Vec<f64>,
+    /// The solver's relative residual at each iteration of the increment
+    /// being solved, and the log's report of it.
+    reported: Vec<(f64, Reported)>,
+    /// The model's length scale, which turns moments into forces when the
+    /// log tells residuals at round-off ([`Reported::of`]).
+    length_scale: f64,
     /// Restart files, and the index in the model's sequence of the first
     /// analysis recorded.
     restart: Option<(RestartWriter, usize)>,
@@ -526,6 +545,9 @@ pub struct Recorder {
     peaks: PeakLoads,
     /// The line of an increment, its buffer kept from step to step.
     text: String,
+    /// The band crossings of spring latches written to `events.csv` by
+    /// the running analysis: engages, disengages, rearms.
+    crossings: [usize; 3],
 }
 
 /// What the recorder follows of a stop or contact over a dynamic
@@ -666,6 +688,9 @@ struct Running {
     start_time: f64,
     end_time: f64,
     initial_iterations: usize,
+    /// `ε_r`: a converged increment whose last relative residual is above
+    /// it was accepted at the round-off plateau of its residual.
+    residual_tolerance: f64,
 }
 
 impl Running {
@@ -676,6 +701,7 @@ impl Running {
             start_time: 0.0,
             end_time: analysis.settings().end_time,
             initial_iterations: 0,
+            residual_tolerance: analysis.settings().residual_tolerance,
         }
     }
 
@@ -687,6 +713,7 @@ impl Running {
             start_time: 0.0,
             end_time: s.end_time,
             initial_iterations: 0,
+            residual_tolerance: s.residual_tolerance,
         }
     }
 }
@@ -765,6 +792,7 @@ impl Recorder {
 
     fn open_next(&mut self, from: f64) {
         self.open = true;
+        self.crossings = [0; 3];
         self.energy_extremes = (0.0, 0.0);
         self.energies = None;
         self.motion = None;
@@ -816,6 +844,8 @@ impl Recorder {
             modal: ModalFiles::default(),
             encoding: Encoding::default(),
             violations: Vec::new(),
+            reported: Vec::new(),
+            length_scale: model.length_scale,
             restart: None,
             energy_extremes: (0.0, 0.0),
             energies: None,
@@ -824,6 +854,7 @@ impl Recorder {
             stops: Vec::new(),
             peaks: PeakLoads::of(model),
             text: String::new(),
+            crossings: [0; 3],
         };
         let analyses = if plan.len() > 1 {
             let each: Vec<String> = plan
@@ -894,6 +925,12 @@ impl Recorder {
         }
         let mut end = end.clone();
         if let Some(d) = end.dynamic.as_mut() {
+            // the outcome keeps locks and unlatches; the band crossings
+            // are the rows this recorder wrote
+            let [engages, disengages, rearms] = std::mem::take(&mut self.crossings);
+            d.engages = d.engages.max(engages);
+            d.disengages = d.disengages.max(disengages);
+            d.rearms = d.rearms.max(rearms);
             let (error, kinetic) = self.energy_extremes;
             d.largest_energy_balance_error = d.largest_energy_balance_error.max(error);
             d.largest_kinetic_energy = d.largest_kinetic_energy.max(kinetic);
@@ -1275,9 +1312,12 @@ impl Observer for Recorder {
     fn iteration(&mut self, info: &IterationInfo) {
         if info.iteration == 0 {
             self.violations.clear();
+            self.reported.clear();
         }
         self.violations.push(info.norms.residual_constraint);
         let n = &info.norms;
+        let reported = Reported::of(n, self.length_scale);
+        self.reported.push((n.relative_residual, reported));
         self.log.write_line(format_args!(
             "    {} {} iteration {}: |r_F| {} (flux {})  |r_M| {} (flux {})  |r_C| {}  relative {}  max|c| {}  max|dx| {}  max|dθ| {}",
             if self.current.kind == "dynamic" {
@@ -1292,7 +1332,7 @@ impl Observer for Recorder {
             Sci::<3>(n.residual_moment),
             Sci::<3>(n.flux_moment),
             Sci::<3>(n.residual_coordinate),
-            Sci::<3>(n.relative_residual),
+            Shown::<3>(reported),
             Sci::<3>(n.residual_constraint),
             Sci::<3>(n.displacement_correction),
             Sci::<3>(n.rotation_correction),
@@ -1351,20 +1391,49 @@ impl Observer for Recorder {
         } else {
             ("increment", "dt")
         };
+        let kinematic = self.current.kind == "kinematic";
+        // converged above the tolerance: accepted at the round-off
+        // plateau of the residual (docs/theory.md §7.1)
+        let last = values
+            .len()
+            .checked_sub(1)
+            .and_then(|k| self.reported.get(k));
+        let stopped = match (kinematic, last, values.last()) {
+            (false, Some(&(value, Reported::Ratio(r))), Some(v)) => {
+                value.to_bits() == v.to_bits()
+                    && info.iterations > 0
+                    && r > self.current.residual_tolerance
+            }
+            _ => false,
+        };
         // the line in a buffer kept from step to step
         let mut text = std::mem::take(&mut self.text);
         text.clear();
         let _ = write!(
             text,
-            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  {what}: ",
+            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  {what}{}: ",
             info.increment,
             info.time,
             Sci::<3>(info.step),
             info.iterations,
+            if stopped {
+                " (stopped at round-off)"
+            } else {
+                ""
+            },
         );
         for (k, r) in values.iter().enumerate() {
             let sep = if k == 0 { "" } else { " " };
-            let _ = write!(text, "{sep}{}", Sci::<1>(*r));
+            // the report of the iteration that gave this residual (the
+            // same value), residuals at round-off told so
+            match self.reported.get(k) {
+                Some(&(value, reported)) if !kinematic && value.to_bits() == r.to_bits() => {
+                    let _ = write!(text, "{sep}{}", Shown::<1>(reported));
+                }
+                _ => {
+                    let _ = write!(text, "{sep}{}", Sci::<1>(*r));
+                }
+            }
         }
         self.line(&text);
         self.text = text;
@@ -1454,6 +1523,12 @@ impl Observer for Recorder {
     }
 
     fn band_crossing(&mut self, info: &LockInfo) {
+        match info.kind {
+            LatchEventKind::Engage => self.crossings[0] += 1,
+            LatchEventKind::Disengage => self.crossings[1] += 1,
+            LatchEventKind::Rearm => self.crossings[2] += 1,
+            LatchEventKind::Lock | LatchEventKind::Unlatch => {}
+        }
         self.lock(info);
     }
 

@@ -36,6 +36,8 @@ impl Recorder {
             start_time: first.settings().time,
             end_time: first.settings().time,
             initial_iterations: 0,
+            // a modal analysis iterates on no residual
+            residual_tolerance: f64::INFINITY,
         };
         let unknowns = first.n_equations();
         Self::create_with(
@@ -68,6 +70,7 @@ impl Recorder {
                 start_time: outcome.time,
                 end_time: outcome.time,
                 initial_iterations: 0,
+                residual_tolerance: f64::INFINITY,
             };
         }
         let index = self.current.index + 1;

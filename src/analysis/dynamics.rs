@@ -49,6 +49,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::constraints::ConstraintRows;
 use super::control::{
     Advance, Attempt, ControlStop, EventFunction, StepBounds, StepController, Stepper,
 };
@@ -371,6 +372,7 @@ struct Run {
     mass_system: MassSystem,
     /// The span of the analysis, `end_time − t₀` (D13).
     span: f64,
+    rates: RateWork,
     redundant: usize,
     /// The unknown with the largest residual at the last failed attempt.
     location: String,
@@ -458,6 +460,30 @@ struct MassSystem {
     /// constraints (D13).
     damping: Option<SparseMatrix>,
     damping_rest: Option<SparseMatrix>,
+    /// By equation: the diagonal of the mass matrix, the kind, whether
+    /// the unknown has no mass, whether a constraint holds it, and the
+    /// scale of the multiplier rows and columns (D8 with `β′ = 1`).
+    diagonal: Vec<f64>,
+    kinds: Vec<EquationKind>,
+    light: Vec<bool>,
+    held: Vec<bool>,
+    s_eq: Vec<f64>,
+    /// The elements with multipliers, for the stiffness of the
+    /// projections (D13–D14).
+    constraints: Option<ConstraintRows>,
+}
+
+/// Work space of `Φ̇` for the velocity projection (D13), kept from one
+/// step to the next.
+struct RateWork {
+    /// The elements with multipliers, which write the rows of `Φ`.
+    rows: ConstraintRows,
+    /// The state moved along its velocities.
+    moved: State,
+    /// `−kΦ` ahead along the motion, by dof.
+    plus: Vec<f64>,
+    /// `−kΦ̇`, by dof.
+    rate: Vec<f64>,
 }
 
 /// The scale factors `s` of distance and angle constraints (D8): rows
@@ -611,6 +637,12 @@ impl DynamicAnalysis {
             // a continued run (a restart within the analysis) keeps the
             // span of the analysis, as the run never stopped did
             span: (s.end_time - if self.continued { s.start_time } else { t0 }).abs(),
+            rates: RateWork {
+                rows: ConstraintRows::new(model, &self.solver.dofs),
+                moved: State::default(),
+                plus: Vec::new(),
+                rate: Vec::new(),
+            },
             redundant: 0,
             location: String::new(),
             locks: Vec::new(),
@@ -1032,6 +1064,14 @@ fn prescribed_rates(model: &Model, state: &mut State, t: f64) {
 /// D9–D10 are taken.
 fn moved(model: &Model, state: &State, e: f64) -> State {
     let mut s = state.clone();
+    move_along(model, state, e, &mut s);
+    s
+}
+
+/// [`moved`] into `s`, whose vectors are reused (no allocation once they
+/// have their lengths).
+fn move_along(model: &Model, state: &State, e: f64, s: &mut State) {
+    s.clone_from(state);
     for node in 0..s.n_nodes() {
         let v = state.velocity[node];
         s.displace_node(
@@ -1045,8 +1085,7 @@ fn moved(model: &Model, state: &State, e: f64) -> State {
     }
     s.time = state.time + e;
     let t = s.time;
-    model.apply_prescribed(&mut s, t);
-    s
+    model.apply_prescribed(s, t);
 }
 
 /// The time step of the differences of D9–D10: the motion over it is
@@ -1118,15 +1157,38 @@ pub(super) fn constraint_rates(
 
 /// `−k Φ̇` of the multiplier rows along the motion, by one central
 /// difference over [`PROJECTION_STEP`] of the motion time (with the span
-/// of the whole analysis, `span`, for a model at rest) (D13).
-fn constraint_rate(model: &Model, solver: &mut NewtonSolver, state: &State, span: f64) -> Vec<f64> {
+/// of the whole analysis, `span`, for a model at rest) (D13), into
+/// `rates.rate` (by dof, zero off the multiplier rows). Only the elements
+/// with multipliers are evaluated, at states moved into `rates.moved`.
+fn constraint_rate(model: &Model, state: &State, span: f64, n: usize, rates: &mut RateWork) {
     let e = PROJECTION_STEP * motion_time(model, state, span);
-    let rp = constraint_residual(model, solver, &moved(model, state, e));
-    let rm = constraint_residual(model, solver, &moved(model, state, -e));
-    rp.iter()
-        .zip(&rm)
-        .map(|(p, m)| (p - m) / (2.0 * e))
-        .collect()
+    let RateWork {
+        rows,
+        moved,
+        plus,
+        rate,
+    } = rates;
+    plus.clear();
+    plus.resize(n, 0.0);
+    rate.clear();
+    rate.resize(n, 0.0);
+    move_along(model, state, e, moved);
+    rows.evaluate(
+        model,
+        &model.context(moved.time, Need::RESIDUAL),
+        moved,
+        plus,
+    );
+    move_along(model, state, -e, moved);
+    rows.evaluate(
+        model,
+        &model.context(moved.time, Need::RESIDUAL),
+        moved,
+        rate,
+    );
+    for (r, p) in rate.iter_mut().zip(plus.iter()) {
+        *r = (p - *r) / (2.0 * e);
+    }
 }
 
 /// D10: the initial velocities must satisfy `Φ̇ = B v + ∂Φ/∂t = 0`, to
@@ -1226,8 +1288,15 @@ enum MasslessRows {
 /// `M` (or a light diagonal weight, `massless`), and the multiplier rows and columns scaled by `m_s/k` (D8 with
 /// `β′ = 1`, without the lower bound 1), left in the solver's matrix: the
 /// matrix of the initial accelerations (D9) and of the velocity projection
-/// (D13). Returns the mass scales `m_s` of translations and rotations and
-/// the scale of each equation.
+/// (D13). Returns the mass scales `m_s` of translations and rotations,
+/// and leaves the scale of each equation in `buffers.s_eq`.
+///
+/// With the light weight and no velocity constraints (the projections,
+/// D13–D14) the stiffness enters the multiplier rows and columns alone:
+/// it is that of the elements with multipliers ([`ConstraintRows`]), and
+/// the mass matrix is assembled without the stiffness of the others, or
+/// taken as it is in `buffers.mass` when `mass_assembled` says it is that
+/// of `state` (the error estimate's, D11a).
 fn constrained_mass_system(
     model: &Model,
     solver: &mut NewtonSolver,
@@ -1235,7 +1304,8 @@ fn constrained_mass_system(
     buffers: &mut MassSystem,
     velocity_rows: Option<(&[bool], &SparseMatrix)>,
     massless: MasslessRows,
-) -> Result<([f64; 2], Vec<f64>), NewtonFailure> {
+    mass_assembled: bool,
+) -> Result<[f64; 2], NewtonFailure> {
     let t = state.time;
     let (dofs, assembler, _) = solver.system();
     let same = |m: &SparseMatrix| {
@@ -1243,9 +1313,11 @@ fn constrained_mass_system(
             && m.nnz() == assembler.matrix.nnz()
             && m.row_indices() == assembler.matrix.row_indices()
     };
+    let mut mass_assembled = mass_assembled;
     if !buffers.stiffness.as_ref().is_some_and(same) {
         buffers.stiffness = Some(assembler.matrix.clone());
         buffers.mass = Some(assembler.matrix.clone());
+        mass_assembled = false;
     }
     let (stiffness, mass) = (
         buffers.stiffness.as_mut().expect("set above"),
@@ -1255,7 +1327,20 @@ fn constrained_mass_system(
         dynamics: true,
         ..model.context(t, Need::with_inertia(0.0, 1.0))
     };
-    assembler.assemble_split(model, &ctx, state, stiffness, mass);
+    if massless == MasslessRows::Light && velocity_rows.is_none() {
+        // the stiffness is used in the multiplier rows and columns alone:
+        // that of the elements with multipliers, with the mass matrix of
+        // all, unless it was just assembled at this state (D11a)
+        if !mass_assembled {
+            assembler.assemble_inertia(model, &ctx, state, mass);
+        }
+        let rows = buffers
+            .constraints
+            .get_or_insert_with(|| ConstraintRows::new(model, dofs));
+        rows.stiffness(model, dofs, &ctx, state, stiffness);
+    } else {
+        assembler.assemble_split(model, &ctx, state, stiffness, mass);
+    }
     if !assembler.residual.iter().all(|r| r.is_finite()) {
         return Err(NewtonFailure::NonFinite {
             iteration: 0,
@@ -1263,91 +1348,134 @@ fn constrained_mass_system(
         });
     }
 
-    // mass scales and the massless rows
+    // mass scales and the massless rows; the entries visited column by
+    // column (`col`, `row_of[i]`), the per-equation lists in `buffers`
     let n = dofs.n_equations();
-    let mut diagonal = vec![0.0; n];
-    for (row, col, v) in mass.entries() {
-        if row == col {
-            diagonal[row] = v;
+    let row_of = stiffness.row_indices();
+    let columns = |col: usize| stiffness.column_start(col)..stiffness.column_start(col + 1);
+    let MassSystem {
+        diagonal,
+        kinds,
+        light,
+        held,
+        s_eq,
+        ..
+    } = buffers;
+    kinds.clear();
+    kinds.extend((0..n).map(|eq| match dofs.equation_kind(eq) {
+        DofKind::Translation | DofKind::Coordinate { .. } => EquationKind::Translation,
+        DofKind::Rotation => EquationKind::Rotation,
+        DofKind::Multiplier(ConstraintKind::Distance) => EquationKind::Distance,
+        DofKind::Multiplier(ConstraintKind::Angle) => EquationKind::Angle,
+    }));
+    let m = mass.values();
+    diagonal.clear();
+    diagonal.resize(n, 0.0);
+    for col in 0..n {
+        for i in columns(col) {
+            if row_of[i] == col {
+                diagonal[col] = m[i];
+            }
         }
     }
     let mut scale = [0.0f64; 2];
-    for (eq, &m) in diagonal.iter().enumerate() {
-        match dofs.equation_kind(eq) {
-            DofKind::Translation | DofKind::Coordinate { .. } => scale[0] = scale[0].max(m),
-            DofKind::Rotation => scale[1] = scale[1].max(m),
-            DofKind::Multiplier(_) => {}
+    for (&kind, &m) in kinds.iter().zip(diagonal.iter()) {
+        match kind {
+            EquationKind::Translation => scale[0] = scale[0].max(m),
+            EquationKind::Rotation => scale[1] = scale[1].max(m),
+            _ => {}
         }
     }
     // the light weight of a massless unknown: the mass scale of its kind,
     // or of the other kind through the model's size if it has none
     let length2 = model.length_scale * model.length_scale;
-    let light_weight = |eq: usize| {
-        let m = match dofs.equation_kind(eq) {
-            DofKind::Rotation if scale[1] > 0.0 => scale[1],
-            DofKind::Rotation => scale[0] * length2,
+    let light_weight = |kind: EquationKind| {
+        let m = match kind {
+            EquationKind::Rotation if scale[1] > 0.0 => scale[1],
+            EquationKind::Rotation => scale[0] * length2,
             _ if scale[0] > 0.0 => scale[0],
             _ => scale[1] / length2,
         };
         LIGHT_WEIGHT * if m > 0.0 { m } else { 1.0 }
     };
-    let is_massless = |eq: usize| match dofs.equation_kind(eq) {
-        DofKind::Translation | DofKind::Coordinate { .. } => diagonal[eq] <= MASSLESS * scale[0],
-        DofKind::Rotation => diagonal[eq] <= MASSLESS * scale[1],
-        DofKind::Multiplier(_) => false,
-    };
-    let is_multiplier: Vec<bool> = (0..n)
-        .map(|eq| matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)))
-        .collect();
-    let light: Vec<bool> = (0..n).map(is_massless).collect();
+    light.clear();
+    light.extend(
+        kinds
+            .iter()
+            .zip(diagonal.iter())
+            .map(|(&kind, &m)| match kind {
+                EquationKind::Translation => m <= MASSLESS * scale[0],
+                EquationKind::Rotation => m <= MASSLESS * scale[1],
+                _ => false,
+            }),
+    );
     // massless rows held by a constraint take the light weight in every
     // use: the constraints carry them, and a stiffness row there (the
     // penalty p BᵀB of the joints) would pass the constraints' rates on
     // to the bodies they hold (as in the impact, docs/theory.md §16)
-    let mut held = vec![false; n];
-    for (row, col, v) in stiffness.entries() {
-        if v != 0.0 && light[row] && is_multiplier[col] {
-            held[row] = true;
+    let k = stiffness.values();
+    held.clear();
+    held.resize(n, false);
+    for col in (0..n).filter(|&col| kinds[col].is_multiplier()) {
+        for i in columns(col) {
+            if k[i] != 0.0 && light[row_of[i]] {
+                held[row_of[i]] = true;
+            }
         }
     }
     // multiplier rows and columns scaled to the mass (D8 with β′ = 1)
-    let s_eq: Vec<f64> = (0..n)
-        .map(|eq| match dofs.equation_kind(eq) {
-            DofKind::Multiplier(kind) => {
-                let (m, k) = match kind {
-                    ConstraintKind::Distance => (scale[0], model.scaling.force.0),
-                    ConstraintKind::Angle => (scale[1], model.scaling.moment.0),
-                };
-                if m > 0.0 {
-                    m / k
-                } else {
-                    1.0
-                }
-            }
-            _ => 1.0,
-        })
-        .collect();
-    let dof_of: Vec<usize> = (0..n).map(|eq| dofs.dof(eq)).collect();
-    let values = assembler.matrix.values_mut();
-    let (k, m) = (stiffness.values(), mass.values());
-    for (i, (row, col, _)) in stiffness.entries().enumerate() {
-        // the rows of velocity constraints take their ∂r/∂v
-        let v = if let Some((c, true)) = velocity_rows.map(|(r, c)| (c, r[dof_of[row]])) {
-            c.values()[i]
-        } else if is_multiplier[row] || is_multiplier[col] {
-            k[i] + m[i]
-        } else if light[row] {
-            match massless {
-                MasslessRows::Stiffness if !held[row] => k[i] + m[i],
-                _ if row == col => light_weight(row),
-                _ => 0.0,
-            }
-        } else {
-            m[i]
+    s_eq.clear();
+    s_eq.extend(kinds.iter().map(|&kind| {
+        let (m, k) = match kind {
+            EquationKind::Distance => (scale[0], model.scaling.force.0),
+            EquationKind::Angle => (scale[1], model.scaling.moment.0),
+            _ => return 1.0,
         };
-        values[i] = v * s_eq[row] * s_eq[col];
+        if m > 0.0 {
+            m / k
+        } else {
+            1.0
+        }
+    }));
+    let velocity_rows = velocity_rows.map(|(r, c)| (r, c.values()));
+    let values = assembler.matrix.values_mut();
+    for col in 0..n {
+        let multiplier_col = kinds[col].is_multiplier();
+        for i in columns(col) {
+            let row = row_of[i];
+            // the rows of velocity constraints take their ∂r/∂v
+            let v = match velocity_rows {
+                Some((r, c)) if r[dofs.dof(row)] => c[i],
+                _ if multiplier_col || kinds[row].is_multiplier() => k[i] + m[i],
+                _ if light[row] => match massless {
+                    MasslessRows::Stiffness if !held[row] => k[i] + m[i],
+                    _ if row == col => light_weight(kinds[row]),
+                    _ => 0.0,
+                },
+                _ => m[i],
+            };
+            values[i] = v * s_eq[row] * s_eq[col];
+        }
     }
-    Ok((scale, s_eq))
+    Ok(scale)
+}
+
+/// The kind of an equation, as the constrained mass system sorts them.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum EquationKind {
+    /// A translation or a coordinate (a length).
+    Translation,
+    Rotation,
+    /// The multiplier of a distance constraint.
+    Distance,
+    /// The multiplier of an angle constraint.
+    Angle,
+}
+
+impl EquationKind {
+    fn is_multiplier(self) -> bool {
+        matches!(self, Self::Distance | Self::Angle)
+    }
 }
 
 /// Solves the constrained mass system left in the solver's matrix by
@@ -1419,15 +1547,17 @@ fn initial_accelerations(
         None
     };
     let rows = damping.as_ref().map(|c| (by_dof.as_slice(), c));
-    let (scale, s_eq) = constrained_mass_system(
+    let scale = constrained_mass_system(
         model,
         solver,
         state,
         &mut run.mass_system,
         rows,
         MasslessRows::Stiffness,
+        false,
     )?;
     run.mass_scale = scale;
+    let s_eq = &run.mass_system.s_eq;
     let (dofs, assembler, _) = solver.system();
     let mut rhs: Vec<f64> = (0..dofs.n_equations())
         .map(|eq| {
@@ -1493,14 +1623,16 @@ fn project_positions(
     }
     let state = &mut run.state;
     let residual = constraint_residual(model, solver, state);
-    let (_, s_eq) = constrained_mass_system(
+    constrained_mass_system(
         model,
         solver,
         state,
         &mut run.mass_system,
         None,
         MasslessRows::Light,
+        false,
     )?;
+    let s_eq = &run.mass_system.s_eq;
     let dofs = &solver.dofs;
     let mut rhs: Vec<f64> = (0..dofs.n_equations())
         .map(|eq| {
@@ -1700,14 +1832,17 @@ impl Dynamics<'_> {
     ///
     /// (the matrix of D9), then assembles the residual again at the
     /// projected state for the observer (reactions, energy balance).
-    fn project_velocities(&mut self, h: f64) -> Result<(), NewtonFailure> {
+    /// `mass_assembled`: the mass matrix of [`MassSystem`] is that of the
+    /// converged state (the error estimate, D11a, has just assembled it).
+    fn project_velocities(&mut self, h: f64, mass_assembled: bool) -> Result<(), NewtonFailure> {
         let (model, run) = (self.model, &mut *self.run);
         let dofs = &self.solver.dofs;
         if dofs.first_multiplier() == dofs.n_dofs() {
             return Ok(());
         }
         let state = &mut run.state;
-        let mut rate = constraint_rate(model, self.solver, state, run.span);
+        constraint_rate(model, state, run.span, dofs.n_dofs(), &mut run.rates);
+        let rate = &mut run.rates.rate;
         // velocity constraints (rolling discs): their rows of the matrix are
         // ∂r/∂v = −kA, their right-hand side their own residual −kA v, so
         // that A(v + δv) = 0 (docs/theory.md §15.7)
@@ -1747,9 +1882,11 @@ impl Dynamics<'_> {
             &mut run.mass_system,
             velocity_rows,
             MasslessRows::Light,
+            mass_assembled,
         );
         run.mass_system.damping = damping;
-        let (_, s_eq) = scaled?;
+        scaled?;
+        let s_eq = &run.mass_system.s_eq;
         let dofs = &self.solver.dofs;
         let rhs = &mut run.work.rhs;
         rhs.clear();
@@ -2360,7 +2497,8 @@ impl Stepper for Dynamics<'_> {
                 // note on a long step has been given
                 let error = (self.settings.adaptive || !self.run.watch.fixed_step_noted)
                     .then(|| self.error_estimate(size));
-                self.project_velocities(size).map(|()| (converged, error))
+                self.project_velocities(size, error.is_some())
+                    .map(|()| (converged, error))
             }) {
             Ok(((iterations, residuals), error)) => {
                 if let Some(what) = self.spurious(size) {

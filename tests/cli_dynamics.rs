@@ -1050,6 +1050,22 @@ acceleration = [0.0, 0.0, -9.81]
         })
         .count();
     assert!(above >= 1, "{log}");
+    // each of them says so before its numbers, and only they (to the
+    // rounding of the two digits shown; docs/results.md, log.txt)
+    for line in log.lines().filter(|l| l.starts_with("step")) {
+        let Some(last) = line
+            .split_whitespace()
+            .last()
+            .and_then(|r| r.parse::<f64>().ok())
+        else {
+            continue;
+        };
+        if line.contains("relative residuals (stopped at round-off): ") {
+            assert!(last >= 0.95e-8, "{line}");
+        } else {
+            assert!(last <= 1.05e-8, "{line}");
+        }
+    }
     let notes: Vec<&str> = log
         .lines()
         .filter(|l| {

@@ -140,14 +140,19 @@ fn residuals_at_round_off_after_a_rigid_lock_are_reported_as_round_off() {
     let after: Vec<&str> = log.lines().skip(lock).collect();
     let length = 0.5;
     let round = 1024.0 * f64::EPSILON;
-    // iterations whose forces and moments are all at round-off
-    let mut both = 0;
+    // iterations whose forces and moments are all at round-off, and those
+    // whose residuals are (the flux of the forces may not be: the pseudo-
+    // accelerations of the restart after the lock die out over the steps)
+    let (mut both, mut residuals) = (0, 0);
     for line in after.iter().filter(|l| l.contains(" iteration ")) {
         let (rf, ff) = field(line, "|r_F|");
         let (rm, fm) = field(line, "|r_M|");
         let (ff, fm) = (ff.unwrap(), fm.unwrap());
         let scale = ff.max(fm / length);
         let relative = line.split("relative ").nth(1).unwrap();
+        if rf <= round * scale && rm <= round * fm {
+            residuals += 1;
+        }
         if rf <= round * scale && ff <= round * scale && rm <= round * fm {
             both += 1;
             assert!(relative.starts_with("round-off"), "{line}");
@@ -158,13 +163,15 @@ fn residuals_at_round_off_after_a_rigid_lock_are_reported_as_round_off() {
         }
     }
     // the case arises (hundreds of steps at rest after the lock)
-    assert!(both >= 100, "{both} iterations at round-off");
+    assert!(
+        residuals >= 100,
+        "{residuals} iterations with residuals at round-off ({both} with fluxes too)"
+    );
     let steps: Vec<&&str> = after
         .iter()
         .filter(|l| l.starts_with("step ") && l.contains("relative residuals"))
         .collect();
     assert!(steps.len() >= 300, "{}", steps.len());
-    let mut stopped = 0;
     for line in &steps {
         let marked = line.contains("relative residuals (stopped at round-off): ");
         let values = line.rsplit_once(": ").unwrap().1;
@@ -176,10 +183,10 @@ fn residuals_at_round_off_after_a_rigid_lock_are_reported_as_round_off() {
             Ok(v) => assert!(v <= 1.05e-8, "{line}"),
             Err(_) => assert!(last == "round-off" && !marked, "{line}"),
         }
-        stopped += usize::from(marked);
     }
-    // and there are such lines (more than the one the note names)
-    assert!(stopped >= 2, "{stopped}");
+    // (with the dense kernel of small systems the steps at rest now reach
+    // residuals of exactly 0 and none stops at the plateau; a step that
+    // does is marked: tests/cli_dynamics.rs)
 }
 
 /// The spring latch's keys on the latched panel: 300 N·m/deg

@@ -26,9 +26,10 @@
 //! - the energy balance of every step ([`super::energy`], D12);
 //! - after every step, the projection of the converged velocities on the
 //!   velocity constraints (D13), with the accelerations and multipliers
-//!   along the method's relations below `ρ∞ = 0.99` (D13a): without it
-//!   the index-3 scheme is unstable on turning constraints once `hω`
-//!   exceeds a bound that vanishes as `ρ∞ → 1` (docs/theory.md §15.7);
+//!   along the method's relations (D13a), or consistent with the
+//!   projected state on a very short step (D13b): without it the index-3
+//!   scheme is unstable on turning constraints once `hω` exceeds a bound
+//!   that vanishes as `ρ∞ → 1` (docs/theory.md §15.7);
 //! - the positions projected on the constraints before the restart after
 //!   an impact (D14), and `a − v̇` not enlarged when the step grows (D15),
 //!   so that neither kicks the multipliers into the alternating transient
@@ -93,11 +94,12 @@ const MOTION_STEP: f64 = 1e-3;
 /// `ε/1e-5` ~2e-11 of the velocities.
 const PROJECTION_STEP: f64 = 1e-5;
 
-/// The spectral radius below which the projection of the velocities on
-/// the velocity constraints (D13) also corrects the pseudo-accelerations,
-/// the accelerations and the multipliers along the method's relations
-/// (D13a); from it up, the velocities alone.
-pub const PROJECTION_RHO: f64 = 0.99;
+/// Steps shorter than this fraction of the motion time `T_m` (D13) take
+/// the accelerations and multipliers consistent with their projected
+/// state (D9) instead of D13a (D13b): there `δv/(γh)` would pass the
+/// round-off of `Φ̇`, ~2e-11 of the velocities, on to `a` as more than
+/// ~4e-3 of the accelerations (docs/theory.md §15.7).
+const SHORT_STEP: f64 = 1e-8;
 
 /// Applications of the filter of the local error estimate (D11a): the
 /// first cancels the growth `∝ (ωh)²` of the estimate of a vibration the
@@ -182,13 +184,6 @@ impl GeneralizedAlpha {
     /// `β′ = (1 − α_m)/((1 − α_f) β h²)`: `δv̇ = β′ x` (D6).
     pub fn beta_prime(&self, h: f64) -> f64 {
         (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * h * h)
-    }
-
-    /// Whether the projection of the velocities (D13) changes the
-    /// velocities alone: for `ρ∞ ≥` [`PROJECTION_RHO`]
-    /// (`ρ∞ = α_f/(1 − α_f)`). Below it, D13a.
-    pub fn projects_velocities_only(&self) -> bool {
-        self.alpha_f / (1.0 - self.alpha_f) >= PROJECTION_RHO
     }
 
     /// `(1/(γh), c)`, `c = (1 − α_m)/((1 − α_f) γ h)`: a change `δv` of
@@ -1899,11 +1894,12 @@ impl Dynamics<'_> {
         }));
         solve_mass_system(model, self.solver, state, rhs)?;
         let dofs = &self.solver.dofs;
-        // D13a: below PROJECTION_RHO, a, v̇ and λ follow δv as a Newton
-        // correction would (D6), so that the next step starts from a
-        // state whose equations of motion hold and whose pseudo-
-        // acceleration matches the projected velocities
-        let (da, dvd) = if self.scheme.projects_velocities_only() {
+        // D13a: a, v̇ and λ follow δv as a Newton correction would (D6),
+        // so that the next step starts from a state whose equations of
+        // motion hold and whose pseudo-acceleration matches the projected
+        // velocities; on a short step, D13b below instead
+        let short = h < SHORT_STEP * motion_time(model, state, run.span);
+        let (da, dvd) = if short {
             (0.0, 0.0)
         } else {
             self.scheme.velocity_to_accelerations(h)
@@ -1923,6 +1919,13 @@ impl Dynamics<'_> {
                 // M δv = kBᵀμ: M δv̇ = c kBᵀμ is balanced by δλ = c μ
                 state.multipliers[d - dofs.first_multiplier()] += dvd * z * s_eq[eq];
             }
+        }
+        if short {
+            // D13b: Newton's a carries the round-off of q over βh², and
+            // D13a would leave that of δv over γh; a, v̇ and λ consistent
+            // with the projected q and v (D9) instead, a = v̇ being the
+            // steady a − v̇ ≈ (α_m − α_f) h g⃛ of so short a step
+            return initial_accelerations(model, self.solver, run, self.settings.end_time);
         }
         let (_, assembler, _) = self.solver.system();
         let ctx = EvalContext {

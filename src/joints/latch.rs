@@ -349,7 +349,14 @@ impl Latch {
             } else {
                 let side = self.side(state);
                 let next = if side == 0.0 {
-                    let out = if x >= 0.0 { 1.0 } else { -1.0 };
+                    // the edge reached; without a dead band both edges are
+                    // at c_L, where the sign of x is round-off (a landing
+                    // within the event tolerance): the motion leaves by the
+                    // side it moves to
+                    let out = match (s.backlash > 0.0, x >= 0.0, rate >= 0.0) {
+                        (true, true, _) | (false, _, true) => 1.0,
+                        _ => -1.0,
+                    };
                     if out * rate > 0.0 {
                         out
                     } else {

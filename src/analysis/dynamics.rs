@@ -1924,7 +1924,10 @@ impl Dynamics<'_> {
             // D13b: Newton's a carries the round-off of q over βh², and
             // D13a would leave that of δv over γh; a, v̇ and λ consistent
             // with the projected q and v (D9) instead, a = v̇ being the
-            // steady a − v̇ ≈ (α_m − α_f) h g⃛ of so short a step
+            // steady a − v̇ ≈ (α_m − α_f) h g⃛ of so short a step; from
+            // such a restart the steps grow back by at most LOCK_REGROWTH
+            // a step, as after a lock (§16)
+            run.regrowing = true;
             return initial_accelerations(model, self.solver, run, self.settings.end_time);
         }
         let (_, assembler, _) = self.solver.system();

@@ -1,7 +1,8 @@
-//! Restart of spring latches (docs/results.md, "Restart files"): a run
+//! Restart of latches (docs/results.md, "Restart files"): a run
 //! restarted from a restart file written while a spring latch is latched
-//! (its spring engaged on either side, or within its dead band) or after
-//! it released goes on as the run that was never stopped, to round-off.
+//! (its spring engaged on either side, or within its dead band), after
+//! it released, or after a rigid latch locked goes on as the run that was
+//! never stopped, to round-off.
 
 mod common;
 
@@ -201,4 +202,34 @@ fn a_released_spring_latch_goes_on_through_a_restart() {
     // to c_L before it can latch again)
     assert_eq!(internals[1][2], 0.0, "{:?}", internals[1]);
     assert_eq!(internals[1][3], 1.0, "{:?}", internals[1]);
+}
+
+/// The panel of tests/common/hinged_panel.rs opened by its spring into a
+/// rigid latch at 90° (locked at t = 0.427641 s), in fixed steps of
+/// 0.01 s. Restarted at t = 0.5 and 0.55, once its steps have grown back
+/// to `time_step` after the lock, it goes on locked as the whole run.
+/// (A file written while they are still growing back, before about
+/// 0.467 s here, starts again from `time_step`: docs/results.md.)
+#[test]
+fn a_run_restarted_after_a_rigid_lock_goes_on_locked_as_the_whole_run() {
+    let text = common::hinged_panel::latched_panel(
+        "panel on a rigid latch",
+        "[analysis]\ntype = \"dynamic\"\nend_time = 0.6\ntime_step = 0.01\nadaptive = false",
+        90.0,
+        "[output]\nrestart_times = [0.5, 0.55]",
+    );
+    let internals = whole_and_restarted("rigid", &text, &[0.5, 0.55]);
+    // internal variables: the unwrapped angles of the hinge, its spring
+    // and its latch, all at the lock's π/2 (to round-off), then the
+    // latch's lock flag, 1
+    for internal in &internals {
+        assert_eq!(internal.len(), 4, "{internal:?}");
+        for angle in &internal[..3] {
+            assert!(
+                (angle - std::f64::consts::FRAC_PI_2).abs() < 1e-12,
+                "{internal:?}"
+            );
+        }
+        assert_eq!(internal[3], 1.0, "{internal:?}");
+    }
 }

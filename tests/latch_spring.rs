@@ -389,6 +389,26 @@ fn a_one_sided_spring_latch_turns_the_panel_back_and_lets_it_go() {
         exit.0 - entry.0,
         std::f64::consts::PI / big_omega
     );
+    // out of the spring the latch goes straight to its free side (no dead
+    // band: docs/joints.md §6.2), no step chasing an event of a band of no
+    // width (down to 5e-13 s before; now none below 1e-4 s after the entry)
+    let shortest = rec
+        .steps
+        .iter()
+        .filter(|(i, _)| i.time > entry.0)
+        .map(|(i, _)| i.step)
+        .fold(f64::INFINITY, f64::min);
+    assert!(shortest >= 1e-6, "a step of {shortest:e} s after the entry");
+    // the spring engages at the entry and disengages at the exit, once each
+    let crossings: Vec<(LatchEventKind, f64)> =
+        rec.crossings.iter().map(|c| (c.kind, c.time)).collect();
+    assert_eq!(crossings.len(), 2, "{crossings:?}");
+    assert_eq!(crossings[0].0, LatchEventKind::Engage, "{crossings:?}");
+    assert_eq!(crossings[1].0, LatchEventKind::Disengage, "{crossings:?}");
+    assert!(
+        (crossings[1].1 - exit.0).abs() <= 1e-12,
+        "{crossings:?} {exit:?}"
+    );
     // the entry at θ_L/ω₀ (1e-5 s, as for the rattle) and at ω₀
     assert!((entry.0 - THETA_R / OMEGA_0).abs() <= 1e-5, "{entry:?}");
     assert!((entry.2 / OMEGA_0 - 1.0).abs() <= 1e-4, "{entry:?}");

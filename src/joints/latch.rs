@@ -363,15 +363,24 @@ impl Latch {
                         side
                     }
                 } else if side * rate < 0.0 {
-                    0.0
+                    // back across the edge: into the band, or, without a
+                    // dead band (both edges at c_L, a band of no width
+                    // whose event function would touch zero without
+                    // crossing it), straight to the other side
+                    if s.backlash > 0.0 {
+                        0.0
+                    } else {
+                        -side
+                    }
                 } else {
                     side
                 };
                 state.internal[slot + SIDE] = next;
                 // the side's sign stands for x: whether the spring acts there
-                if next != side && next != 0.0 && s.acts_at(next) {
+                let acts = |side: f64| side != 0.0 && s.acts_at(side);
+                if next != side && acts(next) && !acts(side) {
                     SpringEvent::Engage
-                } else if next != side && next == 0.0 && s.acts_at(side) {
+                } else if next != side && acts(side) && !acts(next) {
                     SpringEvent::Disengage
                 } else {
                     SpringEvent::Band

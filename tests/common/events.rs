@@ -19,6 +19,8 @@ pub struct Record {
     pub steps: Vec<(IncrementInfo, State)>,
     pub contacts: Vec<ContactInfo>,
     pub locks: Vec<LockInfo>,
+    /// Spring latches' band crossings (engage, disengage, rearm).
+    pub crossings: Vec<LockInfo>,
 }
 
 impl Observer for Record {
@@ -37,6 +39,9 @@ impl Observer for Record {
     }
     fn lock(&mut self, info: &LockInfo) {
         self.locks.push(info.clone());
+    }
+    fn band_crossing(&mut self, info: &LockInfo) {
+        self.crossings.push(info.clone());
     }
 }
 

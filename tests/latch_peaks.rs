@@ -23,8 +23,11 @@
 //! 21 µs, 0.21 ms and 0.63 ms later, 5 to 20 ms after the lock, and the
 //! steps after the last two locks created 0.40 and 0.52 J.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
+
+use common::cli::{self, summary};
 
 /// Length of an arm (m).
 const L: f64 = 0.2;
@@ -37,15 +40,6 @@ const MASS_PER_LENGTH: f64 = 0.0955;
 const K: f64 = 0.2;
 const FREE: f64 = 3.0;
 const LOCK: f64 = 2.0;
-
-/// A fresh scratch directory for one run.
-fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("unfold-latch-peaks-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Arm `k` at `y`, its latch (id `10k + 6`) at `value`.
 fn arm(k: usize, y: f64, value: f64) -> String {
@@ -110,7 +104,7 @@ value = {value:?}
 /// alone), in fixed steps of 0.01 s at `ρ∞ = 0.5` (the ERA platform's,
 /// examples/era.md), run through the command line into `dir/out`.
 fn run(name: &str, offset: Option<f64>) -> PathBuf {
-    let dir = scratch(name);
+    let dir = cli::scratch("latch-peaks", name);
     let second = offset.map_or(String::new(), |d| arm(2, 1.0, LOCK + d));
     let text = format!(
         r#"title = "arms opened by springs into rigid latches"
@@ -135,25 +129,7 @@ inertia_per_length = [8.64e-6, 4.32e-6, 4.32e-6]
 {}{second}"#,
         arm(1, 0.0, LOCK)
     );
-    let model = dir.join("model.toml");
-    std::fs::write(&model, text).unwrap();
-    let out = dir.join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .args([
-            "run",
-            model.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    out
-}
-
-fn summary(out: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+    cli::run_text(&dir, &text).0
 }
 
 /// The column `name` of a CSV file.

@@ -11,71 +11,23 @@
 //! inertia about the hinge is `J = J_c + m/4 = 1/3` and each panel's
 //! equation of motion, with its hinge angle `θ`, is `J θ̈ = M(θ, t)`.
 
-use std::collections::HashMap;
+mod common;
+
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+
+use common::cli::{self, csv_rows as rows, number, summary};
 
 /// The inertia of a panel about its hinge.
 const J: f64 = 1.0 / 12.0 + 0.25;
 
-/// A fresh scratch directory for one test.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "unfold-latch-records-{}-{name}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    cli::scratch("latch-records", name)
 }
 
 /// Writes `text` as a model in `dir` and runs it into `dir/out`.
 fn run(dir: &Path, text: &str) -> PathBuf {
-    let model = dir.join("model.toml");
-    std::fs::write(&model, text).unwrap();
-    let out = dir.join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .args([
-            "run",
-            model.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    out
-}
-
-/// The rows of a CSV file as maps from column name to text.
-fn rows(path: &Path) -> Vec<HashMap<String, String>> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    lines
-        .map(|l| {
-            header
-                .iter()
-                .cloned()
-                .zip(l.split(',').map(str::to_string))
-                .collect()
-        })
-        .collect()
-}
-
-fn number(row: &HashMap<String, String>, column: &str) -> f64 {
-    row[column].parse().unwrap()
-}
-
-fn summary(out: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+    cli::run_text(dir, text).0
 }
 
 /// A panel `n` (node `n`, its hinge node `10 + n` at `(0, y, 0)`, joint

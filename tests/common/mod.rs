@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod ball;
+pub mod cli;
 pub mod elliptic;
 pub mod events;
 pub mod flexible_hinge;

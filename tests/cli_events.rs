@@ -12,6 +12,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use common::cli::{csv_rows as rows, summary};
 use common::hinged_panel::latched_panel;
 use common::pendulum;
 
@@ -60,31 +61,6 @@ fn kinds(out: &Path) -> Vec<String> {
         .into_iter()
         .map(|mut r| r.remove("kind").unwrap())
         .collect()
-}
-
-/// The rows of a CSV file as maps from column name to text.
-fn rows(path: &Path) -> Vec<HashMap<String, String>> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    lines
-        .map(|l| {
-            header
-                .iter()
-                .cloned()
-                .zip(l.split(',').map(str::to_string))
-                .collect()
-        })
-        .collect()
-}
-
-fn summary(out: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
 /// The latched panel of tests/common/hinged_panel.rs (J_O = 1/3 kg·m²,

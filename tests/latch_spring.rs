@@ -760,20 +760,7 @@ fn the_release_is_an_event_in_the_result_files() {
         "end_time = 0.6\ntime_step = 0.001\nerror_tolerance = 1e-6",
         "",
     );
-    let model = dir.join("model.toml");
-    std::fs::write(&model, text).unwrap();
-    let out = dir.join("out");
-    let run = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .args([
-            "run",
-            model.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ])
-        .output()
-        .unwrap();
-    assert_eq!(run.status.code(), Some(0), "{run:?}");
+    let (out, _) = common::cli::run_text(&dir, &text);
     let table = |name: &str| -> (Vec<String>, Vec<Vec<String>>) {
         let text = std::fs::read_to_string(out.join(name)).unwrap();
         let mut lines = text.lines();

@@ -337,6 +337,26 @@ impl Table {
 }
 
 /// `x` to four significant digits, in exponent form outside [1e-3, 1e5).
+/// How many of each noun, in order of first appearance: `["1 lock",
+/// "3 engages"]` (plural with `es` after `ch` and `s`).
+fn counted<'a>(nouns: impl Iterator<Item = &'a str>) -> Vec<String> {
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for noun in nouns {
+        match counts.iter_mut().find(|c| c.0 == noun) {
+            Some(c) => c.1 += 1,
+            None => counts.push((noun, 1)),
+        }
+    }
+    counts
+        .iter()
+        .map(|&(noun, n)| match n {
+            1 => format!("1 {noun}"),
+            _ if noun.ends_with("ch") || noun.ends_with('s') => format!("{n} {noun}es"),
+            _ => format!("{n} {noun}s"),
+        })
+        .collect()
+}
+
 fn significant(x: f64) -> String {
     let a = x.abs();
     if a == 0.0 {
@@ -892,21 +912,7 @@ impl Histories {
             (None, Some(joint)) => format!("joint {joint}: "),
             (None, None) => String::new(),
         };
-        let mut counts: Vec<(&str, usize)> = Vec::new();
-        for e in cluster {
-            let kind = e.kind.as_deref().unwrap_or("event");
-            match counts.iter_mut().find(|c| c.0 == kind) {
-                Some(c) => c.1 += 1,
-                None => counts.push((kind, 1)),
-            }
-        }
-        let what: Vec<String> = counts
-            .iter()
-            .map(|(kind, n)| match n {
-                1 => format!("1 {kind}"),
-                _ => format!("{n} {kind}s"),
-            })
-            .collect();
+        let what = counted(cluster.iter().map(|e| e.kind.as_deref().unwrap_or("event")));
         let (first, last) = (cluster[0].time, cluster[cluster.len() - 1].time);
         let when = if cluster.len() == 1 {
             format!("at {}{time_unit}", significant(first))
@@ -932,23 +938,11 @@ impl Histories {
         if let [e] = group {
             return with_lost(e.label.clone());
         }
-        // counts by kind, in order of first appearance
-        let mut counts: Vec<(String, usize)> = Vec::new();
-        for e in group {
-            let noun = e.kind.clone().unwrap_or_else(|| e.label.clone());
-            match counts.iter_mut().find(|c| c.0 == noun) {
-                Some(c) => c.1 += 1,
-                None => counts.push((noun, 1)),
-            }
-        }
-        let what: Vec<String> = counts
-            .iter()
-            .map(|(noun, n)| match n {
-                1 => format!("1 {noun}"),
-                _ if noun.ends_with("ch") || noun.ends_with('s') => format!("{n} {noun}es"),
-                _ => format!("{n} {noun}s"),
-            })
-            .collect();
+        let what = counted(
+            group
+                .iter()
+                .map(|e| e.kind.as_deref().unwrap_or(e.label.as_str())),
+        );
         let joint = group[0].joint.filter(|j| {
             group.iter().all(|e| e.joint == Some(*j)) && group.iter().all(|e| e.kind.is_some())
         });

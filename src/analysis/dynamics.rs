@@ -2588,6 +2588,8 @@ impl Stepper for Dynamics<'_> {
             run.last_step = None;
             run.a_before.clear();
             run.a_before_coordinates.clear();
+            // from consistent accelerations, as after a lock (§16)
+            run.regrowing = true;
         }
         run.balance.impact(springs.released, 0.0);
         locks.extend(springs.events);

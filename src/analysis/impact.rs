@@ -625,8 +625,8 @@ pub fn spring_latch_events_at(
                     LatchEventKind::Lock
                 }
                 SpringEvent::Unlatch => {
-                    // the dashpot's load d ċ appears at once
-                    out.restart |= spring.damping * l.rate(state).0 != 0.0;
+                    // the latch's load, its unlatch load, vanishes at once
+                    out.restart = true;
                     out.released += energy;
                     LatchEventKind::Unlatch
                 }

@@ -794,7 +794,7 @@ impl DynamicAnalysis {
         }
         run.controller = Some(controller);
         if !matches!(result, Ok(Advance::Accepted(_))) {
-            for w in run.watch.warnings() {
+            for w in run.watch.warnings(self.settings.rho_infinity) {
                 observer.warning(&w);
             }
         }
@@ -2733,8 +2733,9 @@ impl Watch {
 
     /// The warnings of the steps kept by [`Watch::energy_jump`] whose
     /// change of `E` is above [`ENERGY_JUMP`] of the largest energy of the
-    /// motion (once, at the end of the analysis).
-    fn warnings(&mut self) -> Vec<WarningInfo> {
+    /// motion (once, at the end of the analysis). A loss is said to be
+    /// numerical damping only where the integrator damps (`ρ∞ < 1`).
+    fn warnings(&mut self, rho_infinity: f64) -> Vec<WarningInfo> {
         let largest = self.largest;
         std::mem::take(&mut self.jumps)
             .into_iter()
@@ -2746,6 +2747,12 @@ impl Watch {
                 message: if after > before {
                     format!(
                         "the energy balance error changed by {:.3e} in one step (from {before:.3e} to {after:.3e}), more than {} % of the largest energy of the motion ({largest:.3e}): the step created energy; its results are suspect (shorten time_step, or use adaptive steps)",
+                        after - before,
+                        ENERGY_JUMP * 100.0,
+                    )
+                } else if rho_infinity >= 1.0 {
+                    format!(
+                        "the energy balance error changed by {:.3e} in one step (from {before:.3e} to {after:.3e}), more than {} % of the largest energy of the motion ({largest:.3e}): the step lost energy, and with rho_infinity = 1 the integrator damps nothing: the step is too long for the motion (a corner of a spring law, or a load that changes, inside it); its results are suspect (shorten time_step, or use adaptive steps)",
                         after - before,
                         ENERGY_JUMP * 100.0,
                     )
@@ -2904,7 +2911,7 @@ mod tests {
         watch.energy_jump(&step(23), &start, &step23);
         watch.energy_jump(&step(24), &step23, &step24);
         watch.energy_jump(&step(25), &step24, &step25);
-        let warnings = watch.warnings();
+        let warnings = watch.warnings(0.9);
         assert_eq!(warnings.len(), 1, "{warnings:?}");
         assert_eq!(warnings[0].increment, 25);
         let message = &warnings[0].message;
@@ -2923,12 +2930,20 @@ mod tests {
         };
         watch.energy_jump(&step(24), &start, &step24);
         watch.energy_jump(&step(25), &step24, &step25);
-        let warnings = watch.warnings();
+        let kept = watch.jumps.clone();
+        let warnings = watch.warnings(0.5);
         assert_eq!(warnings.len(), 1, "{warnings:?}");
         let message = &warnings[0].message;
         assert!(message.contains("changed by -1.665e2"), "{message}");
         assert!(message.contains("the step lost energy"), "{message}");
         assert!(message.contains("raise rho_infinity"), "{message}");
+        // at ρ∞ = 1 nothing damps: the loss is the step's error, suspect
+        watch.jumps = kept;
+        let warnings = watch.warnings(1.0);
+        let message = &warnings[0].message;
+        assert!(message.contains("the step lost energy"), "{message}");
+        assert!(!message.contains("numerical damping"), "{message}");
+        assert!(message.contains("results are suspect"), "{message}");
     }
 
     /// From rest, the first steps' balance errors are large next to the
@@ -2955,6 +2970,6 @@ mod tests {
         watch.energy_jump(&step(1), &e0, &e1);
         assert_eq!(watch.jumps.len(), 1);
         watch.energy_jump(&step(2), &e1, &e2);
-        assert!(watch.warnings().is_empty());
+        assert!(watch.warnings(0.9).is_empty());
     }
 }

@@ -63,6 +63,7 @@ use crate::analysis::{
     StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
+use crate::joints::latch::Latch;
 use crate::joints::stop::Contact;
 use crate::model::{Id, Model};
 use crate::state::State;
@@ -620,6 +621,16 @@ struct LatchWatch {
     before: bool,
     /// Said already that the analysis carried it past its value.
     passed: bool,
+    /// A spring latch's contact so far.
+    contact: SpringContact,
+    /// The largest force of its spring in the analysis.
+    largest: f64,
+    /// Its whole contacts: steps, start and end times, largest force, and
+    /// the increment that ended it.
+    contacts: Vec<(usize, f64, f64, f64, usize)>,
+    /// Said already that a static analysis loaded it beyond its unlatch
+    /// load.
+    overloaded: bool,
 }
 
 impl LatchWatch {
@@ -646,6 +657,16 @@ impl LatchWatch {
                     high: c,
                     before: l.gap(state) < -impact::event_tolerance(model, l),
                     passed: false,
+                    contact: SpringContact {
+                        sign: spring_force(l, state).signum(),
+                        steps: 0,
+                        from: state.time,
+                        whole: false,
+                        peak: 0.0,
+                    },
+                    largest: 0.0,
+                    contacts: Vec::new(),
+                    overloaded: false,
                 })
             })
             .collect()
@@ -660,6 +681,32 @@ impl LatchWatch {
             w.before |= before.before;
         }
         *watch = now;
+    }
+
+    /// Follows the contact of its spring to the converged step at `time`
+    /// where its force is `f`: a contact is the steps between two changes
+    /// of the force's sign, half a period of the latch's oscillation about
+    /// an edge of its dead band (docs/joints.md §6.2).
+    fn follow_contact(&mut self, f: f64, time: f64, increment: usize) {
+        let sign = if f == 0.0 { 0.0 } else { f.signum() };
+        self.largest = self.largest.max(f.abs());
+        let c = &mut self.contact;
+        if sign == c.sign {
+            c.steps += 1;
+            c.peak = c.peak.max(f.abs());
+            return;
+        }
+        if c.sign != 0.0 && c.whole {
+            self.contacts
+                .push((c.steps, c.from, time, c.peak, increment));
+        }
+        *c = SpringContact {
+            sign,
+            steps: 1,
+            from: time,
+            whole: true,
+            peak: f.abs(),
+        };
     }
 
     /// `c` with its unit, and in degrees for an angle.
@@ -680,6 +727,39 @@ impl LatchWatch {
         }
     }
 }
+
+/// The force of latch `l`'s spring at `state` (without its dashpot): 0
+/// when it is open, not a spring latch, or within its dead band.
+fn spring_force(l: &Latch, state: &State) -> f64 {
+    match l.spring() {
+        Some(s) if l.is_locked(state) => s.spring_force(l.coordinate(state) - l.value()).0,
+        _ => 0.0,
+    }
+}
+
+/// A spring latch's contact being followed ([`LatchWatch::follow_contact`]).
+#[derive(Clone, Copy, Debug)]
+struct SpringContact {
+    /// The sign of the spring's force (0: none).
+    sign: f64,
+    /// Converged steps of that sign so far, from `from`.
+    steps: usize,
+    from: f64,
+    /// Begun within the analysis (not already under way at its start).
+    whole: bool,
+    /// The largest `|f|` of the contact.
+    peak: f64,
+}
+
+/// Contacts whose force stays below this fraction of the spring's largest
+/// force are not counted among the contacts resolved or not.
+const CONTACT_FORCE: f64 = 1e-3;
+
+/// A contact of a spring latch resolved by fewer steps than this is
+/// reported: its half-period sampled at n steps, a peak between two of
+/// them is missed by up to `1 − cos(π/2n)` (8 % at n = 4), and below it
+/// the integration itself no longer follows the spring.
+const RESOLVED_CONTACT_STEPS: usize = 4;
 
 /// The analysis being recorded.
 struct Running {
@@ -1005,6 +1085,23 @@ impl Recorder {
             let Some(l) = model.elements.get(w.element).and_then(|e| e.as_latch()) else {
                 continue;
             };
+            if !statics {
+                w.follow_contact(spring_force(l, state), info.time, info.increment);
+            }
+            if let Some(limit) = l.spring().and_then(|s| s.unlatch_load) {
+                let load = l.spring_state(state).2;
+                if statics && w.locked && !w.overloaded && load.abs() > limit {
+                    w.overloaded = true;
+                    notes.push(format!(
+                        "latch {}: the {} analysis loads it with {} at t = {}, beyond its unlatch_load {}; latches release only in a dynamic analysis: a static or kinematic one holds them whatever the load (docs/joints.md §6.2)",
+                        w.id,
+                        self.current.kind,
+                        format_time(load.abs()),
+                        format_time(info.time),
+                        format_time(limit)
+                    ));
+                }
+            }
             if w.locked {
                 continue;
             }
@@ -1068,6 +1165,46 @@ impl Recorder {
             self.note_line(&n);
         }
         self.never_struck(end);
+        self.unresolved_contacts();
+    }
+
+    /// At the end of a dynamic analysis: a warning for each spring latch
+    /// whose shortest contact lasted fewer than
+    /// [`RESOLVED_CONTACT_STEPS`] steps: the steps do not resolve its
+    /// spring, and its peak load and its rattles are unreliable (with
+    /// fixed steps longer than a contact, a peak load half the true one
+    /// and half the rattles have been seen, with the energy balanced).
+    fn unresolved_contacts(&mut self) {
+        let warnings: Vec<WarningInfo> = self
+            .latches
+            .iter()
+            .filter_map(|w| {
+                // contacts whose force stays below CONTACT_FORCE of the
+                // largest (the round-off of a step landed on an edge) are
+                // not counted
+                let (steps, from, to, _, increment) = w
+                    .contacts
+                    .iter()
+                    .filter(|c| c.3 >= CONTACT_FORCE * w.largest)
+                    .min_by_key(|c| c.0)
+                    .copied()?;
+                (steps < RESOLVED_CONTACT_STEPS).then(|| WarningInfo {
+                    increment,
+                    from,
+                    time: to,
+                    message: format!(
+                        "latch {}: a contact of its spring lasted only {steps} step{} ({} s): the steps do not resolve the latch's spring, so its peak load and the number of its rattles are unreliable; use adaptive steps, or steps at least {} times shorter than a contact",
+                        w.id,
+                        if steps == 1 { "" } else { "s" },
+                        format_time(to - from),
+                        4 * RESOLVED_CONTACT_STEPS
+                    ),
+                })
+            })
+            .collect();
+        for w in &warnings {
+            Observer::warning(self, w);
+        }
     }
 
     /// At the end of a dynamic analysis that reached its end: a note for
@@ -1477,8 +1614,13 @@ impl Observer for Recorder {
     }
 
     fn warning(&mut self, info: &WarningInfo) {
+        let word = if self.current.kind == "dynamic" {
+            "step"
+        } else {
+            "increment"
+        };
         let text = format!(
-            "increment {} (t = {} to {}): {}",
+            "{word} {} (t = {} to {}): {}",
             info.increment + self.increment_offset,
             format_time(info.from),
             format_time(info.time),

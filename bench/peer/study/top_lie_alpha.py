@@ -315,6 +315,8 @@ if __name__ == "__main__":
             e = error(lie(h, rho, project=True, spatial=True))
         elif which == "fixed":
             e = error(lie(h, rho, fixed=True))
-        else:
+        elif which == "ep":
             e = error(ep(h, rho))
+        else:
+            sys.exit(f"unknown variant {which!r}: lie, lieproj, spatial, spatialproj, fixed or ep")
         print(f"{which} rho={rho} h={h:.4e} error={e:.4e}", flush=True)

@@ -336,7 +336,6 @@ impl Table {
     }
 }
 
-/// `x` to four significant digits, in exponent form outside [1e-3, 1e5).
 /// How many of each noun, in order of first appearance: `["1 lock",
 /// "3 engages"]` (plural with `es` after `ch` and `s`).
 fn counted<'a>(nouns: impl Iterator<Item = &'a str>) -> Vec<String> {
@@ -357,6 +356,7 @@ fn counted<'a>(nouns: impl Iterator<Item = &'a str>) -> Vec<String> {
         .collect()
 }
 
+/// `x` to four significant digits, in exponent form outside [1e-3, 1e5).
 fn significant(x: f64) -> String {
     let a = x.abs();
     if a == 0.0 {
@@ -456,8 +456,8 @@ struct Event {
     time: f64,
     joint: Option<Id>,
     label: String,
-    /// Kind of event of `events.csv` (`impact`, `lock`), to count the
-    /// events of a group; `None` for a lock read from `latches.csv`.
+    /// Kind of event of `events.csv` (`impact`, `lock`; `lock` too for a
+    /// lock read from `latches.csv`), to count the events of a group.
     kind: Option<String>,
     /// Energy lost at the event (`events.csv`), in the model's units.
     lost: Option<f64>,
@@ -596,7 +596,7 @@ impl Histories {
                         time: t.number(r, time)?,
                         joint,
                         label: format!("latch {id} locks"),
-                        kind: None,
+                        kind: Some("lock".into()),
                         lost: None,
                         element: Some(id),
                     });

@@ -1137,6 +1137,7 @@ impl Recorder {
         if self.current.kind != "dynamic" || end.error.is_some() {
             return;
         }
+        let span = self.span(end);
         let notes: Vec<String> = self
             .latches
             .iter()
@@ -1145,9 +1146,8 @@ impl Recorder {
                 // a coordinate that crossed the value against the approach
                 let crossed = w.low <= w.value && w.value <= w.high;
                 format!(
-                    "latch {} never locked in the dynamic analysis to t = {}: joint {} stayed within [{}, {}]{}, and the latch locks when the coordinate reaches {} {}",
+                    "latch {} never locked in the dynamic analysis {span}: joint {} stayed within [{}, {}]{}, and the latch locks when the coordinate reaches {} {}",
                     w.id,
-                    format_time(end.time),
                     w.joint,
                     w.show(w.low),
                     w.show(w.high),
@@ -1215,6 +1215,7 @@ impl Recorder {
         if self.current.kind != "dynamic" || end.error.is_some() {
             return;
         }
+        let span = self.span(end);
         let mut notes = Vec::new();
         for w in self.stops.iter().filter(|w| !w.struck) {
             let show = |c: f64| {
@@ -1237,9 +1238,8 @@ impl Recorder {
                         }
                     };
                     format!(
-                        "stop {} was never struck in the dynamic analysis to t = {}: joint {joint} stayed within [{}, {}], and the stop's limits are [{}, {}]",
+                        "stop {} was never struck in the dynamic analysis {span}: joint {joint} stayed within [{}, {}], and the stop's limits are [{}, {}]",
                         w.id,
-                        format_time(end.time),
                         show(w.low),
                         show(w.high),
                         limit(lower),
@@ -1247,9 +1247,8 @@ impl Recorder {
                     )
                 }
                 None => format!(
-                    "contact {} never closed in the dynamic analysis to t = {}: its gap stayed within [{}, {}]",
+                    "contact {} never closed in the dynamic analysis {span}: its gap stayed within [{}, {}]",
                     w.id,
-                    format_time(end.time),
                     format_time(w.low),
                     format_time(w.high)
                 ),
@@ -1257,6 +1256,23 @@ impl Recorder {
         }
         for n in notes {
             self.note_line(&n);
+        }
+    }
+
+    /// The time span of the analysis ending at `end`, in words: `to t =
+    /// 5`, or `from t = 2 to t = 5` when it did not start at 0 (after
+    /// another analysis, or from a restart: what it says covers that span
+    /// alone).
+    fn span(&self, end: &AnalysisEnd) -> String {
+        let start = self.current.start_time;
+        if start > 0.0 {
+            format!(
+                "from t = {} to t = {}",
+                format_time(start),
+                format_time(end.time)
+            )
+        } else {
+            format!("to t = {}", format_time(end.time))
         }
     }
 

@@ -569,12 +569,15 @@ impl DynamicAnalysis {
     /// Starts from a converged step of this analysis (a restart file's
     /// state) rather than from rest or the end of another analysis: the
     /// start keeps the state's velocities, accelerations,
-    /// pseudo-accelerations and multipliers instead of solving for
-    /// consistent ones (D9–D10), so that the steps repeat those of the
-    /// run that wrote the state. With `from` (what that run knew at the
-    /// state) the energy balance goes on and the first step is predicted
-    /// as it was there; without, work and dissipation count from the
-    /// state.
+    /// pseudo-accelerations, multipliers and internal variables instead
+    /// of solving for consistent ones (D9–D10) or locking latches and
+    /// closing stops at their limits, so that the steps repeat those of
+    /// the run that wrote the state. With `from` (what that run knew at
+    /// the state) the energy balance goes on, and the first step is
+    /// sized, predicted and its error estimated as they were there (the
+    /// step controller's memory, the regrowth after a lock, `a_{n−1}`);
+    /// without, work and dissipation count from the state and the steps
+    /// start from `time_step`.
     pub fn continued(mut self, from: Option<Continuation>) -> Self {
         self.continued = true;
         self.continuation = from;
@@ -882,8 +885,9 @@ impl DynamicAnalysis {
                 .map(|()| advance)
                 .map_err(|e| ControlStop::Stepper(e.into())),
             (Some(_), Err(stop)) => {
-                // the observer's report of the stop is kept over a failure
-                // to write the continuation
+                // the observer stopped the analysis at the step it was
+                // told of (an interruption): its continuation is still
+                // given, and the stop is the error reported
                 let _ = observer.continuation(&run.accepted, &Self::continuation_of(run));
                 Err(stop)
             }

@@ -743,8 +743,8 @@ fn run(
             let analysis = DynamicAnalysis::new(model.clone(), d.clone());
             // a restart inside this analysis keeps its velocities and
             // accelerations
-            Some(Planned::Dynamic(Box::new(match continued {
-                Some(motion) if k == 0 => analysis.continued(motion),
+            Some(Planned::Dynamic(Box::new(match &continued {
+                Some(motion) if k == 0 => analysis.continued(motion.clone()),
                 _ => analysis,
             })))
         } else {

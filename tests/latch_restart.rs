@@ -208,8 +208,8 @@ fn a_released_spring_latch_goes_on_through_a_restart() {
 /// rigid latch at 90° (locked at t = 0.427641 s), in fixed steps of
 /// 0.01 s. Restarted at t = 0.5 and 0.55, once its steps have grown back
 /// to `time_step` after the lock, it goes on locked as the whole run.
-/// (A file written while they are still growing back, before about
-/// 0.467 s here, starts again from `time_step`: docs/results.md.)
+/// (Restarts while they grow back:
+/// [`a_run_restarted_while_its_steps_grow_back_repeats_the_whole_run`].)
 #[test]
 fn a_run_restarted_after_a_rigid_lock_goes_on_locked_as_the_whole_run() {
     let text = common::hinged_panel::latched_panel(
@@ -231,5 +231,83 @@ fn a_run_restarted_after_a_rigid_lock_goes_on_locked_as_the_whole_run() {
             );
         }
         assert_eq!(internal[3], 1.0, "{internal:?}");
+    }
+}
+
+/// The rows of `file` in `out` after `t`, from their `time` column on
+/// (the step numbers before it count from the restart), as written.
+fn rows_after(out: &Path, file: &str, t: f64) -> Vec<String> {
+    let text = std::fs::read_to_string(out.join(file)).unwrap();
+    let mut lines = text.lines();
+    let time = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|c| c == "time")
+        .unwrap();
+    lines
+        .filter(|l| l.split(',').nth(time).unwrap().parse::<f64>().unwrap() > t + 1e-12)
+        .map(|l| l.split(',').skip(time).collect::<Vec<_>>().join(","))
+        .collect()
+}
+
+/// The panel opened by its spring into the rigid latch at 90°, with
+/// adaptive steps (locked at t = 0.4275372 s; the steps then double from
+/// the landing step of 5e-9 s for about twenty steps) and with fixed steps
+/// of 0.01 s (locked at 0.4276417 s; the step after it 4 times the
+/// landing step of 1e-8 s, then growing by 1.5 a step, to `time_step`
+/// at about 0.467 s). Restarted before the lock and while the steps grow
+/// back, each restarted run takes the steps of the whole run and writes
+/// the same rows, to the last digit, in every result file: the steps'
+/// times and sizes, the nodes' motion, the joints' and the latch's loads,
+/// the energies; its final state is the whole run's to the last bit.
+#[test]
+fn a_run_restarted_while_its_steps_grow_back_repeats_the_whole_run() {
+    for (name, analysis, times) in [
+        ("adaptive", "", [0.4275, 0.42755, 0.4277, 0.43]),
+        ("fixed", "adaptive = false", [0.4276, 0.42765, 0.428, 0.44]),
+    ] {
+        let list = times.map(|t| t.to_string()).join(", ");
+        let text = common::hinged_panel::latched_panel(
+            "panel on a rigid latch",
+            &format!(
+                "[analysis]\ntype = \"dynamic\"\nend_time = 0.6\ntime_step = 0.01\n{analysis}"
+            ),
+            90.0,
+            &format!("[output]\nrestart_times = [{list}]"),
+        );
+        let dir = scratch(&format!("regrow-{name}"));
+        let model = dir.join("model.toml");
+        std::fs::write(&model, text).unwrap();
+        let whole = dir.join("whole");
+        run(&model, &whole, &[]);
+        let end = json(&whole.join("restart.json"));
+        for t in times {
+            let file = whole.join(format!("restart-{t}.json"));
+            let part = dir.join(format!("from-{t}"));
+            run(&model, &part, &["--restart", file.to_str().unwrap()]);
+            // the file's step controller was growing back: shorter than
+            // time_step, but after 0.4275 (before the lock)
+            let size = json(&file)["motion"]["control"]["size"].as_f64().unwrap();
+            assert!(
+                t == 0.4275 || t == 0.4276 || size < 0.01,
+                "{name} {t}: {size}"
+            );
+            for csv in [
+                "steps.csv",
+                "nodes.csv",
+                "nodes_velocities.csv",
+                "joints.csv",
+                "latches.csv",
+                "energies.csv",
+            ] {
+                let (a, b) = (rows_after(&whole, csv, t), rows_after(&part, csv, t));
+                assert!(a.len() > 5, "{name} {t} {csv}");
+                assert_eq!(a, b, "{name}: restarted at {t}: {csv}");
+            }
+            assert_eq!(events_after(&whole, t), events_after(&part, t));
+            let restarted = json(&part.join("restart.json"));
+            assert_eq!(end["state"], restarted["state"], "{name}: restarted at {t}");
+        }
     }
 }

@@ -21,6 +21,8 @@
 //!   state), the increment numbering, the counts, and the observer's
 //!   cut-back and event reports.
 
+use serde::{Deserialize, Serialize};
+
 use super::newton::NewtonFailure;
 use super::{CutbackInfo, EventInfo, IncrementInfo, Observer};
 use crate::model::Model;
@@ -218,7 +220,8 @@ pub struct StepBounds {
 /// A crossing being located (regula falsi with the Illinois modification):
 /// the crossing lies within `span` (step units) of the accepted state, where
 /// the event function is `g_b` (halved each time this end is kept).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 struct Crossing {
     event: usize,
     span: f64,
@@ -236,6 +239,42 @@ impl Crossing {
         } else {
             0.5
         }
+    }
+}
+
+/// What the step controller carries from one accepted step to the next
+/// besides the stepper's state, as it stands once the next step's size is
+/// chosen: kept in restart files, so that a run continued from a step
+/// takes the steps the run never stopped would have taken
+/// ([`StepController::memory`], [`StepController::resume`]). The output
+/// times landed on and the counts are not in it: they follow from the
+/// time, and a continued run counts its own.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepMemory {
+    /// The size the next step will try.
+    size: f64,
+    /// The error estimate sets the size (no growth by [`GROWTH`]).
+    error_controlled: bool,
+    /// The PI controller's previous estimate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    last_error: Option<f64>,
+    /// The event functions at the accepted state and their sides (a side
+    /// is flipped once a step has landed on the event, whatever the sign
+    /// of the value landed on).
+    event_values: Vec<f64>,
+    event_sides: Vec<f64>,
+    /// A crossing being located, and the step that first crossed it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    crossing: Option<Crossing>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    approach: Option<f64>,
+}
+
+impl StepMemory {
+    /// The size the next step will try.
+    pub fn size(&self) -> f64 {
+        self.size
     }
 }
 
@@ -352,6 +391,38 @@ impl StepController {
             if size > self.size {
                 self.set_size(size);
             }
+        }
+    }
+
+    /// What the controller carries to the next step ([`StepMemory`]).
+    pub fn memory(&self) -> StepMemory {
+        StepMemory {
+            size: self.size,
+            error_controlled: self.error_controlled,
+            last_error: self.last_error,
+            event_values: self.event_values.clone(),
+            event_sides: self.event_sides.clone(),
+            crossing: self.crossing,
+            approach: self.approach,
+        }
+    }
+
+    /// Goes on from `memory`, taken from a controller of the same
+    /// analysis at an accepted step (a restart): the next size (within
+    /// this controller's bounds), the error estimate's memory and the
+    /// events' state. Events whose number differs from the memory's are
+    /// evaluated again at the first step, as at a start.
+    pub fn resume(&mut self, memory: &StepMemory) {
+        self.set_size(memory.size);
+        self.error_controlled = memory.error_controlled;
+        self.last_error = memory.last_error;
+        if memory.event_values.len() == self.events.len()
+            && memory.event_sides.len() == self.events.len()
+        {
+            self.event_values.clone_from(&memory.event_values);
+            self.event_sides.clone_from(&memory.event_sides);
+            self.crossing = memory.crossing.filter(|c| c.event < self.events.len());
+            self.approach = memory.approach;
         }
     }
 
@@ -625,6 +696,10 @@ impl StepController {
                     || on_output_time
                     || !landed.is_empty(),
             };
+            // the next size, before the stepper reports the step
+            if error.is_none() && iterations <= EASY_ITERATIONS && !self.error_controlled {
+                self.size = (self.size * GROWTH).min(self.bounds.max);
+            }
             stepper
                 .accept(&info, observer)
                 .map_err(ControlStop::Stepper)?;
@@ -639,9 +714,6 @@ impl StepController {
             self.counts.increments += 1;
             self.counts.iterations += iterations;
             self.increment += 1;
-            if error.is_none() && iterations <= EASY_ITERATIONS && !self.error_controlled {
-                self.size = (self.size * GROWTH).min(self.bounds.max);
-            }
             return Ok(Advance::Accepted(info));
         }
     }

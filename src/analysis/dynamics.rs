@@ -52,7 +52,7 @@ use std::time::Instant;
 
 use super::constraints::ConstraintRows;
 use super::control::{
-    Advance, Attempt, ControlStop, EventFunction, StepBounds, StepController, Stepper,
+    Advance, Attempt, ControlStop, EventFunction, StepBounds, StepController, StepMemory, Stepper,
 };
 use super::energy::{Energies, EnergyBalance};
 use super::impact::{self, ContactInfo, ContactKind, LockInfo};
@@ -307,15 +307,43 @@ pub use super::statics::Step;
 
 /// What a motion's state alone does not hold and a dynamic analysis
 /// continued from one of its converged steps needs to go on as if never
-/// stopped ([`DynamicAnalysis::continued`]; kept in restart files).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+/// stopped ([`DynamicAnalysis::continued`]; kept in restart files), taken
+/// once the size of the next step is chosen
+/// ([`DynamicAnalysis::continuation`], [`Observer::continuation`]). The
+/// fields after `last_step` are absent from files of version 1 of the
+/// restart format: a run continued from those starts its steps again
+/// from `time_step`, with a first error estimate over one step
+/// (docs/results.md, "Restart files").
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Continuation {
     /// The energy balance at the step: work, dissipation and `T₀ + V₀`
     /// go on from it.
     pub energies: Energies,
-    /// Size of the step that ended there: the predictor of the next step
-    /// scales `a − v̇` with the ratio of the sizes (D5).
+    /// Size of the step that ended there (`None` after an impact or any
+    /// other restart of the accelerations): the predictor of the next step
+    /// scales `a − v̇` with the ratio of the sizes (D5), and the error
+    /// estimate weighs its difference with it (D11).
     pub last_step: Option<f64>,
+    /// The step controller's memory: the size of the next step, the error
+    /// estimate's memory, the events' values and sides.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control: Option<StepMemory>,
+    /// The steps are growing back after a lock, a closure or a very short
+    /// step, by at most [`LOCK_REGROWTH`] a step (docs/theory.md §16).
+    #[serde(default)]
+    pub regrowing: bool,
+    /// `a_{n−1}`, the pseudo-accelerations of the step before, by node and
+    /// by coordinate, for the difference of the error estimate (D11);
+    /// empty when the accelerations were restarted at the step.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub previous_pseudo_acceleration: Vec<[f64; 6]>,
+    /// `a_{n−1}` of the coordinates.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub previous_coordinate_pseudo_accelerations: Vec<f64>,
+    /// The mass scales of translations and rotations of D8, as last set by
+    /// the consistent accelerations (D9).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass_scale: Option<[f64; 2]>,
 }
 
 /// An implicit dynamic analysis of a model (see the module documentation).
@@ -541,12 +569,15 @@ impl DynamicAnalysis {
     /// Starts from a converged step of this analysis (a restart file's
     /// state) rather than from rest or the end of another analysis: the
     /// start keeps the state's velocities, accelerations,
-    /// pseudo-accelerations and multipliers instead of solving for
-    /// consistent ones (D9–D10), so that the steps repeat those of the
-    /// run that wrote the state. With `from` (what that run knew at the
-    /// state) the energy balance goes on and the first step is predicted
-    /// as it was there; without, work and dissipation count from the
-    /// state.
+    /// pseudo-accelerations, multipliers and internal variables instead
+    /// of solving for consistent ones (D9–D10) or locking latches and
+    /// closing stops at their limits, so that the steps repeat those of
+    /// the run that wrote the state. With `from` (what that run knew at
+    /// the state) the energy balance goes on, and the first step is
+    /// sized, predicted and its error estimated as they were there (the
+    /// step controller's memory, the regrowth after a lock, `a_{n−1}`);
+    /// without, work and dissipation count from the state and the steps
+    /// start from `time_step`.
     pub fn continued(mut self, from: Option<Continuation>) -> Self {
         self.continued = true;
         self.continuation = from;
@@ -613,7 +644,7 @@ impl DynamicAnalysis {
             watch: Watch::default(),
             a_start: vec![[0.0; 6]; model.n_nodes()],
             a_start_coordinates: vec![0.0; state.coordinates.len()],
-            last_step: self.continuation.and_then(|c| c.last_step),
+            last_step: self.continuation.as_ref().and_then(|c| c.last_step),
             a_before: Vec::new(),
             a_before_coordinates: Vec::new(),
             state,
@@ -651,9 +682,14 @@ impl DynamicAnalysis {
             error: None,
         };
 
-        // latches at their value lock, without impact (docs/joints.md §6.2)
-        impact::lock_at_start(model, &mut run.state);
-        impact::close_at_start(model, &mut run.state);
+        // latches at their value lock, without impact (docs/joints.md §6.2),
+        // and stops at a limit close; a continued run's state is a
+        // converged step whose latches and stops are as its events left
+        // them (a rebound leaves a stop open at its limit)
+        if !self.continued {
+            impact::lock_at_start(model, &mut run.state);
+            impact::close_at_start(model, &mut run.state);
+        }
         if let Some(e) = impact::beyond_limit_at_start(model, &run.state) {
             run.error = Some(e);
             self.run = Some(run);
@@ -704,7 +740,12 @@ impl DynamicAnalysis {
             };
             assembler.assemble(model, &ctx, &run.state);
         }
-        model.update_internal(&mut run.state);
+        // a continued run's internal variables are those its step was
+        // accepted with, after its events (a stop closed there takes the
+        // scale of its load at the next step, as in the run never stopped)
+        if !self.continued {
+            model.update_internal(&mut run.state);
+        }
         run.accepted.clone_from(&run.state);
         let residual = self.solver.residual().to_vec();
         run.energies = run.balance.record(model, &run.state, Some(&residual));
@@ -742,6 +783,27 @@ impl DynamicAnalysis {
                         .collect(),
                 ),
         );
+        // a continued run goes on with what the run that wrote its state
+        // knew there: the controller's next size and memory, the regrowth
+        // after a lock, a_{n−1} and the mass scales
+        if let Some(c) = self.continuation.as_ref().filter(|_| self.continued) {
+            if let (Some(memory), Some(controller)) = (&c.control, run.controller.as_mut()) {
+                controller.resume(memory);
+            }
+            run.regrowing = c.regrowing;
+            if c.previous_pseudo_acceleration.len() == model.n_nodes()
+                && c.previous_coordinate_pseudo_accelerations.len() == run.state.coordinates.len()
+            {
+                run.a_before.clone_from(&c.previous_pseudo_acceleration);
+                run.a_before_coordinates
+                    .clone_from(&c.previous_coordinate_pseudo_accelerations);
+            }
+            if let Some(scale) = c.mass_scale {
+                run.mass_scale = scale;
+            }
+        }
+        let continuation = observer.continuation(&run.accepted, &Self::continuation_of(&run));
+        let written = written.and(continuation);
         let stopped = written.is_err();
         if let Err(e) = written {
             run.error = Some(e.into());
@@ -751,6 +813,25 @@ impl DynamicAnalysis {
             Step::Stopped
         } else {
             Step::Increment(info)
+        }
+    }
+
+    /// What a run continued from the last accepted step needs besides its
+    /// state ([`Continuation`]), once the next step's size is chosen
+    /// (`None` before [`Self::start`]).
+    pub fn continuation(&self) -> Option<Continuation> {
+        self.run.as_ref().map(Self::continuation_of)
+    }
+
+    fn continuation_of(run: &Run) -> Continuation {
+        Continuation {
+            energies: run.energies,
+            last_step: run.last_step,
+            control: run.controller.as_ref().map(StepController::memory),
+            regrowing: run.regrowing,
+            previous_pseudo_acceleration: run.a_before.clone(),
+            previous_coordinate_pseudo_accelerations: run.a_before_coordinates.clone(),
+            mass_scale: Some(run.mass_scale),
         }
     }
 
@@ -776,16 +857,20 @@ impl DynamicAnalysis {
             solver: &mut self.solver,
             run,
         };
+        let before = stepper.run.accepted.time;
         let result = controller.advance(&mut stepper, observer);
         let run = stepper.run;
+        // a step accepted (reported to the observer, even if the observer
+        // then stopped the analysis), of this size
+        let step = (run.accepted.time > before).then_some(run.accepted.time - before);
         if let Some(size) = run.rebound_step.take() {
             controller.set_size(size);
         } else if std::mem::take(&mut run.closed) {
             controller.resume_after_landing();
         }
-        if let (true, Ok(Advance::Accepted(info))) = (run.regrowing, &result) {
+        if let (true, Some(step)) = (run.regrowing, step) {
             // after a lock, at most LOCK_REGROWTH times the step accepted
-            let cap = LOCK_REGROWTH * info.step;
+            let cap = LOCK_REGROWTH * step;
             if controller.size() > cap {
                 controller.set_size(cap);
             } else {
@@ -793,6 +878,21 @@ impl DynamicAnalysis {
             }
         }
         run.controller = Some(controller);
+        // the step's continuation, for restart files
+        let result = match (step, result) {
+            (Some(_), Ok(advance)) => observer
+                .continuation(&run.accepted, &Self::continuation_of(run))
+                .map(|()| advance)
+                .map_err(|e| ControlStop::Stepper(e.into())),
+            (Some(_), Err(stop)) => {
+                // the observer stopped the analysis at the step it was
+                // told of (an interruption): its continuation is still
+                // given, and the stop is the error reported
+                let _ = observer.continuation(&run.accepted, &Self::continuation_of(run));
+                Err(stop)
+            }
+            (None, result) => result,
+        };
         if !matches!(result, Ok(Advance::Accepted(_))) {
             for w in run.watch.warnings(self.settings.rho_infinity) {
                 observer.warning(&w);

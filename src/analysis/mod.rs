@@ -120,6 +120,18 @@ pub trait Observer {
     /// before that step is reported to [`Observer::increment`].
     fn energies(&mut self, _energies: &energy::Energies) {}
 
+    /// After each converged step of a dynamic analysis (and after its
+    /// start), once the size of the next step is chosen: the state and what
+    /// a run continued from it needs besides (restart files); returning an
+    /// error stops the analysis, as for [`Observer::increment`].
+    fn continuation(
+        &mut self,
+        _state: &State,
+        _continuation: &dynamics::Continuation,
+    ) -> std::io::Result<()> {
+        Ok(())
+    }
+
     /// When an increment is cut back.
     fn cutback(&mut self, _info: &CutbackInfo) {}
 

@@ -10,7 +10,7 @@
 //! (docs/results.md, "Restart files"):
 //!
 //! ```text
-//! { "format": "unfold restart", "version": 1,
+//! { "format": "unfold restart", "version": 2,
 //!   "model": { "title": "…", "fingerprint": "fnv1a64:…" },
 //!   "analysis": 1, "analysis_type": "static", "time": 0.5,
 //!   "state": { "time": 0.5, "x": [[x, y, z], …], "q": [[w, x, y, z], …], … } }
@@ -21,10 +21,16 @@
 //! pseudo-accelerations), every number written to its last bit, so a
 //! continued run repeats the arithmetic of an uninterrupted one. A file
 //! written in a dynamic analysis also has `motion`
-//! ([`crate::analysis::Continuation`]: the energy balance at that step and
-//! the size of the step that ended there); a dynamic analysis continued
-//! from a step inside it keeps the state's velocities and accelerations
-//! and goes on with these ([`crate::analysis::DynamicAnalysis::continued`]).
+//! ([`crate::analysis::Continuation`]: the energy balance at that step,
+//! the size of the step that ended there, and, since version 2, the step
+//! controller's next size and memory, the regrowth after a lock and the
+//! pseudo-accelerations of the step before), written once the next step's
+//! size is chosen ([`crate::analysis::Observer::continuation`]); a dynamic
+//! analysis continued from a step inside it keeps the state's velocities
+//! and accelerations and goes on with these
+//! ([`crate::analysis::DynamicAnalysis::continued`]). Files of version 1
+//! are still read: their `motion` has no controller's memory, and the
+//! continued run starts its steps from `time_step`.
 //! `analysis` (from 1) is the analysis of the model's sequence that was
 //! running. A restart continues that analysis from `time` when `time` is
 //! before its `end_time`, else the next one, and runs the rest of the
@@ -51,8 +57,12 @@ use crate::state::State;
 /// The `format` field of a restart file.
 pub const FORMAT: &str = "unfold restart";
 
-/// The version of the format written; files of other versions are refused.
-pub const VERSION: u32 = 1;
+/// The version of the format written. Version 1 (no step controller's
+/// memory in `motion`) is read too; other versions are refused.
+pub const VERSION: u32 = 2;
+
+/// The versions read.
+const READ_VERSIONS: [u32; 2] = [1, VERSION];
 
 /// Name of the restart file written at the end of a run.
 pub const LAST: &str = "restart.json";
@@ -251,7 +261,7 @@ impl Restart {
             analysis_type: self.analysis_type.clone(),
             time: self.state.time,
             state: self.state.clone(),
-            motion: self.motion,
+            motion: self.motion.clone(),
         };
         let err = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
         let text = serde_json::to_vec(&file).map_err(|e| err(e.into()))?;
@@ -279,13 +289,13 @@ impl Restart {
         if header.format.as_deref() != Some(FORMAT) {
             return Err(parse(format!("its \"format\" is not \"{FORMAT}\"")));
         }
-        if header.version != Some(VERSION) {
+        if !header.version.is_some_and(|v| READ_VERSIONS.contains(&v)) {
             let found = match header.version {
                 Some(v) => format!("version {v}"),
                 None => "no \"version\"".to_string(),
             };
             return Err(parse(format!(
-                "{found}; this unfold reads version {VERSION}"
+                "{found}; this unfold reads versions 1 and {VERSION}"
             )));
         }
         let file: RestartFile = serde_json::from_str(&text).map_err(|e| parse(e.to_string()))?;
@@ -362,6 +372,31 @@ impl Restart {
                 });
             }
         }
+        // a_{n−1} of `motion`: none (after a restart of the accelerations)
+        // or one per node and per coordinate
+        if let Some(m) = &self.motion {
+            for (what, expected, found) in [
+                (
+                    "node pseudo-accelerations of the step before",
+                    n,
+                    m.previous_pseudo_acceleration.len(),
+                ),
+                (
+                    "coordinate pseudo-accelerations of the step before",
+                    nc,
+                    m.previous_coordinate_pseudo_accelerations.len(),
+                ),
+            ] {
+                if found != 0 && found != expected {
+                    return Err(RestartError::Size {
+                        path,
+                        what,
+                        expected,
+                        found,
+                    });
+                }
+            }
+        }
         let analysis_error = |now: String| RestartError::Analysis {
             path: path.clone(),
             index: self.analysis + 1,
@@ -394,7 +429,7 @@ impl Restart {
             analysis,
             state: self.state.clone(),
             continues: analysis == self.analysis,
-            motion: self.motion.filter(|_| analysis == self.analysis),
+            motion: self.motion.clone().filter(|_| analysis == self.analysis),
         })
     }
 }
@@ -476,20 +511,40 @@ impl RestartWriter {
         state: &State,
         motion: Option<Continuation>,
     ) -> io::Result<()> {
+        match self.due(state.time) {
+            Some(t) => self.write_at(t, analysis, analysis_type, state, motion),
+            None => Ok(()),
+        }
+    }
+
+    /// The requested time reached (to round-off), or passed, by a
+    /// converged step at `time` since the last step, if any: its file is
+    /// then due ([`Self::write_at`]; a dynamic analysis writes it once the
+    /// size of its next step is chosen).
+    pub fn due(&mut self, time: f64) -> Option<f64> {
         let mut due = None;
         while let Some(&t) = self.times.get(self.next) {
-            if state.time < t - END_TOLERANCE * t.abs().max(1.0) {
+            if time < t - END_TOLERANCE * t.abs().max(1.0) {
                 break;
             }
             due = Some(t);
             self.next += 1;
         }
-        match due {
-            Some(t) => self
-                .restart(analysis, analysis_type, state, motion)
-                .write(&self.dir.join(format!("restart-{t}.json"))),
-            None => Ok(()),
-        }
+        due
+    }
+
+    /// Writes `restart-<t>.json`, for the requested time `t`, with
+    /// `state`, a converged step of analysis `analysis`, and `motion`.
+    pub fn write_at(
+        &self,
+        t: f64,
+        analysis: usize,
+        analysis_type: &str,
+        state: &State,
+        motion: Option<Continuation>,
+    ) -> io::Result<()> {
+        self.restart(analysis, analysis_type, state, motion)
+            .write(&self.dir.join(format!("restart-{t}.json")))
     }
 
     /// At the end of the run: writes `restart.json` with `state`, the last

@@ -536,8 +536,11 @@ pub struct Recorder {
     /// The energies of its last converged step.
     energies: Option<Energies>,
     /// What it needs besides its last converged state to go on (for
-    /// restart files).
+    /// restart files), as it reported once its next step was sized.
     motion: Option<Continuation>,
+    /// The requested restart time reached by its last converged step,
+    /// whose file is written with that continuation.
+    restart_due: Option<f64>,
     /// The latches of the model over the running analysis.
     latches: Vec<LatchWatch>,
     /// The stops and contacts over the running analysis.
@@ -876,6 +879,7 @@ impl Recorder {
         self.energy_extremes = (0.0, 0.0);
         self.energies = None;
         self.motion = None;
+        self.restart_due = None;
         self.writer.set_dynamic(self.current.kind == "dynamic");
         self.line(&format!(
             "analysis {} of {}: {} from t = {} to t = {}",
@@ -930,6 +934,7 @@ impl Recorder {
             energy_extremes: (0.0, 0.0),
             energies: None,
             motion: None,
+            restart_due: None,
             latches: Vec::new(),
             stops: Vec::new(),
             peaks: PeakLoads::of(model),
@@ -1370,7 +1375,10 @@ impl Recorder {
             let _writing = self.stop.output();
             let index = first + self.current.index;
             // the dynamic analysis that ended at `state`
-            let motion = self.motion.filter(|m| m.energies.time == state.time);
+            let motion = self
+                .motion
+                .clone()
+                .filter(|m| m.energies.time == state.time);
             if let Err(e) = restart.finish(index, self.current.kind, state, motion) {
                 output_errors.push(e);
             }
@@ -1454,6 +1462,24 @@ impl Recorder {
 }
 
 impl Observer for Recorder {
+    fn continuation(&mut self, state: &State, continuation: &Continuation) -> io::Result<()> {
+        self.motion = Some(continuation.clone());
+        let Some(t) = self.restart_due.take() else {
+            return Ok(());
+        };
+        let Some((restart, first)) = &self.restart else {
+            return Ok(());
+        };
+        let _writing = self.stop.output();
+        restart.write_at(
+            t,
+            first + self.current.index,
+            self.current.kind,
+            state,
+            Some(continuation.clone()),
+        )
+    }
+
     fn energies(&mut self, energies: &Energies) {
         let (error, kinetic) = &mut self.energy_extremes;
         *error = error.max(energies.balance_error.abs());
@@ -1522,14 +1548,6 @@ impl Observer for Recorder {
         // written already: its equilibrium there is logged, not written
         let restart =
             info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
-        if self.current.kind == "dynamic" {
-            // the step that ended here (none at the start: a restart there
-            // predicts its first step as the analysis's first)
-            self.motion = self.energies.map(|energies| Continuation {
-                energies,
-                last_step: (info.step > 0.0).then_some(info.step),
-            });
-        }
         let info = &self.renumbered(info);
         self.peaks.sample(model, state, info.increment);
         // a kinematic analysis has no loads: its residual is all constraint
@@ -1610,12 +1628,18 @@ impl Observer for Recorder {
                 self.writer.increment(info, model, state, residual)?;
             }
             if let Some((restart, first)) = &mut self.restart {
-                restart.increment(
-                    *first + self.current.index,
-                    self.current.kind,
-                    state,
-                    self.motion,
-                )?;
+                if self.current.kind == "dynamic" {
+                    // written with the step's continuation, once the next
+                    // step is sized (Observer::continuation)
+                    self.restart_due = restart.due(state.time);
+                } else {
+                    restart.increment(
+                        *first + self.current.index,
+                        self.current.kind,
+                        state,
+                        None,
+                    )?;
+                }
             }
         }
         self.log.flush_at_increment(info.output || stop.is_some())?;

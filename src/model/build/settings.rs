@@ -6,7 +6,9 @@ use super::{
 };
 use crate::analysis::control::LANDING_SNAP;
 use crate::analysis::settings::{default_max_step, DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
-use crate::analysis::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
+use crate::analysis::{
+    AnalysisSettings, DynamicSettings, ModalSettings, NewtonMethod, StaticSettings,
+};
 use crate::eigen::Method;
 use crate::model::input::{Analyses, AnalysisInput, ModelInput};
 use crate::model::{ModelErrorKind, ModelErrors};
@@ -516,6 +518,7 @@ fn dynamic_settings(
         residual_tolerance: a.residual_tolerance.unwrap_or(1e-8),
         displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
         rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
+        newton: NewtonMethod::default(),
         output_every: a.output_every.unwrap_or(1),
         output_times: a.output_times.clone().unwrap_or_default(),
         output_interval: None,

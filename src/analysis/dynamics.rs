@@ -16,7 +16,10 @@
 //! - Newton on the correction `x = h δΔq` with the iteration matrix
 //!   `S = β′M + γ′C + K T(hΔq)` (D6–D7), whose constraint rows and
 //!   multiplier columns are scaled so that it stays well conditioned as
-//!   `h → 0` (D8);
+//!   `h → 0` (D8); each iterate's residual is assembled first and `S`
+//!   only for a correction that needs new factors, which modified Newton
+//!   keeps across iterations and steps while they serve
+//!   ([`NewtonMethod`], docs/theory.md §15.1);
 //! - consistent initial accelerations and multipliers (D9), initial
 //!   velocities checked against the constraints (D10);
 //! - a local error estimate `(β − 1/6) h² (a_{n+1} − a_n)` for the step
@@ -106,7 +109,7 @@ const SHORT_STEP: f64 = 1e-8;
 /// step does not resolve, the second makes it decay as `(ωh)⁻²`.
 const FILTER_PASSES: usize = 2;
 
-/// Modified Newton (docs/theory.md §15.3) makes new factors of the
+/// Modified Newton (docs/theory.md §15.1) makes new factors of the
 /// iteration matrix at an iterate whose progress measure (the relative
 /// residual over its tolerance, or the constraint violation over its,
 /// whichever is larger) is more than this fraction of the last iterate's.
@@ -304,7 +307,7 @@ pub struct DynamicOutcome {
     /// Steps cut back after Newton failed.
     pub cutbacks: usize,
     /// Numeric factorisations of the iteration matrix (at most one per
-    /// iteration; with modified Newton, fewer: docs/theory.md §15.3).
+    /// iteration; with modified Newton, fewer: docs/theory.md §15.1).
     pub factorisations: usize,
     /// Numeric factorisations of the constrained mass system (D9, D13,
     /// D14): one per step with constraints, and one per restart.
@@ -478,7 +481,7 @@ impl Work {
 
 /// The factors of the iteration matrix `S` (D7–D8) that the Newton
 /// iterations solve with, and what they were made for: kept across
-/// iterations and steps by modified Newton (docs/theory.md §15.3), and
+/// iterations and steps by modified Newton (docs/theory.md §15.1), and
 /// used by the error estimate's filter (D11a).
 #[derive(Default)]
 struct IterationFactors {
@@ -1567,7 +1570,10 @@ fn solve_mass_system(
     state: &State,
     rhs: &mut [f64],
 ) -> Result<(), NewtonFailure> {
-    let matrix = buffers.system.as_ref().expect("formed by constrained_mass_system");
+    let matrix = buffers
+        .system
+        .as_ref()
+        .expect("formed by constrained_mass_system");
     let lu = &mut buffers.lu;
     let count = &mut buffers.factorisations;
     let solved = (|| {
@@ -2269,7 +2275,9 @@ impl Dynamics<'_> {
             factors.numbering = numbering;
         }
         let matrix = factors.matrix.as_mut().expect("set above");
-        matrix.values_mut().copy_from_slice(assembler.matrix.values());
+        matrix
+            .values_mut()
+            .copy_from_slice(assembler.matrix.values());
         if factors.lu.is_none() {
             factors.lu = Some(SparseLu::analyze(matrix)?);
         }
@@ -2591,7 +2599,7 @@ impl Dynamics<'_> {
     /// `|ê| ℓ` against `Δx`). `S` is the one the step's last correction
     /// was solved with ([`IterationFactors`]: with modified Newton made at
     /// an earlier iterate of this step or at an earlier step of the same
-    /// size, docs/theory.md §15.3), scaled (D8): its factors, and its
+    /// size, docs/theory.md §15.1), scaled (D8): its factors, and its
     /// constraint rows for the right-hand side (`−kB T` times the row
     /// scale); `M` is assembled at the converged state in the buffers of
     /// [`MassSystem`], the solver's residual and flux kept. Without

@@ -148,7 +148,7 @@ pub struct DynamicSettings {
     /// Rotation correction tolerance (radians).
     pub rotation_tolerance: f64,
     /// Whether Newton factors the iteration matrix at every iteration or
-    /// keeps its factors while they serve (docs/theory.md §15.3).
+    /// keeps its factors while they serve (docs/theory.md §15.1).
     pub newton: NewtonMethod,
     /// Results are written every this many steps.
     pub output_every: usize,
@@ -238,17 +238,17 @@ impl DynamicSettings {
 }
 
 /// How the dynamic analysis's Newton iterations use the iteration matrix
-/// `S` (docs/theory.md §15.3, model files' `[analysis] newton`).
+/// `S` (docs/theory.md §15.1, model files' `[analysis] newton`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum NewtonMethod {
     /// `S` assembled and factored at every iteration: quadratic
     /// convergence, one factorisation per iteration.
+    #[default]
     Full,
     /// The factors of `S` kept across iterations and steps while the step
     /// size, the scaling and the numbering are those they were made for and
     /// each iteration reduces the residual enough; the residual is still
     /// the true one, checked with the same tolerances.
-    #[default]
     Modified,
 }
 

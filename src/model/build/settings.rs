@@ -167,7 +167,7 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
 }
 
 /// The keys that only dynamic analyses take, and whether each is given.
-fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 7] {
+fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 8] {
     [
         ("output_interval", a.output_interval.is_some()),
         ("time_step", a.time_step.is_some()),
@@ -176,6 +176,7 @@ fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 7] {
         ("rho_infinity", a.rho_infinity.is_some()),
         ("error_tolerance", a.error_tolerance.is_some()),
         ("adaptive", a.adaptive.is_some()),
+        ("newton", a.newton.is_some()),
     ]
 }
 
@@ -518,7 +519,18 @@ fn dynamic_settings(
         residual_tolerance: a.residual_tolerance.unwrap_or(1e-8),
         displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
         rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
-        newton: NewtonMethod::default(),
+        newton: match a.newton.as_deref() {
+            Some("full") | None => NewtonMethod::Full,
+            Some("modified") => NewtonMethod::Modified,
+            Some(other) => {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!("unknown newton \"{other}\" (available: modified, full)"),
+                );
+                NewtonMethod::default()
+            }
+        },
         output_every: a.output_every.unwrap_or(1),
         output_times: a.output_times.clone().unwrap_or_default(),
         output_interval: None,

@@ -16,7 +16,10 @@
 //! - Newton on the correction `x = h δΔq` with the iteration matrix
 //!   `S = β′M + γ′C + K T(hΔq)` (D6–D7), whose constraint rows and
 //!   multiplier columns are scaled so that it stays well conditioned as
-//!   `h → 0` (D8);
+//!   `h → 0` (D8); each iterate's residual is assembled first and `S`
+//!   only for a correction that needs new factors, which modified Newton
+//!   keeps across iterations and steps while they serve
+//!   ([`NewtonMethod`], docs/theory.md §15.1);
 //! - consistent initial accelerations and multipliers (D9), initial
 //!   velocities checked against the constraints (D10);
 //! - a local error estimate `(β − 1/6) h² (a_{n+1} − a_n)` for the step
@@ -57,11 +60,11 @@ use super::control::{
 use super::energy::{Energies, EnergyBalance};
 use super::impact::{self, ContactInfo, ContactKind, LockInfo};
 use super::newton::{non_finite_origin, NewtonFailure, NewtonSolver, SINGULAR_PIVOT};
-use super::settings::DynamicSettings;
+use super::settings::{DynamicSettings, NewtonMethod};
 use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer, WarningInfo};
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
 use crate::elements::{ConstraintKind, ConstraintScaling, EvalContext, Need};
-use crate::linalg::{smallest_relative_pivot, SparseLu, SparseMatrix};
+use crate::linalg::{smallest_relative_pivot, SolveError, SparseLu, SparseMatrix};
 use crate::model::{Id, Model, Prescribed};
 use crate::so3::{self, Mat3, Vec3};
 use crate::state::State;
@@ -105,6 +108,26 @@ const SHORT_STEP: f64 = 1e-8;
 /// first cancels the growth `∝ (ωh)²` of the estimate of a vibration the
 /// step does not resolve, the second makes it decay as `(ωh)⁻²`.
 const FILTER_PASSES: usize = 2;
+
+/// Modified Newton (docs/theory.md §15.1) makes new factors of the
+/// iteration matrix at an iterate whose progress measure (the relative
+/// residual over its tolerance, or the constraint violation over its,
+/// whichever is larger) is more than this fraction of the last iterate's.
+/// An iteration with kept factors costs a residual assembly and two
+/// triangular solves, about a fifth of one that assembles and factors `S`
+/// (the pendulum of bench/peer); at a contraction of 0.1 the kept factors
+/// gain a decade of the residual per iteration, and from 1e-6 of the flux
+/// to 1e-8 (the default tolerance) they take two iterations, less than one
+/// new factorisation. Poorer contractions mean the factors are far from
+/// the tangent (a sudden load, a joint's law changing branch, a large
+/// rotation): new ones restore Newton's quadratic convergence.
+const POOR_CONTRACTION: f64 = 0.1;
+
+/// Longest wait, in steps, before factors are carried into a step again
+/// after carried factors served poorly: the waits double from one step,
+/// so that a motion where they never serve pays for a trial at most every
+/// this many steps (a residual assembly and a solve).
+const CARRY_WAIT: usize = 64;
 
 /// Initial velocities whose constraint rates exceed this fraction of the
 /// velocity scale violate the joints (D10).
@@ -283,6 +306,15 @@ pub struct DynamicOutcome {
     pub wasted_iterations: usize,
     /// Steps cut back after Newton failed.
     pub cutbacks: usize,
+    /// Numeric factorisations of the iteration matrix (at most one per
+    /// iteration; with modified Newton, fewer: docs/theory.md §15.1).
+    pub factorisations: usize,
+    /// Numeric factorisations of the constrained mass system (D9, D13,
+    /// D14): one per step with constraints, and one per restart.
+    pub mass_factorisations: usize,
+    /// Steps whose modified Newton iterations failed with kept factors and
+    /// were retried with fresh ones.
+    pub newton_retries: usize,
     /// Constraint equations removed as redundant (the most at any time).
     pub redundant_constraints: usize,
     /// Rank analyses of the constraints run again during the analysis.
@@ -393,6 +425,8 @@ struct Run {
     /// The matrices of the constrained mass system (D9, D13), and of the
     /// mass matrix of the error estimate (D11a).
     mass_system: MassSystem,
+    /// The factors of the iteration matrix and what they were made for.
+    factors: IterationFactors,
     /// The span of the analysis, `end_time − t₀` (D13).
     span: f64,
     rates: RateWork,
@@ -473,6 +507,37 @@ impl Work {
     }
 }
 
+/// The factors of the iteration matrix `S` (D7–D8) that the Newton
+/// iterations solve with, and what they were made for: kept across
+/// iterations and steps by modified Newton (docs/theory.md §15.1), and
+/// used by the error estimate's filter (D11a).
+#[derive(Default)]
+struct IterationFactors {
+    /// The LU of [`Self::matrix`], its symbolic analysis made once per
+    /// numbering.
+    lu: Option<SparseLu>,
+    /// The matrix factored, scaled (D8), on the solver's pattern.
+    matrix: Option<SparseMatrix>,
+    /// The solver's numbering of the symbolic analysis.
+    numbering: usize,
+    /// The step size and the scaling of the factors; `None` when there are
+    /// none to keep (none yet, a failed solve, a restart).
+    made_for: Option<(f64, Scale)>,
+    /// Numeric factorisations so far.
+    count: usize,
+    /// Modified Newton attempts retried with fresh factors so far.
+    retries: usize,
+    /// Steps still to start from fresh factors after carried ones served
+    /// poorly, and the wait after the next such step (doubled each time,
+    /// up to [`CARRY_WAIT`]; back to 0 when carried factors serve well).
+    carry_wait: usize,
+    carry_backoff: usize,
+    /// Iterations of the last converged step that started from new
+    /// factors: factors carried into a step serve if it converges in as
+    /// many.
+    fresh_iterations: usize,
+}
+
 /// The stiffness and the mass matrix of the constrained mass system (D9,
 /// D13), kept from one step to the next while the pattern is unchanged.
 #[derive(Default)]
@@ -494,6 +559,12 @@ struct MassSystem {
     /// The elements with multipliers, for the stiffness of the
     /// projections (D13–D14).
     constraints: Option<ConstraintRows>,
+    /// The constrained mass system's matrix (scaled), and its own LU, so
+    /// that its factorisation leaves the iteration matrix's alone.
+    system: Option<SparseMatrix>,
+    lu: Option<SparseLu>,
+    /// Numeric factorisations so far.
+    factorisations: usize,
 }
 
 /// Work space of `Φ̇` for the velocity projection (D13), kept from one
@@ -660,6 +731,7 @@ impl DynamicAnalysis {
             energies: Energies::default(),
             mass_scale: [0.0; 2],
             mass_system: MassSystem::default(),
+            factors: IterationFactors::default(),
             // a continued run (a restart within the analysis) keeps the
             // span of the analysis, as the run never stopped did
             span: (s.end_time - if self.continued { s.start_time } else { t0 }).abs(),
@@ -991,6 +1063,13 @@ impl DynamicAnalysis {
             .as_ref()
             .map_or(0.0, |r| r.started.elapsed().as_secs_f64());
         let contacts = run.as_ref().map_or(Vec::new(), |r| r.contacts.clone());
+        let factored = run.as_ref().map_or([0; 3], |r| {
+            [
+                r.factors.count,
+                r.mass_system.factorisations,
+                r.factors.retries,
+            ]
+        });
         let (state, counts, redundant, energies, error, locks) = match run {
             Some(r) => {
                 let mut counts = r.controller.map(|c| c.counts()).unwrap_or_default();
@@ -1022,6 +1101,9 @@ impl DynamicAnalysis {
             iterations: counts.iterations,
             wasted_iterations: counts.wasted_iterations,
             cutbacks: counts.cutbacks,
+            factorisations: factored[0],
+            mass_factorisations: factored[1],
+            newton_retries: factored[2],
             redundant_constraints: redundant.max(self.solver.redundant_count()),
             rank_analyses: counts.rank_analyses,
             event_retries: counts.event_retries,
@@ -1414,6 +1496,10 @@ fn constrained_mass_system(
         buffers.mass = Some(assembler.matrix.clone());
         mass_assembled = false;
     }
+    if !buffers.system.as_ref().is_some_and(same) {
+        buffers.system = Some(assembler.matrix.clone());
+        buffers.lu = None;
+    }
     let (stiffness, mass) = (
         buffers.stiffness.as_mut().expect("set above"),
         buffers.mass.as_mut().expect("set above"),
@@ -1454,6 +1540,7 @@ fn constrained_mass_system(
         light,
         held,
         s_eq,
+        system,
         ..
     } = buffers;
     kinds.clear();
@@ -1533,7 +1620,7 @@ fn constrained_mass_system(
         }
     }));
     let velocity_rows = velocity_rows.map(|(r, c)| (r, c.values()));
-    let values = assembler.matrix.values_mut();
+    let values = system.as_mut().expect("set above").values_mut();
     for col in 0..n {
         let multiplier_col = kinds[col].is_multiplier();
         for i in columns(col) {
@@ -1573,25 +1660,33 @@ impl EquationKind {
     }
 }
 
-/// Solves the constrained mass system left in the solver's matrix by
-/// [`constrained_mass_system`] for the right-hand side `rhs` (in place).
+/// Solves the constrained mass system left in `buffers` by
+/// [`constrained_mass_system`] for the right-hand side `rhs` (in place),
+/// with the LU of its own (the iteration matrix's factors are kept).
 fn solve_mass_system(
     model: &Model,
-    solver: &mut NewtonSolver,
+    solver: &NewtonSolver,
+    buffers: &mut MassSystem,
     state: &State,
     rhs: &mut [f64],
 ) -> Result<(), NewtonFailure> {
-    let (_, assembler, lu) = solver.system();
+    let matrix = buffers
+        .system
+        .as_ref()
+        .expect("formed by constrained_mass_system");
+    let lu = &mut buffers.lu;
+    let count = &mut buffers.factorisations;
     let solved = (|| {
         if lu.is_none() {
-            *lu = Some(SparseLu::analyze(&assembler.matrix)?);
+            *lu = Some(SparseLu::analyze(matrix)?);
         }
         let lu = lu.as_mut().expect("analysed above");
-        lu.factor(&assembler.matrix)?;
+        *count += 1;
+        lu.factor(matrix)?;
         lu.solve_in_place(rhs)
     })();
     if solved.is_err() || !rhs.iter().all(|v| v.is_finite()) {
-        return Err(singular(model, solver, state, 0));
+        return Err(singular(model, solver, matrix, state, 0));
     }
     Ok(())
 }
@@ -1664,7 +1759,8 @@ fn initial_accelerations(
             }
         })
         .collect();
-    solve_mass_system(model, solver, state, &mut rhs)?;
+    solve_mass_system(model, solver, &mut run.mass_system, state, &mut rhs)?;
+    let s_eq = &run.mass_system.s_eq;
     let (dofs, _, _) = solver.system();
     for (eq, z) in rhs.iter().enumerate() {
         let d = dofs.dof(eq);
@@ -1738,7 +1834,7 @@ fn project_positions(
             }
         })
         .collect();
-    solve_mass_system(model, solver, state, &mut rhs)?;
+    solve_mass_system(model, solver, &mut run.mass_system, state, &mut rhs)?;
     let dofs = &solver.dofs;
     for (eq, z) in rhs.iter_mut().enumerate() {
         if matches!(dofs.equation_kind(eq), DofKind::Multiplier(_)) {
@@ -1766,16 +1862,16 @@ fn restart_after_impact(
 
 /// The failure of a singular or nearly singular iteration matrix: the
 /// unknown without stiffness or mass.
+/// `matrix` is the one that failed to factor or solve.
 fn singular(
     model: &Model,
-    solver: &mut NewtonSolver,
+    solver: &NewtonSolver,
+    matrix: &SparseMatrix,
     state: &State,
     iteration: usize,
 ) -> NewtonFailure {
-    let (_, assembler, _) = solver.system();
-    let matrix = &assembler.matrix;
     if !(matrix.values().iter().all(|v| v.is_finite())
-        && assembler.residual.iter().all(|v| v.is_finite()))
+        && solver.residual().iter().all(|v| v.is_finite()))
     {
         return NewtonFailure::NonFinite {
             iteration,
@@ -1992,7 +2088,8 @@ impl Dynamics<'_> {
                 0.0
             }
         }));
-        solve_mass_system(model, self.solver, state, rhs)?;
+        solve_mass_system(model, self.solver, &mut run.mass_system, state, rhs)?;
+        let s_eq = &run.mass_system.s_eq;
         let dofs = &self.solver.dofs;
         // D13a: a, v̇ and λ follow δv as a Newton correction would (D6),
         // so that the next step starts from a state whose equations of
@@ -2211,42 +2308,137 @@ impl Dynamics<'_> {
     }
 
     /// One step of size `h` from the accepted state: predictor, then
-    /// Newton on `S x = −r` (D6–D8).
+    /// Newton on `S x = −r` (D6–D8) with the settings' method. A modified
+    /// Newton attempt that fails after solving with factors made at an
+    /// earlier iterate is retried from the predictor with fresh factors at
+    /// every iteration (full Newton) before the step is given up: the step
+    /// is cut back only where full Newton fails too. The iterations
+    /// reported are those of both attempts.
     fn newton(
         &mut self,
         h: f64,
         increment: usize,
         observer: &mut dyn Observer,
     ) -> Result<(usize, Vec<f64>), NewtonFailure> {
+        let scale = Scale::new(
+            &self.model.scaling,
+            self.scheme.beta_prime(h),
+            self.run.mass_scale,
+        );
+        // the factors kept hold for the same step size and scaling, in
+        // the same numbering, and not across a restart (an impact, a lock,
+        // a contact: `last_step` is cleared) nor a change of the active
+        // set ([`Stepper::update_active_set`])
+        let factors = &mut self.run.factors;
+        if factors.made_for != Some((h, scale))
+            || factors.numbering != self.solver.numbering()
+            || self.run.last_step.is_none()
+        {
+            factors.made_for = None;
+        }
+        // after factors carried into a step served poorly, the next steps
+        // start from fresh ones for a while
+        if factors.made_for.is_some() && factors.carry_wait > 0 {
+            factors.carry_wait -= 1;
+            factors.made_for = None;
+        }
+        let method = self.settings.newton;
+        match self.iterate(h, scale, 0, method, increment, observer) {
+            Err((failure, true)) if method == NewtonMethod::Modified => {
+                let spent = failure.iterations_spent() + 1;
+                self.run.factors.made_for = None;
+                self.run.factors.retries += 1;
+                self.iterate(h, scale, spent, NewtonMethod::Full, increment, observer)
+                    .map(|(iterations, residuals)| (spent + iterations, residuals))
+                    .map_err(|(failure, _)| failure)
+            }
+            other => other.map_err(|(failure, _)| failure),
+        }
+    }
+
+    /// Factors `S`, assembled unscaled in the solver's matrix, after
+    /// scaling it (D8), into the run's [`IterationFactors`], made for
+    /// `(h, scale)`.
+    fn factor_iteration_matrix(&mut self, h: f64, scale: Scale) -> Result<(), SolveError> {
+        let numbering = self.solver.numbering();
+        let run = &mut *self.run;
+        let (_, assembler, _) = self.solver.system();
+        scale.apply(&run.work, &mut assembler.matrix);
+        let factors = &mut run.factors;
+        factors.made_for = None;
+        let same = |m: &SparseMatrix| {
+            m.nnz() == assembler.matrix.nnz() && m.row_indices() == assembler.matrix.row_indices()
+        };
+        if factors.numbering != numbering || !factors.matrix.as_ref().is_some_and(same) {
+            factors.matrix = Some(assembler.matrix.clone());
+            factors.lu = None;
+            factors.numbering = numbering;
+        }
+        let matrix = factors.matrix.as_mut().expect("set above");
+        matrix
+            .values_mut()
+            .copy_from_slice(assembler.matrix.values());
+        if factors.lu.is_none() {
+            factors.lu = Some(SparseLu::analyze(matrix)?);
+        }
+        let lu = factors.lu.as_mut().expect("analysed above");
+        factors.count += 1;
+        lu.factor(matrix)?;
+        factors.made_for = Some((h, scale));
+        Ok(())
+    }
+
+    /// The iterations of [`Self::newton`] from the predictor, numbered from
+    /// `first`. Each iterate's residual (and the flux of the norms) is
+    /// assembled first; `S` is assembled and factored only for a
+    /// correction that needs new factors: at every iteration with
+    /// [`NewtonMethod::Full`]; with [`NewtonMethod::Modified`] when there
+    /// are none for this step size and scaling, or when the last
+    /// correction reduced the residual by less than [`POOR_CONTRACTION`].
+    /// A failure comes with whether a correction was solved with factors
+    /// made at an earlier iterate.
+    fn iterate(
+        &mut self,
+        h: f64,
+        scale: Scale,
+        first: usize,
+        method: NewtonMethod,
+        increment: usize,
+        observer: &mut dyn Observer,
+    ) -> Result<(usize, Vec<f64>), (NewtonFailure, bool)> {
         let model = self.model;
-        let sc = self.scheme;
         self.predict(h);
         self.run.dq_predicted.clone_from(&self.run.dq);
         self.run.watch.round_off = None;
-        let scale = Scale::new(&model.scaling, sc.beta_prime(h), self.run.mass_scale);
         let t = self.run.state.time;
         let mut residuals = Vec::new();
+        // the progress measure of each iterate: the larger of the relative
+        // residual over its tolerance and the constraint violation over its
+        let mut progress: Vec<f64> = Vec::new();
         let mut last: Option<(f64, f64)> = None;
         let free_size = model.length_scale;
         let mut x = Vec::new();
+        let mut stale_used = false;
+        let carried = method == NewtonMethod::Modified && self.run.factors.made_for.is_some();
+        // whether new factors were made in this attempt
+        let mut refreshed = false;
+        let tol = self.settings.residual_tolerance;
         for iteration in 0..=self.settings.max_iterations {
-            // assemble residual and S = β′M + γ′C + K T(hΔq)
-            {
-                let run = &mut *self.run;
-                let (dofs, assembler, _) = self.solver.system();
-                run.work.prepare(dofs, &assembler.matrix, model.n_nodes());
-                for (node, f) in run.work.factors.iter_mut().enumerate() {
-                    let dq = &run.dq[node];
-                    *f = so3::tangent(&(Vec3::new(dq[3], dq[4], dq[5]) * h));
-                }
-                let ctx = dynamic_context(model, t, &sc, h);
-                assembler.assemble_factored(model, &ctx, &run.state, &run.work.factors);
-                // the flux of the step: Σₑ |rₑ| at the predictor (v̇ = 0)
-                if iteration == 0 {
-                    let n = run.work.flux.len();
-                    run.work.flux.copy_from_slice(&assembler.flux[..n]);
-                }
-            }
+            let numbered = first + iteration;
+            // S with the residual where a correction with new factors is
+            // sure to follow (the predictor without factors kept), or
+            // expected to (full Newton whose last contraction, repeated,
+            // leaves the residual above tolerance); else the residual
+            // alone, S assembled after it if needed
+            let expected = match progress[..] {
+                [.., previous, now] if previous > 0.0 => now * now / previous,
+                _ => 0.0,
+            };
+            let with_tangent = match method {
+                NewtonMethod::Full => iteration == 0 || expected > 1.0,
+                NewtonMethod::Modified => iteration == 0 && self.run.factors.made_for.is_none(),
+            };
+            self.assemble_iterate(h, with_tangent, iteration == 0);
             let motion = self.step_motion(h);
             let (mut norms, worst) = self.norms(FLOOR_FACTOR, motion);
             if let Some((dx, dth)) = last {
@@ -2254,9 +2446,13 @@ impl Dynamics<'_> {
                 norms.rotation_correction = dth;
             }
             residuals.push(norms.relative_residual);
+            progress.push(
+                (norms.relative_residual / tol.max(f64::MIN_POSITIVE))
+                    .max(norms.residual_constraint),
+            );
             observer.iteration(&IterationInfo {
                 increment,
-                iteration,
+                iteration: numbered,
                 time: t,
                 norms,
             });
@@ -2266,12 +2462,15 @@ impl Dynamics<'_> {
                 && norms.residual_constraint.is_finite();
             if !finite {
                 self.run.location = self.solver.dof_label(model, worst);
-                return Err(NewtonFailure::NonFinite {
-                    iteration,
-                    origin: non_finite_origin(model, &self.run.state, t),
-                });
+                let origin = non_finite_origin(model, &self.run.state, t);
+                return Err((
+                    NewtonFailure::NonFinite {
+                        iteration: numbered,
+                        origin,
+                    },
+                    stale_used,
+                ));
             }
-            let tol = self.settings.residual_tolerance;
             if last.is_some() {
                 let ratio = match residuals[..] {
                     [.., previous, now] if previous > 0.0 => (now / previous).min(1.0),
@@ -2298,6 +2497,12 @@ impl Dynamics<'_> {
                         let (dx, dth) = last.unwrap_or_default();
                         self.run.watch.round_off = Some((norms.relative_residual, dx, dth));
                     }
+                    let factors = &mut self.run.factors;
+                    if !carried {
+                        factors.fresh_iterations = iteration;
+                    } else if !refreshed {
+                        factors.carry_backoff = 0;
+                    }
                     return Ok((iteration, residuals));
                 }
             }
@@ -2307,30 +2512,60 @@ impl Dynamics<'_> {
                     self.solver.dof_label(model, worst),
                     norms.relative_residual
                 );
-                return Err(NewtonFailure::MaxIterations {
-                    iterations: iteration,
-                    relative_residual: norms.relative_residual,
-                });
+                return Err((
+                    NewtonFailure::MaxIterations {
+                        iterations: numbered,
+                        relative_residual: norms.relative_residual,
+                    },
+                    stale_used,
+                ));
             }
 
-            // solve S x = −r with the constraint rows and multipliers
-            // scaled (D8)
-            let solved = {
+            // the factors for this iterate's correction: new ones unless
+            // those kept reduced the progress measure by POOR_CONTRACTION
+            // at the last correction (CARRY_CONTRACTION at the first
+            // correction of factors carried from an earlier step)
+            let contraction = match progress[..] {
+                [.., previous, now] if previous > 0.0 => now / previous,
+                _ => 0.0,
+            };
+            let refactor = match method {
+                NewtonMethod::Full => true,
+                NewtonMethod::Modified => {
+                    let factors = &mut self.run.factors;
+                    // factors carried from an earlier step that have not
+                    // converged the step in the iterations new ones took:
+                    // new ones, and the next steps wait before carrying
+                    let carried_poorly =
+                        carried && !refreshed && iteration >= factors.fresh_iterations.max(1);
+                    if carried_poorly {
+                        factors.carry_backoff = (2 * factors.carry_backoff).clamp(1, CARRY_WAIT);
+                        factors.carry_wait = factors.carry_backoff;
+                    }
+                    factors.made_for.is_none() || carried_poorly || contraction > POOR_CONTRACTION
+                }
+            };
+            // new factors of S at this iterate if needed, then S x = −r
+            // with the constraint rows and multipliers scaled (D8)
+            let mut solved = Ok(());
+            if refactor {
+                if !with_tangent {
+                    self.assemble_iterate(h, true, false);
+                }
+                solved = self.factor_iteration_matrix(h, scale);
+                refreshed = true;
+            } else {
+                stale_used = true;
+            }
+            let solved = solved.and_then(|()| {
                 let run = &mut *self.run;
-                let (dofs, assembler, lu) = self.solver.system();
-                scale.apply(&run.work, &mut assembler.matrix);
+                let (dofs, assembler, _) = self.solver.system();
                 for (eq, r) in run.work.rhs.iter_mut().enumerate() {
                     *r = -assembler.residual[dofs.dof(eq)] * scale.of(dofs.equation_kind(eq));
                 }
-                (|| {
-                    if lu.is_none() {
-                        *lu = Some(SparseLu::analyze(&assembler.matrix)?);
-                    }
-                    let lu = lu.as_mut().expect("analysed above");
-                    lu.factor(&assembler.matrix)?;
-                    lu.solve_in_place(&mut run.work.rhs)
-                })()
-            };
+                let lu = run.factors.lu.as_mut().expect("factored above or before");
+                lu.solve_in_place(&mut run.work.rhs)
+            });
             x.clone_from(&self.run.work.rhs);
             let dofs = &self.solver.dofs;
             let (mut dx, mut dth) = (0.0f64, 0.0f64);
@@ -2352,17 +2587,51 @@ impl Dynamics<'_> {
             if solved.is_err()
                 || !(dx <= RUNAWAY_CORRECTION * free_size && dth <= RUNAWAY_CORRECTION)
             {
-                let failure = singular(model, self.solver, &self.run.state, iteration);
+                // the matrix of the factors names the singular unknown
+                let run = &*self.run;
+                let failure = match &run.factors.matrix {
+                    Some(matrix) => singular(model, self.solver, matrix, &run.state, numbered),
+                    None => NewtonFailure::NonFinite {
+                        iteration: numbered,
+                        origin: "in the solution of the linear system".into(),
+                    },
+                };
                 self.run.location = match &failure {
                     NewtonFailure::Singular { dof, .. } => dof.clone(),
                     _ => self.solver.dof_label(model, worst),
                 };
-                return Err(failure);
+                self.run.factors.made_for = None;
+                return Err((failure, stale_used));
             }
             self.correct(h, &x);
             last = Some((dx, dth));
         }
         unreachable!("the loop returns at max_iterations")
+    }
+
+    /// Assembles at the current iterate the residual and the flux, with
+    /// `S = β′M + γ′C + K T(hΔq)` (D7, unscaled) if `with_tangent`; at the
+    /// predictor (`predictor`) keeps the flux of the step.
+    fn assemble_iterate(&mut self, h: f64, with_tangent: bool, predictor: bool) {
+        let model = self.model;
+        let run = &mut *self.run;
+        let (dofs, assembler, _) = self.solver.system();
+        run.work.prepare(dofs, &assembler.matrix, model.n_nodes());
+        let ctx = dynamic_context(model, run.state.time, &self.scheme, h);
+        if with_tangent {
+            for (node, f) in run.work.factors.iter_mut().enumerate() {
+                let dq = &run.dq[node];
+                *f = so3::tangent(&(Vec3::new(dq[3], dq[4], dq[5]) * h));
+            }
+            assembler.assemble_factored(model, &ctx, &run.state, &run.work.factors);
+        } else {
+            assembler.assemble(model, &ctx.with_need(Need::RESIDUAL), &run.state);
+        }
+        // the flux of the step: Σₑ |rₑ| at the predictor (v̇ = 0)
+        if predictor {
+            let n = run.work.flux.len();
+            run.work.flux.copy_from_slice(&assembler.flux[..n]);
+        }
     }
 
     /// D11: the local error estimate `e = (β − 1/6) h² (a_{n+1} − a_n)`,
@@ -2427,19 +2696,21 @@ impl Dynamics<'_> {
     /// `Δx`, `Δθ` the largest translation and rotation of the step, at
     /// least 1e-3 of the model size and 1e-3 rad; the largest over the
     /// nodes (Euclidean norms for a node without mass; a coordinate's
-    /// `|ê| ℓ` against `Δx`). `S`'s factors are those of the last
-    /// iteration (scaled, D8) and its constraint rows those of the
-    /// converged state (the solver's matrix, unscaled); `M` is assembled
-    /// at the converged state in the buffers of [`MassSystem`], the
-    /// solver's residual and flux kept. Without factors, or if a solve
-    /// fails, `ê = e`.
+    /// `|ê| ℓ` against `Δx`). `S` is the one the step's last correction
+    /// was solved with ([`IterationFactors`]: with modified Newton made at
+    /// an earlier iterate of this step or at an earlier step of the same
+    /// size, docs/theory.md §15.1), scaled (D8): its factors, and its
+    /// constraint rows for the right-hand side (`−kB T` times the row
+    /// scale); `M` is assembled at the converged state in the buffers of
+    /// [`MassSystem`], the solver's residual and flux kept. Without
+    /// factors, or if a solve fails, `ê = e`.
     fn error_estimate(&mut self, h: f64) -> f64 {
         self.local_error(h);
         let (dx, dth) = self.step_motion(h);
         let (model, sc) = (self.model, self.scheme);
         let run = &mut *self.run;
         let t = run.state.time;
-        let (dofs, assembler, lu) = self.solver.system();
+        let (dofs, assembler, _) = self.solver.system();
         let n = dofs.n_equations();
         // M at the converged state, the solver's residual and flux kept
         let work = &mut run.work;
@@ -2462,23 +2733,26 @@ impl Dynamics<'_> {
         std::mem::swap(&mut assembler.flux, &mut work.kept_flux);
 
         // D11a, applied FILTER_PASSES times: right-hand side β′ M u, and
-        // −kB T u on the constraint rows (the solver's matrix holds S
-        // unscaled), scaled by D8
-        let scale = Scale::new(&model.scaling, sc.beta_prime(h), run.mass_scale);
+        // −kB T u on the constraint rows, scaled by D8 (those of the
+        // matrix factored, scaled already)
         let bp = sc.beta_prime(h);
         work.filtered.clone_from(&work.error);
         work.product.resize(n, 0.0);
         work.spare.resize(n, 0.0);
-        let mut filtered = lu.is_some();
+        let factors = &mut run.factors;
+        let mut filtered = factors.made_for.is_some() && factors.lu.is_some();
         for _ in 0..FILTER_PASSES {
-            let Some(lu) = lu.as_mut().filter(|_| filtered) else {
+            let (Some(lu), Some(matrix)) = (
+                factors.lu.as_mut().filter(|_| filtered),
+                factors.matrix.as_ref(),
+            ) else {
                 break;
             };
             mass.mul_vec(&work.filtered, &mut work.product);
-            assembler.matrix.mul_vec(&work.filtered, &mut work.spare);
+            matrix.mul_vec(&work.filtered, &mut work.spare);
             for (eq, f) in work.product.iter_mut().enumerate() {
                 *f = match dofs.equation_kind(eq) {
-                    k @ DofKind::Multiplier(_) => work.spare[eq] * scale.of(k),
+                    DofKind::Multiplier(_) => work.spare[eq],
                     _ => bp * *f,
                 };
             }
@@ -2572,6 +2846,8 @@ impl Stepper for Dynamics<'_> {
         if !self.solver.active_set_changed(model, &run.accepted, time) {
             return Ok(false);
         }
+        // the constraints of the factors are no longer those acting
+        run.factors.made_for = None;
         let before = self.solver.redundant_count();
         let rank = self.solver.constraint_rank(model, &run.accepted, time);
         for &k in &rank.redundant {

@@ -32,7 +32,9 @@ pub use energy::{Energies, EnergyBalance};
 pub use impact::{ContactInfo, ContactKind, LatchEventKind, LockInfo};
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
-pub use settings::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
+pub use settings::{
+    AnalysisSettings, DynamicSettings, ModalSettings, NewtonMethod, StaticSettings,
+};
 pub use statics::{StaticAnalysis, StaticOutcome, Step, LIMIT_POINT_WARNING};
 
 use crate::model::Model;

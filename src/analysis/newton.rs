@@ -322,6 +322,9 @@ pub struct NewtonSolver {
     /// simplicial kernel.
     determinant: DeterminantSign,
     newton_sign: Option<f64>,
+    /// Numberings made so far: a factorisation kept outside the solver
+    /// holds while this is the one it was made in.
+    numbering: usize,
 }
 
 impl NewtonSolver {
@@ -358,6 +361,7 @@ impl NewtonSolver {
             scaling: model.scaling,
             determinant: DeterminantSign::default(),
             newton_sign: None,
+            numbering: 0,
         }
     }
 
@@ -421,6 +425,7 @@ impl NewtonSolver {
         self.dofs = DofMap::with_suppressed(model, &self.redundant);
         self.assembler = Assembler::new(model, &self.dofs);
         self.lu = None;
+        self.numbering += 1;
         self.newton_sign = None;
         self.held_entries = None;
         self.resize();
@@ -483,6 +488,13 @@ impl NewtonSolver {
     pub(crate) fn system(&mut self) -> (&DofMap, &mut Assembler, &mut Option<SparseLu>) {
         self.fresh = false;
         (&self.dofs, &mut self.assembler, &mut self.lu)
+    }
+
+    /// Which numbering of the unknowns is current: it changes whenever the
+    /// pattern is built again (a rank analysis that renumbers), so that an
+    /// analysis keeping its own factors knows they no longer apply.
+    pub(crate) fn numbering(&self) -> usize {
+        self.numbering
     }
 
     /// The assembler (its last residual, flux and matrix).

@@ -147,6 +147,9 @@ pub struct DynamicSettings {
     pub displacement_tolerance: f64,
     /// Rotation correction tolerance (radians).
     pub rotation_tolerance: f64,
+    /// Whether Newton factors the iteration matrix at every iteration or
+    /// keeps its factors while they serve (docs/theory.md §15.1).
+    pub newton: NewtonMethod,
     /// Results are written every this many steps.
     pub output_every: usize,
     /// Times the analysis lands on and writes results at, increasing.
@@ -180,6 +183,7 @@ impl DynamicSettings {
             residual_tolerance: 1e-8,
             displacement_tolerance: 1e-6,
             rotation_tolerance: 1e-6,
+            newton: NewtonMethod::default(),
             output_every: 1,
             output_times: Vec::new(),
             output_interval: None,
@@ -230,6 +234,31 @@ impl DynamicSettings {
     pub fn error_tolerance(mut self, tol: f64) -> Self {
         self.error_tolerance = tol;
         self
+    }
+}
+
+/// How the dynamic analysis's Newton iterations use the iteration matrix
+/// `S` (docs/theory.md §15.1, model files' `[analysis] newton`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NewtonMethod {
+    /// `S` assembled and factored at every iteration: quadratic
+    /// convergence, one factorisation per iteration.
+    #[default]
+    Full,
+    /// The factors of `S` kept across iterations and steps while the step
+    /// size, the scaling and the numbering are those they were made for and
+    /// each iteration reduces the residual enough; the residual is still
+    /// the true one, checked with the same tolerances.
+    Modified,
+}
+
+impl NewtonMethod {
+    /// The name used in model files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Full => "full",
+            Self::Modified => "modified",
+        }
     }
 }
 

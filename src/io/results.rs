@@ -141,6 +141,14 @@ pub struct DynamicRecord {
     pub newton_iterations: usize,
     /// Newton iterations of the rejected steps.
     pub wasted_iterations: usize,
+    /// Numeric factorisations of the iteration matrix (docs/results.md).
+    pub factorisations: usize,
+    /// Numeric factorisations of the constrained mass system of the
+    /// velocity projection and the restarts.
+    pub mass_factorisations: usize,
+    /// Steps whose modified Newton iterations were retried with fresh
+    /// factors.
+    pub newton_retries: usize,
     /// Wall-clock time, seconds.
     pub wall_time_s: f64,
     /// Energy balance error `(T + V) − (T₀ + V₀) − W + D` at the last
@@ -191,6 +199,9 @@ impl DynamicRecord {
             error_rejections: outcome.error_rejections,
             newton_iterations: outcome.iterations,
             wasted_iterations: outcome.wasted_iterations,
+            factorisations: outcome.factorisations,
+            mass_factorisations: outcome.mass_factorisations,
+            newton_retries: outcome.newton_retries,
             wall_time_s: outcome.wall_time,
             energy_balance_error: outcome.energies.balance_error,
             largest_energy_balance_error: largest_error.max(outcome.energies.balance_error.abs()),

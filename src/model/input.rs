@@ -733,6 +733,10 @@ pub struct AnalysisInput {
     /// true); `false` for fixed steps.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adaptive: Option<bool>,
+    /// Dynamics: `full` (default; the iteration matrix factored at every
+    /// iteration) or `modified` (its factors kept while they serve).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub newton: Option<String>,
     /// Modal analysis: number of modes, default 10.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub modes: Option<usize>,
@@ -780,6 +784,7 @@ impl Default for AnalysisInput {
             rho_infinity: None,
             error_tolerance: None,
             adaptive: None,
+            newton: None,
             modes: None,
             shift: None,
             frequency_range: None,

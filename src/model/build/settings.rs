@@ -6,7 +6,9 @@ use super::{
 };
 use crate::analysis::control::LANDING_SNAP;
 use crate::analysis::settings::{default_max_step, DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
-use crate::analysis::{AnalysisSettings, DynamicSettings, ModalSettings, StaticSettings};
+use crate::analysis::{
+    AnalysisSettings, DynamicSettings, ModalSettings, NewtonMethod, StaticSettings,
+};
 use crate::eigen::Method;
 use crate::model::input::{Analyses, AnalysisInput, ModelInput};
 use crate::model::{ModelErrorKind, ModelErrors};
@@ -165,7 +167,7 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
 }
 
 /// The keys that only dynamic analyses take, and whether each is given.
-fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 7] {
+fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 8] {
     [
         ("output_interval", a.output_interval.is_some()),
         ("time_step", a.time_step.is_some()),
@@ -174,6 +176,7 @@ fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 7] {
         ("rho_infinity", a.rho_infinity.is_some()),
         ("error_tolerance", a.error_tolerance.is_some()),
         ("adaptive", a.adaptive.is_some()),
+        ("newton", a.newton.is_some()),
     ]
 }
 
@@ -516,6 +519,18 @@ fn dynamic_settings(
         residual_tolerance: a.residual_tolerance.unwrap_or(1e-8),
         displacement_tolerance: a.displacement_tolerance.unwrap_or(1e-6),
         rotation_tolerance: a.rotation_tolerance.unwrap_or(1e-6),
+        newton: match a.newton.as_deref() {
+            Some("full") | None => NewtonMethod::Full,
+            Some("modified") => NewtonMethod::Modified,
+            Some(other) => {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!("unknown newton \"{other}\" (available: modified, full)"),
+                );
+                NewtonMethod::default()
+            }
+        },
         output_every: a.output_every.unwrap_or(1),
         output_times: a.output_times.clone().unwrap_or_default(),
         output_interval: None,

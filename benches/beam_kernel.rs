@@ -5,7 +5,8 @@
 //! at both nodes; and, for comparison, the residual alone.
 //!
 //! Run with `cargo bench --bench beam_kernel`; prints nanoseconds per
-//! evaluation (median of repetitions of 10,000 evaluations).
+//! evaluation (median of repetitions of 10,000 evaluations; `-- quick`
+//! for five repetitions only).
 
 #[allow(dead_code)]
 mod common;
@@ -75,7 +76,11 @@ fn time_per_evaluation(beam: &Beam, state: &State, need: Need, dynamics: bool) -
     let mut inertia = [0.0; 144];
     let mut times = Vec::new();
     let start = Instant::now();
-    while times.len() < 5 || (start.elapsed() < Duration::from_secs(2) && times.len() < 200) {
+    // `-- quick`: five repetitions (for an instruction count under callgrind)
+    let quick = std::env::args().any(|a| a == "quick");
+    while times.len() < 5
+        || (!quick && start.elapsed() < Duration::from_secs(2) && times.len() < 200)
+    {
         let t0 = Instant::now();
         for _ in 0..BATCH {
             residual.fill(0.0);

@@ -4,8 +4,10 @@
 //! steps writes a line per Newton iteration with nine such numbers, and a
 //! row of `nodes.csv` per node and output step with eleven.
 //!
-//! The digits come from the shortest decimal that reads back to the same
-//! double (the `zmij` crate: Schubfach, Giulietti 2020). Rounding those
+//! The digits come from the double scaled by an exact power of ten, the
+//! product kept exactly as the sum of two doubles (below), and otherwise
+//! from the shortest decimal that reads back to the same double (the
+//! `zmij` crate: Schubfach, Giulietti 2020). Rounding those
 //! digits to `P + 1` significant ones gives the rounding of the double
 //! itself unless the double and its shortest decimal lie on two sides of a
 //! rounding boundary; that cannot happen when the shortest decimal is
@@ -38,39 +40,56 @@ pub struct Shortest(pub f64);
 const TEXT: usize = 32;
 
 /// The digits `q` (`P + 1` of them, `10^P ≤ q < 10^(P+1)`) and the
-/// exponent of `a > 0` rounded to `P + 1` significant digits, when one
-/// floating-point product decides them: `m = a·10^(P−e)` is within
-/// `10^(P+1)·2⁻⁵³` of the exact scaled value, so its rounding to an
-/// integer is that of the exact decimal expansion unless its fraction is
-/// within 1e-6 of one half (then `None`, as for exponents beyond the exact
-/// powers of ten). Used for `P ≤ 6`, where `10^(P+1)·2⁻⁵³ < 1e-8`.
+/// exponent `e` of `a > 0` rounded to `P + 1` significant digits, when the
+/// scaled value `m = a·10^(P−e)` is found exactly enough: with an exact
+/// power of ten (`|P − e| ≤ 22`), `m` is the unevaluated sum `m₁ + m₂` of
+/// the rounded product (or quotient) and its error, found exactly by a
+/// fused multiply–add (Dekker's product; the remainder of a division), to
+/// about 2⁻¹⁰⁶ of `m`. Its rounding to an integer is that of the exact
+/// decimal expansion unless its fraction is within 1e-9 of one half (then
+/// `None`, as for exponents beyond the exact powers of ten).
 fn digits_by_product<const P: usize>(a: f64) -> Option<(u64, i32)> {
     let lo = POW10[P];
     let hi = POW10[P + 1];
-    let scaled = |e: i32| -> Option<f64> {
+    let scaled = |e: i32| -> Option<(f64, f64)> {
         let k = P as i32 - e;
         let p = *POW10.get(k.unsigned_abs() as usize)?;
-        Some(if k >= 0 { a * p } else { a / p })
+        Some(if k >= 0 {
+            let m = a * p;
+            (m, a.mul_add(p, -m))
+        } else {
+            let m = a / p;
+            (m, (-m).mul_add(p, a) / p)
+        })
     };
     let mut e = a.log10().floor() as i32;
-    let mut m = scaled(e)?;
+    let (mut m, mut err) = scaled(e)?;
     if m < lo {
         e -= 1;
-        m = scaled(e)?;
+        (m, err) = scaled(e)?;
     } else if m >= hi {
         e += 1;
-        m = scaled(e)?;
+        (m, err) = scaled(e)?;
     }
-    if !(lo..hi).contains(&m) {
+    // the exact value within [10^P, 10^(P+1))
+    if !(lo..hi).contains(&m) || (m == lo && err < 0.0) {
         return None;
     }
-    let floor = m.floor();
-    let frac = m - floor;
-    if (frac - 0.5).abs() < 1e-6 {
+    // (in integers: above 2⁵³ not every integer is a double)
+    let mut floor = m.floor() as u64;
+    let mut frac = (m - m.floor()) + err;
+    if frac < 0.0 {
+        floor -= 1;
+        frac += 1.0;
+    } else if frac >= 1.0 {
+        floor += 1;
+        frac -= 1.0;
+    }
+    if (frac - 0.5).abs() < 1e-9 {
         return None;
     }
-    let mut q = floor as u64 + u64::from(frac > 0.5);
-    if q as f64 >= hi {
+    let mut q = floor + u64::from(frac > 0.5);
+    if q >= 10u64.pow(P as u32 + 1) {
         q /= 10;
         e += 1;
     }
@@ -227,11 +246,7 @@ impl<const P: usize> Sci<P> {
         let (q, e) = if a == 0.0 {
             (0, 0)
         } else if a.is_finite() && a > 1e-300 && P <= 15 {
-            if P <= 6 {
-                digits_by_product::<P>(a)?
-            } else {
-                digits_by_shortest::<P>(a)?
-            }
+            digits_by_product::<P>(a).or_else(|| digits_by_shortest::<P>(a))?
         } else {
             return None;
         };

@@ -670,9 +670,8 @@ impl Element for Beam {
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         let k = self.current(ctx, state);
         let ops = Operators::new(&k.phi);
-        let mut kt = Mat12::zeros();
-        let need_tangent = out.stiffness.is_some();
-        let f = self.local(&k, &ops, need_tangent.then_some(&mut kt));
+        let mut kt = out.stiffness.is_some().then(Mat12::zeros);
+        let f = self.local(&k, &ops, kt.as_mut());
         let q = self.offset_matrices();
 
         // residual, rotated from section to node frames: f_Θ = Q f_α
@@ -684,8 +683,8 @@ impl Element for Beam {
             add_vec(out.residual, 6 * i, &(fx + ctx.gravity * weight));
             add_vec(out.residual, 6 * i + 3, &(q[i] * fa));
         }
-        if let Some(stiffness) = out.stiffness.as_deref_mut() {
-            add_in_node_frames(stiffness, &kt, &q);
+        if let (Some(kt), Some(stiffness)) = (&kt, out.stiffness.as_deref_mut()) {
+            add_in_node_frames(stiffness, kt, &q);
         }
 
         // Rayleigh damping, I10–I12: forces and their q-derivatives in

@@ -172,7 +172,7 @@ fn digits_by_shortest<const P: usize>(a: f64) -> Option<(u64, i32)> {
     };
     let boundary = (frac - 0.5).abs() * unit;
     let ulp = f64::from_bits(a.to_bits() + 1) - a;
-    if e - (P as i32) < -290 || !(boundary > ulp) {
+    if e - (P as i32) < -290 || boundary.is_nan() || boundary <= ulp {
         return None;
     }
     if frac > 0.5 {

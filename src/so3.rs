@@ -196,6 +196,33 @@ impl SkewSeries {
         }
     }
 
+    /// `T(ψ)` and `exp(ψ~)` at one rotation vector, with one norm and one
+    /// set of sines for both: the same as [`Self::new`] for each.
+    pub fn tangent_and_exp(psi: &Vec3) -> [Self; 2] {
+        let t = psi.norm();
+        let series = t < SERIES_ANGLE;
+        let (tangent, exp) = if series {
+            (
+                coefficients(Operator::Tangent, t, true),
+                coefficients(Operator::Exp, t, true),
+            )
+        } else {
+            let (s, c) = t.sin_cos();
+            let omc = one_minus_cos(t);
+            (
+                tangent_coefficients(t, s, omc),
+                exp_coefficients(t, s, c, omc),
+            )
+        };
+        [tangent, exp].map(|(c1, c2, d1, d2)| Self {
+            psi: *psi,
+            c1,
+            c2,
+            d1,
+            d2,
+        })
+    }
+
     /// The operator as a matrix, `I + c₁ ψ~ + c₂ ψ~²`.
     pub fn matrix(&self) -> Mat3 {
         let s = skew(&self.psi);
@@ -253,13 +280,7 @@ fn coefficients(op: Operator, t: f64, series: bool) -> (f64, f64, f64, f64) {
                 )
             } else {
                 let (s, c) = t.sin_cos();
-                let omc = 2.0 * (0.5 * t).sin().powi(2); // 1 − cos ψ
-                (
-                    s / t,
-                    omc / t2,
-                    (t * c - s) / (t2 * t),
-                    (t * s - 2.0 * omc) / (t2 * t2),
-                )
+                exp_coefficients(t, s, c, one_minus_cos(t))
             }
         }
         Operator::Tangent => {
@@ -271,14 +292,7 @@ fn coefficients(op: Operator, t: f64, series: bool) -> (f64, f64, f64, f64) {
                     poly(&TAN_C2_D, t2),
                 )
             } else {
-                let s = t.sin();
-                let omc = 2.0 * (0.5 * t).sin().powi(2);
-                (
-                    -omc / t2,
-                    (t - s) / (t2 * t),
-                    -(t * s - 2.0 * omc) / (t2 * t2),
-                    (t * omc - 3.0 * (t - s)) / (t2 * t2 * t),
-                )
+                tangent_coefficients(t, t.sin(), one_minus_cos(t))
             }
         }
         Operator::TangentInv => {
@@ -296,6 +310,38 @@ fn coefficients(op: Operator, t: f64, series: bool) -> (f64, f64, f64, f64) {
             }
         }
     }
+}
+
+/// `1 − cos ψ = 2 sin²(ψ/2)`, without the cancellation near 0.
+#[inline]
+fn one_minus_cos(t: f64) -> f64 {
+    2.0 * (0.5 * t).sin().powi(2)
+}
+
+/// The coefficients of `exp(ψ~)` (eq. 2) at `ψ = t` from `sin t`, `cos t`
+/// and `1 − cos t`.
+#[inline]
+fn exp_coefficients(t: f64, s: f64, c: f64, omc: f64) -> (f64, f64, f64, f64) {
+    let t2 = t * t;
+    (
+        s / t,
+        omc / t2,
+        (t * c - s) / (t2 * t),
+        (t * s - 2.0 * omc) / (t2 * t2),
+    )
+}
+
+/// The coefficients of `T(ψ)` (eq. 4) at `ψ = t` from `sin t` and
+/// `1 − cos t`.
+#[inline]
+fn tangent_coefficients(t: f64, s: f64, omc: f64) -> (f64, f64, f64, f64) {
+    let t2 = t * t;
+    (
+        -omc / t2,
+        (t - s) / (t2 * t),
+        -(t * s - 2.0 * omc) / (t2 * t2),
+        (t * omc - 3.0 * (t - s)) / (t2 * t2 * t),
+    )
 }
 
 /// The exponential map: the rotation `exp(ψ~)` as a unit quaternion.
@@ -408,6 +454,32 @@ pub fn rotation_between(a: &Vec3, b: &Vec3) -> Rotation {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `tangent_and_exp` gives the two operators of `new`, to the bit, on
+    /// both sides of the series angle.
+    #[test]
+    fn tangent_and_exp_equal_new() {
+        for t in [
+            0.0,
+            1e-9,
+            0.5 * SERIES_ANGLE,
+            2.0 * SERIES_ANGLE,
+            0.3,
+            1.7,
+            3.1,
+        ] {
+            let psi = Vec3::new(0.6, -0.48, 0.64) * t;
+            let [tangent, exp] = SkewSeries::tangent_and_exp(&psi);
+            for (a, op) in [(tangent, Operator::Tangent), (exp, Operator::Exp)] {
+                let b = SkewSeries::new(op, &psi);
+                assert_eq!(
+                    [a.c1, a.c2, a.d1, a.d2].map(f64::to_bits),
+                    [b.c1, b.c2, b.d1, b.d2].map(f64::to_bits),
+                    "{op:?} at {t}"
+                );
+            }
+        }
+    }
     use approx::assert_relative_eq;
     use proptest::prelude::*;
     use std::f64::consts::PI;

@@ -167,25 +167,28 @@ struct Operators {
     bphi: [Mat3; 2],
     /// `Bβᵢ`: `δβ = Bβ₁ δα₁ + Bβ₂ δα₂`.
     bbeta: [Mat3; 2],
+    /// `T⁻¹(φ)` and `Tₕ` as matrices.
+    ti_m: Mat3,
+    /// See [`Self::ti_m`].
+    th_m: Mat3,
 }
 
 impl Operators {
     fn new(phi: &Vec3) -> Self {
         // operators of the interpolation, B3
         let ti = SkewSeries::new(Operator::TangentInv, phi);
-        let th = SkewSeries::new(Operator::Tangent, &(phi * 0.5));
-        let eh = SkewSeries::new(Operator::Exp, &(phi * 0.5));
+        let [th, eh] = SkewSeries::tangent_and_exp(&(phi * 0.5));
         let (ti_m, th_m, eh_m) = (ti.matrix(), th.matrix(), eh.matrix());
         // δφ = Bφ₁ δα₁ + Bφ₂ δα₂, δβ = Bβ₁ δα₁ + Bβ₂ δα₂ (spin of Λₘ), B4
+        let th_ti = th_m * ti_m * 0.5;
         Self {
             ti,
             th,
             eh,
             bphi: [-ti_m.transpose(), ti_m],
-            bbeta: [
-                eh_m.transpose() - th_m * ti_m.transpose() * 0.5,
-                th_m * ti_m * 0.5,
-            ],
+            bbeta: [eh_m.transpose() - th_m * ti_m.transpose() * 0.5, th_ti],
+            ti_m,
+            th_m,
         }
     }
 }
@@ -308,20 +311,19 @@ impl Beam {
         }
     }
 
-    /// Local residual and tangent in the section variables
-    /// `(δx₁, δα₁, δx₂, δα₂)`, `δαᵢ = Qᵢᵀ δΘᵢ`.
-    fn local(&self, k: &Kinematics, ops: &Operators, need_tangent: bool) -> (Vec12, Option<Mat12>) {
+    /// Local residual, and tangent into `kt` if given, in the section
+    /// variables `(δx₁, δα₁, δx₂, δα₂)`, `δαᵢ = Qᵢᵀ δΘᵢ`.
+    fn local(&self, k: &Kinematics, ops: &Operators, kt: Option<&mut Mat12>) -> Vec12 {
         let c = &self.section.stiffness;
         let sigma = c * k.strain;
         let f = self.internal_forces(k, ops, &sigma);
-        if !need_tangent {
-            return (f, None);
+        if let Some(kt) = kt {
+            // material stiffness, B7, and geometric stiffness, B8
+            let b = self.strain_matrix(k, ops);
+            material_stiffness(&b, &(c * self.length), kt);
+            self.add_geometric(kt, k, ops, &sigma);
         }
-        // material stiffness, B7, and geometric stiffness, B8
-        let b = self.strain_matrix(k, ops);
-        let mut kt: Mat12 = b.transpose() * (c * b) * self.length;
-        self.add_geometric(&mut kt, k, ops, &sigma);
-        (f, Some(kt))
+        f
     }
 
     /// The forces `L₀ Bᵀ σ` of the section stresses `σ = (N, M)`, B5:
@@ -366,7 +368,7 @@ impl Beam {
         let m: Vec3 = sigma.fixed_rows::<3>(3).into();
         let h = n.cross(&k.dm);
         let (ti, th, eh) = (&ops.ti, &ops.th, &ops.eh);
-        let ti_m = ti.matrix();
+        let ti_m = ops.ti_m;
         let n_skew = skew(&n);
         let dm_skew = skew(&k.dm);
         // derivatives of Bβᵢᵀ w and Bφᵢᵀ w with respect to φ, B9
@@ -427,7 +429,8 @@ impl Beam {
     /// matrix `b` of the current state.
     fn damping_matrix(&self, b: &Mat6x12, q: &[Mat3; 2]) -> Mat12 {
         let RayleighDamping { alpha, beta } = self.section.damping;
-        let k_mat = b.transpose() * (self.section.stiffness * b) * self.length;
+        let mut k_mat = Mat12::zeros();
+        material_stiffness(b, &(self.section.stiffness * self.length), &mut k_mat);
         rayleigh_damping(
             alpha,
             beta,
@@ -504,7 +507,7 @@ impl Beam {
         let w: [Vec3; 2] = [v.fixed_rows::<3>(3).into(), v.fixed_rows::<3>(9).into()];
         let u: Vec3 = (v.fixed_rows::<3>(6) - v.fixed_rows::<3>(0)) / l0;
         let (ti, th, eh) = (&ops.ti, &ops.th, &ops.eh);
-        let th_m = th.matrix();
+        let th_m = ops.th_m;
         let beta_rate = ops.bbeta[0] * w[0] + ops.bbeta[1] * w[1];
         // ∂β̇/∂φ: Bβ₁ w = Eₕᵀ w − ½ Tₕ T⁻ᵀ w, Bβ₂ w = ½ Tₕ T⁻¹ w, with
         // Tₕ and Eₕ functions of ½φ
@@ -530,6 +533,61 @@ impl Beam {
         }
         e
     }
+}
+
+/// The material stiffness `Bᵀ (L₀C) B` (B7) into `kt`, block by block on
+/// the pattern of the strain–displacement matrix `b` (B6): strain rows
+/// `(−A, G₁, A, G₂)`, curvature rows `(0, P₁, 0, P₂)` with
+/// `A = Λₘᵀ/L₀`, `Gᵢ = g~ Bβᵢ`, `Pᵢ = Bφᵢ/L₀`. With `Y = (L₀C)[:, Γ] A` and
+/// `Zⱼ = (L₀C)[:, Γ] Gⱼ + (L₀C)[:, K] Pⱼ` (6 × 3 each), the blocks are
+/// `±Aᵀ Y_Γ`, `±Aᵀ Zⱼ_Γ` in the rows of `x`, and
+/// `∓(Gᵢᵀ Y_Γ + Pᵢᵀ Y_K)`, `Gᵢᵀ Zⱼ_Γ + Pᵢᵀ Zⱼ_K` in the rows of `α`.
+fn material_stiffness(b: &Mat6x12, cl: &SectionStiffness, kt: &mut Mat12) {
+    let a: Mat3 = b.fixed_view::<3, 3>(0, 6).into();
+    let g: [Mat3; 2] = [
+        b.fixed_view::<3, 3>(0, 3).into(),
+        b.fixed_view::<3, 3>(0, 9).into(),
+    ];
+    let p: [Mat3; 2] = [
+        b.fixed_view::<3, 3>(3, 3).into(),
+        b.fixed_view::<3, 3>(3, 9).into(),
+    ];
+    // (L₀C) in 3 × 3 blocks: strain and curvature rows and columns
+    let block = |r: usize, c: usize| -> Mat3 { cl.fixed_view::<3, 3>(r, c).into() };
+    let (c_gg, c_gk, c_kg, c_kk) = (block(0, 0), block(0, 3), block(3, 0), block(3, 3));
+    let y = [c_gg * a, c_kg * a];
+    let z = [
+        [c_gg * g[0] + c_gk * p[0], c_kg * g[0] + c_kk * p[0]],
+        [c_gg * g[1] + c_gk * p[1], c_kg * g[1] + c_kk * p[1]],
+    ];
+    let at = a.transpose();
+    let xx = at * y[0];
+    set_block(kt, 0, 0, &xx);
+    set_block(kt, 0, 6, &-xx);
+    set_block(kt, 6, 0, &-xx);
+    set_block(kt, 6, 6, &xx);
+    for j in 0..2 {
+        let cj = 6 * j + 3;
+        let xa = at * z[j][0];
+        set_block(kt, 0, cj, &-xa);
+        set_block(kt, 6, cj, &xa);
+    }
+    for i in 0..2 {
+        let ri = 6 * i + 3;
+        let (gt, pt) = (g[i].transpose(), p[i].transpose());
+        let ax = gt * y[0] + pt * y[1];
+        set_block(kt, ri, 0, &-ax);
+        set_block(kt, ri, 6, &ax);
+        for j in 0..2 {
+            let aa = gt * z[j][0] + pt * z[j][1];
+            set_block(kt, ri, 6 * j + 3, &aa);
+        }
+    }
+}
+
+#[inline]
+fn set_block(k: &mut Mat12, r: usize, c: usize, m: &Mat3) {
+    k.fixed_view_mut::<3, 3>(r, c).copy_from(m);
 }
 
 #[inline]
@@ -612,7 +670,8 @@ impl Element for Beam {
     fn evaluate(&self, ctx: &EvalContext, state: &State, out: &mut ElementOutput) {
         let k = self.current(ctx, state);
         let ops = Operators::new(&k.phi);
-        let (f, kt) = self.local(&k, &ops, out.stiffness.is_some());
+        let mut kt = out.stiffness.is_some().then(Mat12::zeros);
+        let f = self.local(&k, &ops, kt.as_mut());
         let q = self.offset_matrices();
 
         // residual, rotated from section to node frames: f_Θ = Q f_α
@@ -624,8 +683,8 @@ impl Element for Beam {
             add_vec(out.residual, 6 * i, &(fx + ctx.gravity * weight));
             add_vec(out.residual, 6 * i + 3, &(q[i] * fa));
         }
-        if let (Some(kt), Some(stiffness)) = (kt, out.stiffness.as_deref_mut()) {
-            add_in_node_frames(stiffness, &kt, &q);
+        if let (Some(kt), Some(stiffness)) = (&kt, out.stiffness.as_deref_mut()) {
+            add_in_node_frames(stiffness, kt, &q);
         }
 
         // Rayleigh damping, I10–I12: forces and their q-derivatives in

@@ -386,6 +386,8 @@ impl BeamInertia {
         let Some((d, [w_mass, w_damping])) = matrix else {
             return;
         };
+        // the 12 × 12 buffer, its length checked once
+        let d = &mut d[..144];
         for i in 0..2 {
             let jo = self.rotary[i].inertia_at_node();
             let w = v3(velocity[i], 3);

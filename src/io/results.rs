@@ -39,6 +39,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::number::{Sci, Shortest};
 use super::vtk;
 use crate::analysis::{
     AnalysisSettings, ContactKind, DynamicOutcome, Energies, IncrementInfo, LatchEventKind,
@@ -1082,15 +1083,26 @@ impl ResultWriter {
     ) {
         use std::fmt::Write as _;
         let t = info.time;
+        // `step,time,` of every row
+        let mut lead = String::new();
+        let _ = write!(lead, "{step},");
+        Sci::<12>(t).push_to(&mut lead);
+        lead.push(',');
         for &i in &self.node_order {
             let x = state.x[i];
             let u = x - model.reference_x[i];
             let q = state.q[i].quaternion();
-            let _ = writeln!(
-                self.nodes.pending,
-                "{step},{t:.12e},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.15e},{:.15e},{:.15e},{:.15e}",
-                model.node_ids[i], x.x, x.y, x.z, u.x, u.y, u.z, q.w, q.i, q.j, q.k
-            );
+            let w = &mut self.nodes.pending;
+            w.push_str(&lead);
+            let _ = write!(w, "{}", model.node_ids[i]);
+            push_values::<12>(w, &[x.x, x.y, x.z, u.x, u.y, u.z]);
+            // the quaternion to the last digit: it reads back to the same
+            // unit quaternion
+            for c in [q.w, q.i, q.j, q.k] {
+                w.push(',');
+                Shortest(c).push_to(w);
+            }
+            w.push('\n');
         }
         let ctx = model.context(t, Need::RESIDUAL);
         // the state moved along its velocities, for the rates
@@ -1109,13 +1121,13 @@ impl ResultWriter {
                 values.fill(0.0);
                 e.results(&ctx, state, values);
                 let w = &mut table.file.pending;
-                let _ = write!(w, "{step},{t:.12e},{}", e.id());
+                w.push_str(&lead);
+                let _ = write!(w, "{}", e.id());
                 for v in values.iter() {
                     // absent quantities (a joint with fewer coordinates) are empty
-                    if v.is_nan() {
-                        w.push(',');
-                    } else {
-                        let _ = write!(w, ",{v:.9e}");
+                    w.push(',');
+                    if !v.is_nan() {
+                        Sci::<9>(*v).push_to(w);
                     }
                 }
                 if table.rates > 0 {
@@ -1125,10 +1137,9 @@ impl ResultWriter {
                         None => r.fill(0.0),
                     }
                     for (v, c) in r.iter().zip(values.iter()) {
-                        if c.is_nan() {
-                            w.push(',');
-                        } else {
-                            let _ = write!(w, ",{v:.9e}");
+                        w.push(',');
+                        if !c.is_nan() {
+                            Sci::<9>(*v).push_to(w);
                         }
                     }
                 }
@@ -1147,11 +1158,12 @@ impl ResultWriter {
                 let r = so3::matrix(&state.q[i]);
                 let w = r * Vec3::new(v[3], v[4], v[5]);
                 let dw = r * Vec3::new(a[3], a[4], a[5]);
-                let _ = writeln!(
-                    m.velocities.pending,
-                    "{step},{t:.12e},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
-                    model.node_ids[i], v[0], v[1], v[2], w.x, w.y, w.z, a[0], a[1], a[2], dw.x, dw.y, dw.z
-                );
+                let out = &mut m.velocities.pending;
+                out.push_str(&lead);
+                let _ = write!(out, "{}", model.node_ids[i]);
+                push_values::<12>(out, &[v[0], v[1], v[2], w.x, w.y, w.z]);
+                push_values::<9>(out, &[a[0], a[1], a[2], dw.x, dw.y, dw.z]);
+                out.push('\n');
             }
             match (self.moving, &self.energies) {
                 (true, Some(e)) => {
@@ -1190,11 +1202,11 @@ impl ResultWriter {
                     residual[6 * i + 5],
                 );
                 let m = so3::matrix(&state.q[i]) * m_mat;
-                let _ = writeln!(
-                    file.pending,
-                    "{step},{t:.12e},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
-                    model.node_ids[i], f.x, f.y, f.z, m.x, m.y, m.z
-                );
+                let out = &mut file.pending;
+                out.push_str(&lead);
+                let _ = write!(out, "{}", model.node_ids[i]);
+                push_values::<9>(out, &[f.x, f.y, f.z, m.x, m.y, m.z]);
+                out.push('\n');
             }
         }
         let _ = writeln!(
@@ -1245,6 +1257,15 @@ impl ResultWriter {
                 Err(e)
             }
         }
+    }
+}
+
+/// Appends `,v` for every value, with `P` digits after the point
+/// (`{:.Pe}`).
+fn push_values<const P: usize>(out: &mut String, values: &[f64]) {
+    for &v in values {
+        out.push(',');
+        Sci::<P>(v).push_to(out);
     }
 }
 

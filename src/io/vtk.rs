@@ -77,7 +77,7 @@ impl Value for f64 {
     }
     fn push_text(self, out: &mut String) {
         // shortest text that reads back to the same number
-        let _ = write!(out, "{self:e}");
+        super::number::Shortest(self).push_to(out);
     }
 }
 

@@ -112,10 +112,13 @@ fn column(path: &Path, name: &str) -> Vec<f64> {
 /// spring's work in the energy balance (measured: at ρ∞ = 0.5, E
 /// unchanged in those steps, which the location of the release keeps to
 /// 4e-8 s; at ρ∞ = 0.9 at most 2.0e-3 J, 0.25 %, the others losing up to
-/// 7.7e-3 J, the ringing the long step damps); and a gravity of 1e-14 m/s², a perturbation at round-off,
-/// leaves the stop's peak load unchanged to 1e-12 relative (measured
-/// 1.5e-14 at ρ∞ = 0.5, 5.5e-15 at 0.9; at 0.9 the steps after the
-/// third closure differ, the peak, on the first swing, does not).
+/// 7.7e-3 J, the ringing the long step damps); and a gravity of
+/// 1e-14 m/s², a perturbation at round-off, leaves the stop's peak load
+/// unchanged to 1e-9 relative (measured 1.5e-14 at ρ∞ = 0.5; at 0.9
+/// 5.5e-15, and 1.7e-12 with a beam kernel whose round-off differs: at
+/// 0.9 the steps after the third closure differ, the peak, on the first
+/// swing, does not; the locks' peaks before their regrowth bound moved
+/// by tens of percent under the same perturbation, tests/latch_peaks.rs).
 #[test]
 fn the_steps_after_a_stop_closes_on_a_flexible_arm_create_no_energy() {
     let work = 0.5 * 0.2 * (3.0f64.powi(2) - 1.0);
@@ -150,7 +153,7 @@ fn the_steps_after_a_stop_closes_on_a_flexible_arm_create_no_energy() {
         }
         eprintln!("ρ∞ = {rho}: peaks {peaks:?}");
         assert!(
-            (peaks[0] - peaks[1]).abs() <= 1e-12 * peaks[0].abs(),
+            (peaks[0] - peaks[1]).abs() <= 1e-9 * peaks[0].abs(),
             "ρ∞ = {rho}: {peaks:?}"
         );
     }

@@ -137,6 +137,13 @@ const VELOCITY_TOLERANCE: f64 = 1e-6;
 /// radians, mean the iteration matrix is singular or nearly so.
 const RUNAWAY_CORRECTION: f64 = 1e6;
 
+/// A step whose linear solve fails, or whose correction runs away, after
+/// iterations that raised the force or moment residual above this times
+/// the predictor's, diverged ([`NewtonFailure::Diverged`]): the matrix is
+/// singular at an iterate far from the motion, which says nothing of the
+/// structure's supports.
+const DIVERGED_GROWTH: f64 = 1e3;
+
 /// Largest rotation of a node in one converged step, in radians: the
 /// incremental rotation vector `h |Δq_θ|` or the turn at the end
 /// velocity `h |Ω_{n+1}|`. A rotation vector of `2π` is the identity:
@@ -2412,6 +2419,9 @@ impl Dynamics<'_> {
         self.run.watch.round_off = None;
         let t = self.run.state.time;
         let mut residuals = Vec::new();
+        // |r_F|, |r_M| of each iterate, whose growth from the predictor's
+        // tells a divergence
+        let mut forces: Vec<[f64; 2]> = Vec::new();
         // the progress measure of each iterate: the larger of the relative
         // residual over its tolerance and the constraint violation over its
         let mut progress: Vec<f64> = Vec::new();
@@ -2446,6 +2456,7 @@ impl Dynamics<'_> {
                 norms.rotation_correction = dth;
             }
             residuals.push(norms.relative_residual);
+            forces.push([norms.residual_force, norms.residual_moment]);
             progress.push(
                 (norms.relative_residual / tol.max(f64::MIN_POSITIVE))
                     .max(norms.residual_constraint),
@@ -2595,6 +2606,37 @@ impl Dynamics<'_> {
                         iteration: numbered,
                         origin: "in the solution of the linear system".into(),
                     },
+                };
+                // after iterations that drove the residual up, a singular
+                // matrix or a runaway correction is the divergence's
+                // doing, not a mechanism's
+                let growth = match (forces.first(), forces.last()) {
+                    (Some(a), Some(b)) => (0..2)
+                        .filter(|&k| a[k] > 0.0)
+                        .map(|k| b[k] / a[k])
+                        .fold(0.0f64, f64::max),
+                    _ => 0.0,
+                };
+                let failure = match forces.first().zip(forces.last()) {
+                    Some((from, to)) if numbered > 0 && growth > DIVERGED_GROWTH => {
+                        let (from, to) = (from[0].max(from[1]), to[0].max(to[1]));
+                        let what = match &failure {
+                            NewtonFailure::Singular { dof, .. } => {
+                                format!("the iteration matrix singular there, at {dof}")
+                            }
+                            _ if solved.is_ok() => format!(
+                                "a correction of {dx:.1e} in translation, {dth:.1e} rad in rotation"
+                            ),
+                            other => other.to_string(),
+                        };
+                        NewtonFailure::Diverged {
+                            iteration: numbered,
+                            from,
+                            to,
+                            what,
+                        }
+                    }
+                    _ => failure,
                 };
                 self.run.location = match &failure {
                     NewtonFailure::Singular { dof, .. } => dof.clone(),

@@ -184,6 +184,23 @@ pub enum NewtonFailure {
         /// Relative residual then.
         relative_residual: f64,
     },
+    /// Dynamics: the iterations moved away from the solution (the
+    /// residual grew from the predictor's) until the iteration matrix
+    /// could not be solved or the correction ran away: the step is too
+    /// long for the motion, not a sign of a mechanism.
+    #[error("Newton diverged: the residual grew from {from:.1e} to {to:.1e} in {iteration} iterations ({what}); the step is too long for the motion there")]
+    Diverged {
+        /// Iteration at which it stopped.
+        iteration: usize,
+        /// The larger of the force and moment residuals (N, N·m) at the
+        /// predictor.
+        from: f64,
+        /// The same at the last iterate.
+        to: f64,
+        /// What stopped it: a singular iteration matrix at the diverged
+        /// iterate (naming the unknown), a runaway correction.
+        what: String,
+    },
     /// NaN or infinite values appeared.
     #[error("non-finite values at iteration {iteration} {origin}")]
     NonFinite {
@@ -243,6 +260,7 @@ impl NewtonFailure {
                 *iterations
             }
             Self::Diverging { iteration, .. }
+            | Self::Diverged { iteration, .. }
             | Self::NonFinite { iteration, .. }
             | Self::NoArcRoot { iteration }
             | Self::PathReversed { iteration } => *iteration,

@@ -632,6 +632,9 @@ fn a_latch_spring_the_steps_do_not_resolve_is_warned_of() {
     let s = summary(&fine);
     let warnings = s["warnings"].to_string();
     assert!(!warnings.contains("do not resolve"), "{warnings}");
+    // a load −f of f = 0 (in the band) is written 0, not −0
+    let latches = std::fs::read_to_string(fine.join("latches.csv")).unwrap();
+    assert!(latches.contains(",0.000000000e0") && !latches.contains("-0.000000000e0"));
     let peak = s["latches"][0]["peak_load"].as_f64().unwrap();
     // the first contact from the rate at the first engage: a half-sine of
     // amplitude ċ√(J k_L) (the torsion spring's 1 N·m/rad beside

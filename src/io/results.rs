@@ -1126,8 +1126,9 @@ impl ResultWriter {
                 for v in values.iter() {
                     // absent quantities (a joint with fewer coordinates) are empty
                     w.push(',');
+                    // + 0.0: a load −f of f = 0 is written 0, not −0
                     if !v.is_nan() {
-                        Sci::<9>(*v).push_to(w);
+                        Sci::<9>(*v + 0.0).push_to(w);
                     }
                 }
                 if table.rates > 0 {
@@ -1139,7 +1140,7 @@ impl ResultWriter {
                     for (v, c) in r.iter().zip(values.iter()) {
                         w.push(',');
                         if !c.is_nan() {
-                            Sci::<9>(*v).push_to(w);
+                            Sci::<9>(*v + 0.0).push_to(w);
                         }
                     }
                 }

@@ -1582,17 +1582,27 @@ impl Observer for Recorder {
         text.clear();
         let _ = write!(
             text,
-            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  {what}{}: ",
+            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  ",
             info.increment,
             info.time,
             Sci::<3>(info.step),
             info.iterations,
-            if stopped {
-                " (stopped at round-off)"
-            } else {
-                ""
-            },
         );
+        if values.is_empty() {
+            // the start of a dynamic analysis: its state, no equations
+            // solved for a step
+            text.push_str("(the initial state)");
+        } else {
+            let _ = write!(
+                text,
+                "{what}{}: ",
+                if stopped {
+                    " (stopped at round-off)"
+                } else {
+                    ""
+                }
+            );
+        }
         for (k, r) in values.iter().enumerate() {
             let sep = if k == 0 { "" } else { " " };
             // the report of the iteration that gave this residual (the

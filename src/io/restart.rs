@@ -174,12 +174,16 @@ pub enum RestartError {
         now: String,
     },
     /// Nothing is left to run after the restart time.
-    #[error("{path}: the restart is at the end of the last analysis (t = {time}): nothing is left to run; raise its end_time or add an analysis")]
+    #[error("{path}: the restart (t = {time}) is {where_} the end of the last analysis (end_time = {end}): nothing is left to run; raise its end_time above {time} or add an analysis")]
     Finished {
         /// The file.
         path: PathBuf,
         /// Time of the restart.
         time: f64,
+        /// The last analysis's end time.
+        end: f64,
+        /// `at` or `past`.
+        where_: &'static str,
     },
 }
 
@@ -423,7 +427,18 @@ impl Restart {
             self.analysis + 1
         };
         if analysis >= plan.len() {
-            return Err(RestartError::Finished { path, time: s.time });
+            let end = plan.last().map_or(end, |a| a.end_time());
+            let where_ = if s.time > end + END_TOLERANCE * end.abs().max(1.0) {
+                "past"
+            } else {
+                "at"
+            };
+            return Err(RestartError::Finished {
+                path,
+                time: s.time,
+                end,
+                where_,
+            });
         }
         Ok(Resume {
             analysis,

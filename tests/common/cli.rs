@@ -1,6 +1,5 @@
 //! Runs of the command line on a model text and readers of the result
-//! files (tests/user_trial.rs, tests/latch_records.rs,
-//! tests/latch_peaks.rs).
+//! files, shared by the command-line tests.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -51,6 +50,13 @@ pub fn csv_rows(path: &Path) -> Vec<HashMap<String, String>> {
         .collect();
     lines
         .map(|l| {
+            // every row has the header's columns
+            assert_eq!(
+                l.split(',').count(),
+                header.len(),
+                "{}: {l}",
+                path.display()
+            );
             header
                 .iter()
                 .cloned()
@@ -62,7 +68,9 @@ pub fn csv_rows(path: &Path) -> Vec<HashMap<String, String>> {
 
 /// The number in column `column` of a row of [`csv_rows`].
 pub fn number(row: &HashMap<String, String>, column: &str) -> f64 {
-    row[column].parse().unwrap()
+    row[column]
+        .parse()
+        .unwrap_or_else(|_| panic!("{column} = {:?}", row[column]))
 }
 
 /// `summary.json` of the results in `out`.

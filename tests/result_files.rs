@@ -5,6 +5,7 @@
 //! the PVD collection, summary.json, and an output directory that holds
 //! one run only.
 
+mod common;
 mod vtk_reader;
 
 use std::path::{Path, PathBuf};
@@ -24,17 +25,7 @@ fn run_example_into(name: &str, tag: &str) -> PathBuf {
         .join(name);
     let out = std::env::temp_dir().join(format!("unfold-results-{}-{tag}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let status = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .args([
-            "run",
-            model.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ])
-        .status()
-        .unwrap();
-    assert!(status.success());
+    common::cli::run_model(&model, &out);
     out
 }
 

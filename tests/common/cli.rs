@@ -19,6 +19,13 @@ pub fn run_text(dir: &Path, text: &str) -> (PathBuf, Output) {
     let model = dir.join("model.toml");
     std::fs::write(&model, text).unwrap();
     let out = dir.join("out");
+    let o = run_model(&model, &out);
+    (out, o)
+}
+
+/// Runs `unfold run --quiet` on the model file `model` into `out`, which
+/// must end with exit code 0.
+pub fn run_model(model: &Path, out: &Path) -> Output {
     let o = Command::new(env!("CARGO_BIN_EXE_unfold"))
         .args([
             "run",
@@ -35,7 +42,7 @@ pub fn run_text(dir: &Path, text: &str) -> (PathBuf, Output) {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    (out, o)
+    o
 }
 
 /// The rows of a CSV file as maps from column name to text.

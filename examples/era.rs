@@ -409,7 +409,9 @@ fn main() -> Result<(), Box<dyn Error>> {
             }
         },
     };
-    let report = run(structure, &gravities, &out, true)?;
+    let report = unfold::assembly::on_worker_thread(|| {
+        run(structure, &gravities, &out, true).map_err(|e| e.to_string())
+    })?;
     if report.deployments.iter().any(|d| !d.completed) {
         std::process::exit(1);
     }

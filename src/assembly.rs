@@ -518,6 +518,26 @@ impl<'a> Layout<'a> {
 /// pool's only worker costs two context switches).
 const SEQUENTIAL_CHUNK: usize = 256;
 
+/// Runs `f` on a worker thread of rayon's global pool (at once when the
+/// pool has one thread or the caller is one of its workers), so that the
+/// parallel sections of the assembly and the factorisation fork from a
+/// worker. Forked from a thread outside the pool, each section is handed
+/// to the pool while the caller sleeps on a lock until it is done: two
+/// context switches per section, several per Newton iteration. Measured
+/// with `unfold run` on the flexible pendulum of bench/peer (320 beams,
+/// 400 steps, 2 threads on the 2 cores, three runs each): 2.22–2.29 s
+/// forked from the main thread, 1.96–1.97 s from a worker, 2.11–2.18 s on
+/// one thread; the heavy top and the 20-beam pendulum, which have no
+/// parallel section, the same either way. Programs driving an analysis
+/// call their whole run through it (`unfold run`, the examples).
+pub fn on_worker_thread<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    if rayon::current_num_threads() == 1 || rayon::current_thread_index().is_some() {
+        f()
+    } else {
+        rayon::scope(|_| f())
+    }
+}
+
 /// Evaluates `elements` into `buffer` (stiffness and residual) and
 /// `inertia` (when asked), whose layouts `layout` gives, splitting the work
 /// recursively over rayon tasks; applies `factors` to the rotation columns

@@ -43,6 +43,7 @@ use unfold::analysis::{
     AnalysisSettings, DynamicAnalysis, DynamicError, DynamicSettings, IncrementInfo, ModalAnalysis,
     ModalError, ModalOutcome, ModalSettings, NewtonFailure, StaticAnalysis,
 };
+use unfold::assembly::on_worker_thread;
 use unfold::io::histories::{Format, Group, Histories, HistoryError, Request, UnitLabels};
 use unfold::io::model_file::read_model;
 use unfold::io::restart::{fingerprint, Restart, RestartError, RestartWriter, Resume};
@@ -268,7 +269,8 @@ fn main() -> ExitCode {
             } else {
                 Encoding::Binary
             };
-            run(&model, &out, quiet, encoding, restart.as_deref())
+            // on a worker of the thread pool (unfold::assembly::on_worker_thread)
+            on_worker_thread(|| run(&model, &out, quiet, encoding, restart.as_deref()))
         }
     }
 }

@@ -102,7 +102,7 @@ fn main() -> ExitCode {
         eprintln!("error: thread pool: {e}");
         return ExitCode::from(2);
     }
-    match run(&args) {
+    match unfold::assembly::on_worker_thread(|| run(&args)) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {

@@ -8,7 +8,7 @@
 use super::latch::SpringLatch;
 use super::types::{Coordinate, JointParameters, SliderCurve};
 use super::*;
-use crate::elements::testing::{eval, rate_errors, tangent_error};
+use crate::elements::testing::{eval, rate_errors, scaled_tangent_error, tangent_error};
 use crate::elements::{ConstraintScaling, Element, EvalContext};
 use crate::so3::{self, Mat3, Rotation, Vec3};
 use crate::state::State;
@@ -109,6 +109,16 @@ fn joint_tangents_match_finite_differences() {
                 let nn = if grounded { 1 } else { 2 };
                 let s = moved(&mut rng, &x[..nn], &q[..nn], &j);
                 let err = tangent_error(&j, &ctx(), &s, 1e-6);
+                // entry by entry too, against the scale of its row and
+                // column (measured at most 1.5e-9): the multiplier rows
+                // and the geometric terms λ ∂B/∂q are far smaller than
+                // the penalty p BᵀB
+                let scaled = scaled_tangent_error(&j, &ctx(), &s, 1e-6);
+                assert!(
+                    scaled < 1e-6,
+                    "{} (grounded {grounded}): entry-wise tangent error {scaled:.3e}",
+                    t.name()
+                );
                 worst = worst.max(err);
                 assert!(
                     err < 1e-6,

@@ -2,8 +2,8 @@
 //!
 //! ```text
 //! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii] [--restart FILE]
-//! unfold check MODEL.toml
-//! unfold plot RESULTS_DIR [joints|moments|energies ...] [--joint ID ...] [--format png|svg|both]
+//! unfold check MODEL.toml [--threads N]
+//! unfold plot RESULTS_DIR [joints|moments|energies|hinge_laws ...] [--joint ID ...] [--format png|svg|both]
 //!             [--out DIR] [--degrees] [--units si|model] [--model MODEL.toml]
 //! ```
 //! `unfold plot` draws the time histories of a run from its result files
@@ -111,14 +111,18 @@ enum Command {
     Check {
         /// Model file.
         model: PathBuf,
+        /// Worker threads for the factorisation of the checks (default:
+        /// every core), as for `run`.
+        #[arg(long)]
+        threads: Option<usize>,
     },
     /// Draw the time histories of a run from its result files: joint
     /// coordinates, moments along them, energies (docs/plots.md).
     Plot {
         /// Results directory of a run (`unfold run MODEL --out DIR`).
         results: PathBuf,
-        /// Charts to draw: `joints`, `moments`, `energies` (default: every
-        /// one the results allow).
+        /// Charts to draw: `joints`, `moments`, `energies`, `hinge_laws`
+        /// (default: every one the results allow).
         #[arg(value_name = "WHAT")]
         what: Vec<String>,
         /// Only the joint and moment charts of this joint (repeatable).
@@ -168,7 +172,10 @@ const EXIT_INPUT: u8 = 2;
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Check { model } => check(&model),
+        Command::Check { model, threads } => match thread_pool(threads) {
+            Ok(()) => check(&model),
+            Err(code) => code,
+        },
         Command::Plot {
             results,
             what,
@@ -215,24 +222,8 @@ fn main() -> ExitCode {
             vtk_ascii,
             restart,
         } => {
-            if let Some(n) = threads {
-                if n == 0 {
-                    eprintln!(
-                        "error: --threads 0: give at least 1 (or leave it out to use every core)"
-                    );
-                    return ExitCode::from(EXIT_INPUT);
-                }
-                let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
-                if n > cores {
-                    eprintln!("warning: --threads {n}: more threads than the {cores} cores available, which only slows the run down");
-                }
-                if let Err(e) = rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build_global()
-                {
-                    eprintln!("error: --threads: {e}");
-                    return ExitCode::from(EXIT_INPUT);
-                }
+            if let Err(code) = thread_pool(threads) {
+                return code;
             }
             let out = out.unwrap_or_else(|| {
                 let stem = model
@@ -273,6 +264,29 @@ fn main() -> ExitCode {
             on_worker_thread(|| run(&model, &out, quiet, encoding, restart.as_deref()))
         }
     }
+}
+
+/// The global thread pool with `threads` workers (`--threads`; rayon's
+/// default, one per core, when not given).
+fn thread_pool(threads: Option<usize>) -> Result<(), ExitCode> {
+    let Some(n) = threads else {
+        return Ok(());
+    };
+    if n == 0 {
+        eprintln!("error: --threads 0: give at least 1 (or leave it out to use every core)");
+        return Err(ExitCode::from(EXIT_INPUT));
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    if n > cores {
+        eprintln!("warning: --threads {n}: more threads than the {cores} cores available, which only slows the run down");
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build_global()
+        .map_err(|e| {
+            eprintln!("error: --threads: {e}");
+            ExitCode::from(EXIT_INPUT)
+        })
 }
 
 /// Whether the restart file `restart` lies in the output directory `out`

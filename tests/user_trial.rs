@@ -432,3 +432,84 @@ free_value = 3.5
         "{log}"
     );
 }
+
+/// `unfold check` on `text` (written as `model.toml` in a scratch
+/// directory) with `args`: exit code and stderr.
+fn check(name: &str, text: &str, args: &[&str]) -> (Option<i32>, String) {
+    let model = scratch(name).join("model.toml");
+    std::fs::write(&model, text).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .arg("check")
+        .arg(&model)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// A one-beam cantilever with the analysis `analysis`.
+fn cantilever(analysis: &str) -> String {
+    format!(
+        "{analysis}
+[[sections]]
+name = \"s\"
+EA = 1e6
+GA2 = 1e6
+GA3 = 1e6
+GJ = 10.0
+EI2 = 10.0
+EI3 = 10.0
+mass_per_length = 1.0
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 2
+x = [1.0, 0.0, 0.0]
+
+[[beams]]
+id = 1
+nodes = [1, 2]
+section = \"s\"
+orientation = [0.0, 0.0, 1.0]
+
+[[supports]]
+node = 1
+fixed = [\"all\"]
+"
+    )
+}
+
+/// The messages a new user met for slips in the analysis block: a typo
+/// in the type is reported as an unknown type, not first as dynamic keys
+/// in a static analysis; a time step above `max_step` names that bound
+/// alone, without the default `min_step` the user never gave; and
+/// `check` takes `--threads` as `run` does (exit 0 on a valid model).
+#[test]
+fn slips_in_the_analysis_block_are_named_for_what_they_are() {
+    let typo = cantilever("[analysis]\ntype = \"dynamics\"\nend_time = 1.0\ntime_step = 0.01\n");
+    let (code, err) = check("type-typo", &typo, &[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("unknown analysis type \"dynamics\""), "{err}");
+    assert!(!err.contains("belongs to dynamic analyses"), "{err}");
+
+    let long = cantilever(
+        "[analysis]\ntype = \"dynamic\"\nend_time = 2.5\ntime_step = 5.0\nmax_step = 0.02\n",
+    );
+    let (code, err) = check("step-above-max", &long, &[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("time_step (5) must not exceed max_step (0.02)"),
+        "{err}"
+    );
+    assert!(!err.contains("min_step"), "{err}");
+
+    let fine = cantilever("[analysis]\ntype = \"dynamic\"\nend_time = 0.1\ntime_step = 0.01\n");
+    let (code, err) = check("threads", &fine, &["--threads", "1"]);
+    assert_eq!(code, Some(0), "{err}");
+}

@@ -149,8 +149,12 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
         let s = if a.kind == "dynamic" {
             AnalysisSettings::Dynamic(dynamic_settings(ck, &entity, a, start))
         } else {
+            // keys of dynamic analyses in a static one (an unknown type
+            // is reported by `settings` alone: a typo such as "dynamics"
+            // would otherwise first be told to take the static keys)
+            let known = matches!(a.kind.as_str(), "static" | "kinetostatic" | "kinematic");
             for (key, given) in dynamic_keys(a) {
-                if given {
+                if given && known {
                     ck.push(
                         ModelErrorKind::Invalid,
                         &entity,
@@ -570,15 +574,24 @@ fn dynamic_settings(
                 num(s.max_step)
             ),
         );
-    } else if steps_ok && !(s.min_step <= s.time_step && s.time_step <= s.max_step) {
+    } else if steps_ok && s.time_step > s.max_step {
         ck.push(
             ModelErrorKind::Invalid,
             entity,
             format!(
-                "time steps must satisfy min_step ≤ time_step ≤ max_step, got {} ≤ {} ≤ {}",
-                num(s.min_step),
+                "time_step ({}) must not exceed max_step ({})",
                 num(s.time_step),
                 num(s.max_step)
+            ),
+        );
+    } else if steps_ok && s.time_step < s.min_step {
+        ck.push(
+            ModelErrorKind::Invalid,
+            entity,
+            format!(
+                "time_step ({}) must not be below min_step ({})",
+                num(s.time_step),
+                num(s.min_step)
             ),
         );
     }

@@ -10,7 +10,7 @@
 //! else does work, so the kinetic energy can never exceed `W` (plus the
 //! integration's error, which the energy balance measures). The plastic
 //! stop holds the hinge's light node (the root section's rotary inertia,
-//! 1.1e-7 kg·m²): its impact dissipates little (1.3e-4 to 1.5e-4 J), the
+//! 1.1e-7 kg·m²): its impact dissipates little (1.0e-4 to 1.5e-4 J), the
 //! bent arm unloads, the stop's load falls to zero and the arm leaves the
 //! stop with nearly all of `W`, swings back close to its start and
 //! returns (four arrivals in 0.5 s).

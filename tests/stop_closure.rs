@@ -9,10 +9,10 @@
 //! and opened from rest by a torsion spring of 0.2 N·m/rad unloaded at
 //! 3 rad: work `E = ½ k (3² − 1²) = 0.8 J` up to 2 rad), stopped at 2 rad
 //! by a plastic stop (`e = 0`) on its hinge instead of a latch. The stop
-//! holds the hinge's node, the arm bends on, the stop's load swings and
-//! the stop releases and closes again as the light hinge node rattles
-//! against it. Fixed steps of 0.01 s (those of the ERA platform), to
-//! 0.1 s.
+//! holds the hinge's node, the arm bends on, the stop's load swings
+//! back to zero as the bent arm unloads, and the stop releases there
+//! (docs/theory.md §16.4). Fixed steps of 0.01 s (those of the ERA
+//! platform), to 0.1 s.
 
 mod common;
 
@@ -111,14 +111,12 @@ fn column(path: &Path, name: &str) -> Vec<f64> {
 /// after a landing step of 2.4e-10 s) creates at most 0.5 % of the
 /// spring's work in the energy balance (measured: at ρ∞ = 0.5, E
 /// unchanged in those steps, which the location of the release keeps to
-/// 4e-8 s; at ρ∞ = 0.9 at most 2.0e-3 J, 0.25 %, the others losing up to
+/// 4e-8 s; at ρ∞ = 0.9, one closure to 0.1 s, the step after it losing
 /// 7.7e-3 J, the ringing the long step damps); and a gravity of
 /// 1e-14 m/s², a perturbation at round-off, leaves the stop's peak load
-/// unchanged to 1e-9 relative (measured 1.5e-14 at ρ∞ = 0.5; at 0.9
-/// 5.5e-15, and 1.7e-12 with a beam kernel whose round-off differs: at
-/// 0.9 the steps after the third closure differ, the peak, on the first
-/// swing, does not; the locks' peaks before their regrowth bound moved
-/// by tens of percent under the same perturbation, tests/latch_peaks.rs).
+/// unchanged to 1e-9 relative (measured 2.0e-14 at ρ∞ = 0.5 and 1.7e-12
+/// at 0.9; the locks' peaks before their regrowth bound moved by tens of
+/// percent under the same perturbation, tests/latch_peaks.rs).
 #[test]
 fn the_steps_after_a_stop_closes_on_a_flexible_arm_create_no_energy() {
     let work = 0.5 * 0.2 * (3.0f64.powi(2) - 1.0);
@@ -133,7 +131,9 @@ fn the_steps_after_a_stop_closes_on_a_flexible_arm_create_no_energy() {
                 .filter(|e| e["kind"] == "contact")
                 .map(|e| e["step"].parse().unwrap())
                 .collect();
-            assert!(closures.len() >= 2, "{rho} {name}: {closures:?}");
+            // at least the arrival (at ρ∞ = 0.5 the hinge node is struck
+            // once more as the arm leaves; at 0.9 the release leaves at once)
+            assert!(!closures.is_empty(), "{rho} {name}: {closures:?}");
             for &k in &closures {
                 let Some(after) = balance.get(k + 1) else {
                     continue;

@@ -3085,6 +3085,11 @@ impl Dynamics<'_> {
         run.balance.impact(i.energy_lost, i.work);
         run.rebound_step = i.rebound_step;
         run.closed = i.events.iter().any(|c| c.kind == ContactKind::Close);
+        // after a release the steps grow back from the landing step, as
+        // after a lock (docs/theory.md §16.4, "Resuming after a release")
+        if i.events.iter().any(|c| c.kind == ContactKind::Release) {
+            run.regrowing = true;
+        }
         Ok(i.events)
     }
 }

@@ -760,11 +760,26 @@ pub fn gap_tolerance(model: &Model, stop: &Stop) -> f64 {
     }
 }
 
-/// `|N|` at or below which a closed stop's load counts as zero.
+/// `|N|` at or below which a closed stop's load counts as zero:
+/// `N_tol = 1e-6 max(N_max, |N|, 1e-12 k)` (docs/theory.md §16.4,
+/// "Releases located on the load"), `N_max` the largest load carried
+/// since it closed. `|N|` is in it so that the event function
+/// `w = N/N_tol` keeps one scale over the step that first carries a load:
+/// `N_max` is 0 at the state that closed the stop and becomes `|N|` when
+/// the step after it is accepted, and with `N_tol` from `N_max` alone `w`
+/// went from 4.5e15 (`N` = 47 N·m against `N_tol` = 1.0e-14 N·m) to
+/// −1.8e6 over the next step of the arm of tests/stop_rest.rs: the regula
+/// falsi never located the fall of `N` to zero, and the release was taken
+/// after 30 retries where the stop pulled by 86 N·m.
 fn load_tolerance(model: &Model, stop: &Stop, state: &State) -> f64 {
     let ctx = model.context(state.time, Need::RESIDUAL);
     let k = stop.scaling(&ctx).0;
-    RELEASE_TOLERANCE * stop.load_scale(state).max(NEGLIGIBLE_LOAD * k)
+    let load = if stop.contact(state) == Contact::Open {
+        0.0
+    } else {
+        stop.load(&ctx, state).abs()
+    };
+    RELEASE_TOLERANCE * stop.load_scale(state).max(load).max(NEGLIGIBLE_LOAD * k)
 }
 
 /// The stop's watched quantity relative to its tolerance, `w`: the gap
@@ -868,7 +883,10 @@ fn stop_failure(model: &Model, stops: &[&Stop], time: f64, why: Singular) -> Dyn
 ///   event band from `g_tol` away: above it the impact has restitution
 ///   `e`, `B Δv = −(1 + e) ċ⁻`, and the stop stays open; at or below it the
 ///   impact is plastic, `B Δv = −ċ⁻`, and the stop closes (persistent
-///   contact: no chattering of ever shorter rebounds).
+///   contact: no chattering of ever shorter rebounds);
+/// - an open stop found beyond the band (`g < −g_tol`) without having
+///   been above it at the step before is struck where it is found if it
+///   is deeper than at the step before.
 ///
 /// Each event is counted in the stop's state ([`Stop::watch_sign`]). The
 /// accelerations are left to the caller (D9 at the post-event state),
@@ -916,10 +934,13 @@ pub fn stop_events_at(
             let (w0, w1) = (stop_watch(model, s, before), stop_watch(model, s, state));
             // reached from above the event band; or found beyond it
             // having never left it since a rebound (a flight out of the
-            // band and back within one step: struck where it is found)
+            // band and back within one step: struck where it is found),
+            // deeper than at the step before: a stop released beyond its
+            // band (closed there, `|g| > tol`) is leaving, not struck
+            // (§16.4, "Struck beyond the band")
             s.contact(state) == Contact::Open
                 && s.contact(before) == Contact::Open
-                && ((w0 > 1.0 && w1 <= 1.0) || (w0 <= 1.0 && w1 < -1.0))
+                && ((w0 > 1.0 && w1 <= 1.0) || (w0 <= 1.0 && w1 < -1.0 && w1 < w0))
         })
         .collect();
     if reached.is_empty() {

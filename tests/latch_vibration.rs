@@ -17,7 +17,18 @@ use common::cli::{self, csv_rows, number, summary};
 /// The boom, its beams' sections with `damping` (a line of the section).
 fn boom(name: &str, damping: &str) -> std::path::PathBuf {
     let dir = cli::scratch("latch-vibration", name);
-    let text = format!(
+    cli::run_text(&dir, &boom_text(damping, true)).0
+}
+
+/// The model text of the boom, with `inertia` the sections' rotational
+/// inertia per length.
+fn boom_text(damping: &str, inertia: bool) -> String {
+    let inertia = if inertia {
+        "inertia_per_length = [2.5e-5, 1.25e-5, 1.25e-5]"
+    } else {
+        ""
+    };
+    format!(
         r#"title = "two-beam boom opened by a hinge spring onto a latch"
 [analysis]
 type = "dynamic"
@@ -34,7 +45,7 @@ GJ = 244.0
 EI2 = 325.0
 EI3 = 325.0
 mass_per_length = 0.305
-inertia_per_length = [2.5e-5, 1.25e-5, 1.25e-5]
+{inertia}
 {damping}
 
 [[nodes]]
@@ -91,8 +102,7 @@ joint = 1
 value = -90.0
 unit = "deg"
 "#
-    );
-    cli::run_text(&dir, &text).0
+    )
 }
 
 /// The lock's rate and whether the run warned of a vibrating lock.
@@ -135,4 +145,24 @@ fn a_lock_of_a_vibrating_joint_is_reported() {
         (rate - rigid).abs() <= 0.02 * rigid.abs(),
         "{rate} against {rigid}"
     );
+}
+
+/// Without `inertia_per_length` the beams' rotations have no inertia, and
+/// the lock, whose impulse turns the hinge's nodes, cannot be resolved:
+/// the run stops there (exit 1) and says that beams take their rotational
+/// inertia from `inertia_per_length` alone, not from their mass.
+#[test]
+fn a_lock_on_beams_without_rotational_inertia_names_inertia_per_length() {
+    let dir = cli::scratch("latch-vibration", "no-inertia");
+    let model = dir.join("model.toml");
+    std::fs::write(&model, boom_text("", false)).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args(["run", model.to_str().unwrap(), "--quiet", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("the lock of latch 3"), "{err}");
+    assert!(err.contains("inertia_per_length"), "{err}");
 }

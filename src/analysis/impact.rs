@@ -478,12 +478,14 @@ pub fn lock_latches(
             .join(", ");
         let reason = match why {
             Singular::Massless(node, c) => format!(
-                "the impulse of the lock acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies the latch joins their mass (rigid bodies, point masses or beams at the joint's nodes, or nodes glued to them)",
+                "the impulse of the lock acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies the latch joins their mass (rigid bodies, point masses or beams at the joint's nodes, or nodes glued to them){}",
                 model.node_ids[node],
-                crate::model::COMPONENT_NAMES[c]
+                crate::model::COMPONENT_NAMES[c],
+                rotation_hint(c >= 3)
             ),
             Singular::System(at) => format!(
-                "the impact equations are singular{at}: the mass matrix is singular on the motion the impulse excites (an unknown without mass that no constraint holds); give the bodies mass"
+                "the impact equations are singular{at}: the mass matrix is singular on the motion the impulse excites (an unknown without mass that no constraint holds); give the bodies mass{}",
+                rotation_hint(names_rotation(&at))
             ),
         };
         DynamicError::Impact {
@@ -847,6 +849,24 @@ pub struct ContactImpact {
     pub rebound_step: Option<f64>,
 }
 
+/// Whether the location `at` of a singular impact (` at node 101 rx`)
+/// names a rotation.
+fn names_rotation(at: &str) -> bool {
+    [" rx", " ry", " rz"].iter().any(|r| at.contains(r))
+}
+
+/// What to add to the message of a singular impact on a rotation: beams
+/// carry rotational inertia only from their section's
+/// `inertia_per_length` (0 when not given), so that a beam with mass
+/// leaves its nodes' rotations without any.
+fn rotation_hint(rotation: bool) -> &'static str {
+    if rotation {
+        "; a rotation has no inertia there: beams have rotational inertia only from the inertia_per_length of their section (0 when not given), whatever their mass_per_length"
+    } else {
+        ""
+    }
+}
+
 /// The error of an impact at stops.
 fn stop_failure(model: &Model, stops: &[&Stop], time: f64, why: Singular) -> DynamicError {
     let latches = stops
@@ -856,13 +876,15 @@ fn stop_failure(model: &Model, stops: &[&Stop], time: f64, why: Singular) -> Dyn
         .join(", ");
     let reason = match why {
         Singular::Massless(node, c) => format!(
-            "the impulse of the {} acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies it acts on their mass (rigid bodies, point masses or beams at its nodes)",
+            "the impulse of the {} acts on node {} ({}) which has no mass in that direction and no other constraint holds, so the velocity jump is not defined; give the bodies it acts on their mass (rigid bodies, point masses or beams at its nodes){}",
             stops[0].noun(),
             model.node_ids[node],
-            crate::model::COMPONENT_NAMES[c]
+            crate::model::COMPONENT_NAMES[c],
+            rotation_hint(c >= 3)
         ),
         Singular::System(at) => format!(
-            "the impact equations are singular{at}: the mass matrix is singular on the motion the impulse excites; give the bodies mass"
+            "the impact equations are singular{at}: the mass matrix is singular on the motion the impulse excites; give the bodies mass{}",
+            rotation_hint(names_rotation(&at))
         ),
     };
     DynamicError::Impact {

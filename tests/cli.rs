@@ -128,7 +128,8 @@ fn duplicate_id() {
     assert_rejected(
         "duplicate_element",
         &text,
-        &["beam 1", "duplicate element id"],
+        // the element that holds the id already is named
+        &["beam 1", "duplicate element id: beam 1 has id 1 already"],
     );
 }
 

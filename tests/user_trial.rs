@@ -513,3 +513,49 @@ fn slips_in_the_analysis_block_are_named_for_what_they_are() {
     let (code, err) = check("threads", &fine, &["--threads", "1"]);
     assert_eq!(code, Some(0), "{err}");
 }
+
+/// The model's own warnings (here a latch value that reads as degrees)
+/// are in `summary.json` too, as `model_warnings`, not only on stderr:
+/// a script reading the summary alone sees them.
+#[test]
+fn the_models_warnings_are_in_the_summary() {
+    let text = "[analysis]
+type = \"static\"
+end_time = 1.0
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[rigid_bodies]]
+id = 1
+node = 1
+mass = 1.0
+inertia = [1.0, 1.0, 1.0]
+
+[[joints]]
+id = 2
+type = \"revolute\"
+nodes = [1]
+axis = [0.0, 0.0, 1.0]
+
+[[joint_springs]]
+id = 3
+joint = 2
+stiffness = 1.0
+
+[[latches]]
+id = 4
+joint = 2
+value = 90.0
+";
+    let (out, _) = run(&scratch("model-warnings"), text);
+    let s = summary(&out);
+    let warnings = s["model_warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    let w = warnings[0].as_str().unwrap();
+    assert!(
+        w.starts_with("latch 4:") && w.contains("gives no unit"),
+        "{w}"
+    );
+}

@@ -392,6 +392,10 @@ pub struct Summary {
     /// Warnings of the analyses about converged increments (a limit point
     /// passed under load control), as logged.
     pub warnings: Vec<String>,
+    /// The model's own warnings, as `unfold check` and `unfold run` print
+    /// them (a latch value that reads as degrees, a unit that looks
+    /// wrong): `entity: message`.
+    pub model_warnings: Vec<String>,
     /// Every converged increment.
     pub increment_log: Vec<IncrementRecord>,
     /// What each modal analysis of the run found (docs/results.md,
@@ -473,6 +477,7 @@ impl Summary {
             output_steps: 0,
             analyses: Vec::new(),
             warnings: Vec::new(),
+            model_warnings: model.warnings.iter().map(|w| w.to_string()).collect(),
             increment_log: Vec::new(),
             modes: Vec::new(),
             latches: Vec::new(),

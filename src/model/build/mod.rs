@@ -249,7 +249,8 @@ struct Builder<'i> {
     sections: HashMap<String, BeamSection>,
     /// Names of sections defined with errors (already reported).
     invalid_sections: HashSet<String>,
-    element_ids: HashSet<Id>,
+    /// The element ids claimed so far, with the entity that holds each.
+    element_ids: HashMap<Id, String>,
     elements: Vec<Box<dyn Element>>,
     beam_specs: Vec<BeamSpec>,
     fixed: Vec<[bool; 6]>,
@@ -281,12 +282,13 @@ impl Builder<'_> {
                 format!("id {id} is larger than {MAX_ID}, the largest a model file can hold"),
             );
             false
-        } else if self.element_ids.insert(id) {
-            true
-        } else {
-            self.ck
-                .push(ModelErrorKind::DuplicateId, entity, "duplicate element id");
+        } else if let Some(holder) = self.element_ids.get(&id) {
+            let message = format!("duplicate element id: {holder} has id {id} already");
+            self.ck.push(ModelErrorKind::DuplicateId, entity, message);
             false
+        } else {
+            self.element_ids.insert(id, entity.to_string());
+            true
         }
     }
 
@@ -365,7 +367,7 @@ impl Model {
             invalid_nodes: HashSet::new(),
             sections: HashMap::new(),
             invalid_sections: HashSet::new(),
-            element_ids: HashSet::new(),
+            element_ids: HashMap::new(),
             elements: Vec::new(),
             beam_specs: Vec::new(),
             fixed: Vec::new(),

@@ -451,6 +451,12 @@ fn mechanism_without_driver_is_reported() {
         run_model(&dir, "free_hinge.toml", &hinged(ok))
     };
     assert!(err.contains("singular tangent"), "{err}");
+    // the free motion is the hinge's: the message names its joint, not
+    // only the unknown of the smallest pivot
+    assert!(
+        err.contains("in a free motion that moves joint 30"),
+        "{err}"
+    );
 
     // a kinematic analysis of the rigid link alone, hinged to the ground
     let link = "[analysis]\ntype = \"kinematic\"\n\n[[nodes]]\nid = 1\nx = [0.0, 0.0, 0.0]\n\n[[joints]]\nid = 1\ntype = \"revolute\"\nnodes = [1]\naxis = [0, 0, 1]\n";

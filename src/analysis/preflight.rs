@@ -39,6 +39,7 @@ use crate::dofs::DofKind;
 use crate::elements::ElementKind;
 use crate::linalg::{smallest_relative_pivot, SparseLu};
 use crate::model::{Model, ModelWarning};
+use crate::state::State;
 
 // the Newton solver's thresholds: a check reports what a run would
 use super::newton::{non_finite_origin, RUNAWAY_CORRECTION, SINGULAR_PIVOT};
@@ -86,7 +87,7 @@ pub fn check(model: &Model, settings: &StaticSettings) -> Result<Preflight, Stat
             },
         });
     }
-    if let Some(failure) = singular_direction(model, &solver) {
+    if let Some(failure) = singular_direction(model, &solver, &state) {
         return Err(StaticError::Initial { time: 0.0, failure });
     }
     Ok(Preflight {
@@ -141,7 +142,11 @@ fn redundant_drivers(model: &Model, redundant: &[usize]) -> Vec<ModelWarning> {
 /// Newton solver, a correction beyond [`RUNAWAY_CORRECTION`] (`·L` for
 /// translations) marks a singular tangent, confirmed and located by the
 /// smallest relative pivot (below [`SINGULAR_PIVOT`]).
-fn singular_direction(model: &Model, solver: &NewtonSolver) -> Option<NewtonFailure> {
+fn singular_direction(
+    model: &Model,
+    solver: &NewtonSolver,
+    state: &State,
+) -> Option<NewtonFailure> {
     let k = solver.tangent();
     let n = k.dim();
     if n == 0 {
@@ -169,6 +174,7 @@ fn singular_direction(model: &Model, solver: &NewtonSolver) -> Option<NewtonFail
             factor * d * size
         })
         .collect();
+    let load = probe.clone();
     let solved = SparseLu::analyze(k).and_then(|mut lu| {
         lu.factor(k)?;
         lu.solve_in_place(&mut probe)
@@ -185,10 +191,123 @@ fn singular_direction(model: &Model, solver: &NewtonSolver) -> Option<NewtonFail
         return None;
     }
     match smallest_relative_pivot(k) {
-        Ok((eq, pivot)) if pivot < SINGULAR_PIVOT => Some(NewtonFailure::Singular {
-            dof: solver.dof_label(model, solver.dofs.dof(eq)),
-            pivot,
-        }),
+        Ok((eq, pivot)) if pivot < SINGULAR_PIVOT => {
+            let mut dof = solver.dof_label(model, solver.dofs.dof(eq));
+            // the runaway correction is the free motion: the joints it
+            // moves are those to look at (a hinge without spring), not
+            // the unknown of the smallest pivot, often inside a member
+            let finite = solved.is_ok() && probe.iter().all(|v| v.is_finite());
+            let motion = if finite {
+                Some(probe)
+            } else {
+                shifted_solve(k, load)
+            };
+            let joints = motion
+                .map(|m| moving_joints(model, solver, state, &m))
+                .unwrap_or_default();
+            if !joints.is_empty() {
+                dof = format!("{dof}, in a free motion that moves {}", joints.join(", "));
+            }
+            Some(NewtonFailure::Singular { dof, pivot })
+        }
         _ => None,
     }
 }
+
+/// The joints whose coordinates (`c1`–`c3` of their results) the motion
+/// `direction` (by equation) moves, largest first, at most
+/// [`FREE_JOINTS_NAMED`]: `direction` scaled to a turn of 1e-6 rad (or a
+/// translation of 1e-6 of the model size) at its largest, a joint whose
+/// coordinate changes by more than 1e-2 of that (in radians or model
+/// sizes) is moved by it; a joint that holds its coordinate is not.
+fn moving_joints(
+    model: &Model,
+    solver: &NewtonSolver,
+    state: &State,
+    direction: &[f64],
+) -> Vec<String> {
+    let length = model.length_scale;
+    let dofs = &solver.dofs;
+    let largest = direction
+        .iter()
+        .enumerate()
+        .map(|(eq, d)| match dofs.equation_kind(eq) {
+            DofKind::Translation => d.abs() / length,
+            DofKind::Rotation => d.abs(),
+            DofKind::Coordinate { length: l } => d.abs() * l / length,
+            DofKind::Multiplier(_) => 0.0,
+        })
+        .fold(0.0f64, f64::max);
+    if !(largest.is_finite() && largest > 0.0) {
+        return Vec::new();
+    }
+    let e = 1e-6 / largest;
+    let step: Vec<f64> = direction
+        .iter()
+        .enumerate()
+        .map(|(eq, d)| match dofs.equation_kind(eq) {
+            DofKind::Multiplier(_) => 0.0,
+            _ => e * d,
+        })
+        .collect();
+    let mut moved = state.clone();
+    moved.update(dofs, &step);
+    let ctx = model.context(state.time, crate::elements::Need::RESIDUAL);
+    let mut found: Vec<(f64, String)> = Vec::new();
+    let (mut before, mut after) = ([0.0; 3], [0.0; 3]);
+    for el in model
+        .elements
+        .iter()
+        .filter(|el| el.kind() == ElementKind::Joint)
+    {
+        before.fill(f64::NAN);
+        after.fill(f64::NAN);
+        el.results(&ctx, state, &mut before);
+        el.results(&ctx, &moved, &mut after);
+        let change = before
+            .iter()
+            .zip(&after)
+            .filter(|(b, a)| b.is_finite() && a.is_finite())
+            .map(|(b, a)| (a - b).abs())
+            .fold(0.0f64, f64::max);
+        if change > 1e-2 * 1e-6 {
+            found.push((change, format!("joint {}", el.id())));
+        }
+    }
+    found.sort_by(|a, b| b.0.total_cmp(&a.0));
+    found
+        .into_iter()
+        .take(FREE_JOINTS_NAMED)
+        .map(|(_, name)| name)
+        .collect()
+}
+
+/// `(K + σ D) Δq = b` with `D` the magnitude of each column's diagonal
+/// (its largest entry where the diagonal is zero, the largest diagonal of
+/// `K` where the column is zero) and `σ` = 1e-9: where `K` is singular to
+/// working precision, the solution is dominated by its directions
+/// without stiffness, which the shift makes finite.
+fn shifted_solve(k: &crate::linalg::SparseMatrix, mut b: Vec<f64>) -> Option<Vec<f64>> {
+    let diagonal = |eq: usize| k.position(eq, eq).map_or(0.0, |p| k.values()[p].abs());
+    let scale = (0..k.dim()).map(diagonal).fold(0.0f64, f64::max);
+    let mut shifted = k.clone();
+    for eq in 0..k.dim() {
+        if let Some(p) = k.position(eq, eq) {
+            let d = match diagonal(eq) {
+                d if d > 0.0 => d,
+                _ => match k.column_max_abs(eq) {
+                    c if c > 0.0 => c,
+                    _ => scale,
+                },
+            };
+            shifted.values_mut()[p] += 1e-9 * d;
+        }
+    }
+    let mut lu = SparseLu::analyze(&shifted).ok()?;
+    lu.factor(&shifted).ok()?;
+    lu.solve_in_place(&mut b).ok()?;
+    b.iter().all(|v| v.is_finite()).then_some(b)
+}
+
+/// Joints named at most in the message of a singular tangent.
+const FREE_JOINTS_NAMED: usize = 4;

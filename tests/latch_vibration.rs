@@ -156,11 +156,14 @@ fn a_lock_on_beams_without_rotational_inertia_names_inertia_per_length() {
     let dir = cli::scratch("latch-vibration", "no-inertia");
     let model = dir.join("model.toml");
     std::fs::write(&model, boom_text("", false)).unwrap();
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .args(["run", model.to_str().unwrap(), "--quiet", "--out"])
-        .arg(dir.join("out"))
-        .output()
-        .unwrap();
+    let out = dir.join("out");
+    let o = cli::unfold(&[
+        "run",
+        model.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("the lock of latch 3"), "{err}");

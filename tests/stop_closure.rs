@@ -16,94 +16,27 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use common::cli::{self, summary};
+use common::stop_arm;
 
 /// The model at `rho` (ρ∞) with a gravity `g` (m/s², along y, in the
 /// plane of the motion).
 fn arm(name: &str, rho: f64, g: f64) -> PathBuf {
     let dir = cli::scratch("stop-closure", name);
-    let text = format!(
-        r#"title = "arm opened by a spring onto a plastic stop"
-[analysis]
-type = "dynamic"
+    let analysis = format!(
+        "[analysis]
+type = \"dynamic\"
 end_time = 0.1
 time_step = 0.01
 max_step = 0.01
 adaptive = false
 rho_infinity = {rho:?}
-
-[[sections]]
-name = "tube"
-EA = 6.57e6
-GA2 = 3.58e5
-GA3 = 3.58e5
-GJ = 64.8
-EI2 = 297.0
-EI3 = 297.0
-mass_per_length = 0.0955
-inertia_per_length = [8.64e-6, 4.32e-6, 4.32e-6]
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[nodes]]
-id = 2
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 3
-x = [0.2, 0.0, 0.0]
-
-[[beam_lines]]
-nodes = [2, 3]
-elements = 4
-section = "tube"
-orientation = [0.0, 0.0, 1.0]
-first_node = 100
-first_element = 100
-
-[[point_masses]]
-id = 150
-node = 3
-mass = 0.01
-
-[[joints]]
-id = 4
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-
-[[joint_springs]]
-id = 5
-joint = 4
-stiffness = 0.2
-free_value = 3.0
-
-[[stops]]
-id = 6
-joint = 4
-upper = 2.0
-restitution = 0.0
-
-[gravity]
-acceleration = [0.0, {g:?}, 0.0]
-curve = "constant"
-"#
+"
     );
+    let text = stop_arm::arm(&analysis, Some(g));
     cli::run_text(&dir, &text).0
-}
-
-/// The column `name` of a CSV file.
-fn column(path: &Path, name: &str) -> Vec<f64> {
-    let rows = cli::csv_rows(path);
-    rows.iter().map(|r| cli::number(r, name)).collect()
 }
 
 /// At ρ∞ = 0.5 and 0.9, the step after each closure of the stop (which
@@ -119,12 +52,12 @@ fn column(path: &Path, name: &str) -> Vec<f64> {
 /// percent under the same perturbation, tests/latch_peaks.rs).
 #[test]
 fn the_steps_after_a_stop_closes_on_a_flexible_arm_create_no_energy() {
-    let work = 0.5 * 0.2 * (3.0f64.powi(2) - 1.0);
+    let work = stop_arm::WORK;
     for rho in [0.5, 0.9] {
         let mut peaks = Vec::new();
         for (name, g) in [("exact", 0.0), ("perturbed", 1e-14)] {
             let out = arm(&format!("{rho}-{name}"), rho, g);
-            let balance = column(&out.join("energies.csv"), "balance_error");
+            let balance = cli::column(&out.join("energies.csv"), "balance_error");
             let events = cli::csv_rows(&out.join("events.csv"));
             let closures: Vec<usize> = events
                 .iter()

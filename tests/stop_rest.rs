@@ -17,93 +17,27 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use common::cli::{self, summary};
-
-/// The spring's work from the start (0 rad) to the stop (2 rad), J.
-const WORK: f64 = 0.5 * 0.2 * (3.0 * 3.0 - 1.0);
+use common::stop_arm::{self, WORK};
 
 /// The model run to `end_time`, with fixed steps of 0.01 s (those of the
 /// ERA platform) or adaptive ones.
 fn arm(name: &str, adaptive: bool, end_time: f64) -> PathBuf {
     let dir = cli::scratch("stop-rest", name);
-    let text = format!(
-        r#"title = "arm opened by a spring onto a plastic stop"
-[analysis]
-type = "dynamic"
+    let analysis = format!(
+        "[analysis]
+type = \"dynamic\"
 end_time = {end_time:?}
 time_step = 0.01
 max_step = 0.01
 adaptive = {adaptive}
 rho_infinity = 0.9
-
-[[sections]]
-name = "tube"
-EA = 6.57e6
-GA2 = 3.58e5
-GA3 = 3.58e5
-GJ = 64.8
-EI2 = 297.0
-EI3 = 297.0
-mass_per_length = 0.0955
-inertia_per_length = [8.64e-6, 4.32e-6, 4.32e-6]
-
-[[nodes]]
-id = 1
-x = [0.0, 0.0, 0.0]
-
-[[supports]]
-node = 1
-fixed = ["all"]
-
-[[nodes]]
-id = 2
-x = [0.0, 0.0, 0.0]
-
-[[nodes]]
-id = 3
-x = [0.2, 0.0, 0.0]
-
-[[beam_lines]]
-nodes = [2, 3]
-elements = 4
-section = "tube"
-orientation = [0.0, 0.0, 1.0]
-first_node = 100
-first_element = 100
-
-[[point_masses]]
-id = 150
-node = 3
-mass = 0.01
-
-[[joints]]
-id = 4
-type = "revolute"
-nodes = [1, 2]
-axis = [0.0, 0.0, 1.0]
-
-[[joint_springs]]
-id = 5
-joint = 4
-stiffness = 0.2
-free_value = 3.0
-
-[[stops]]
-id = 6
-joint = 4
-upper = 2.0
-restitution = 0.0
-"#
+"
     );
+    let text = stop_arm::arm(&analysis, None);
     cli::run_text(&dir, &text).0
-}
-
-/// The column `name` of a CSV file.
-fn column(path: &Path, name: &str) -> Vec<f64> {
-    let rows = cli::csv_rows(path);
-    rows.iter().map(|r| cli::number(r, name)).collect()
 }
 
 /// The largest value of a column.
@@ -127,8 +61,8 @@ fn largest(values: &[f64]) -> f64 {
 fn a_flexible_arm_on_a_plastic_stop_with_fixed_steps_creates_no_energy() {
     let out = arm("fixed", false, 0.5);
     let energies = out.join("energies.csv");
-    let kinetic = largest(&column(&energies, "kinetic"));
-    let balance = column(&energies, "balance_error");
+    let kinetic = largest(&cli::column(&energies, "kinetic"));
+    let balance = cli::column(&energies, "balance_error");
     let created = largest(&balance);
     let lost = -balance.iter().copied().fold(f64::INFINITY, f64::min);
     let s = summary(&out);
@@ -178,8 +112,8 @@ fn a_flexible_arm_on_a_plastic_stop_with_fixed_steps_creates_no_energy() {
 fn a_flexible_arm_on_a_plastic_stop_with_adaptive_steps_does_not_chatter() {
     let out = arm("adaptive", true, 0.075);
     let energies = out.join("energies.csv");
-    let kinetic = largest(&column(&energies, "kinetic"));
-    let balance = column(&energies, "balance_error");
+    let kinetic = largest(&cli::column(&energies, "kinetic"));
+    let balance = cli::column(&energies, "balance_error");
     let worst = balance.iter().fold(0.0f64, |a, e| a.max(e.abs()));
     let s = summary(&out);
     let d = &s["analyses"][0]["dynamic"];

@@ -438,12 +438,9 @@ free_value = 3.5
 fn check(name: &str, text: &str, args: &[&str]) -> (Option<i32>, String) {
     let model = scratch(name).join("model.toml");
     std::fs::write(&model, text).unwrap();
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .arg("check")
-        .arg(&model)
-        .args(args)
-        .output()
-        .unwrap();
+    let mut all = vec!["check", model.to_str().unwrap()];
+    all.extend(args);
+    let o = cli::unfold(&all);
     (
         o.status.code(),
         String::from_utf8_lossy(&o.stderr).into_owned(),

@@ -23,19 +23,24 @@ pub fn run_text(dir: &Path, text: &str) -> (PathBuf, Output) {
     (out, o)
 }
 
+/// Runs `unfold` with the arguments `args`, whatever its exit code.
+pub fn unfold<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
 /// Runs `unfold run --quiet` on the model file `model` into `out`, which
 /// must end with exit code 0.
 pub fn run_model(model: &Path, out: &Path) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .args([
-            "run",
-            model.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ])
-        .output()
-        .unwrap();
+    let o = unfold(&[
+        "run",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -43,6 +48,11 @@ pub fn run_model(model: &Path, out: &Path) -> Output {
         String::from_utf8_lossy(&o.stderr)
     );
     o
+}
+
+/// The column `name` of a CSV file, as numbers.
+pub fn column(path: &Path, name: &str) -> Vec<f64> {
+    csv_rows(path).iter().map(|r| number(r, name)).collect()
 }
 
 /// The rows of a CSV file as maps from column name to text.

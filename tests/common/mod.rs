@@ -13,6 +13,7 @@ pub mod quadrature;
 pub mod rigid_body;
 pub mod rolling_disc;
 pub mod spring_latch;
+pub mod stop_arm;
 
 use std::sync::Arc;
 

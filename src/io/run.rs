@@ -1202,9 +1202,11 @@ impl Recorder {
         self.unresolved_contacts();
     }
 
-    /// A warning when latch `info.latch` locks a joint whose rate ranged,
-    /// over the last [`RATE_WINDOW_STEPS`] steps, by more than
-    /// [`LOCK_RATE_RANGE`] of its mean rate: the joint vibrates (the ends of
+    /// A warning when latch `info.latch` locks a joint whose rate swung,
+    /// over the last [`RATE_WINDOW_STEPS`] steps, about its least-squares
+    /// line in time by more than [`LOCK_RATE_RANGE`] of its mean rate (one
+    /// allocation per open latch and step, for `ċ`'s gradient, in the
+    /// observer, not in Newton's loop): the joint vibrates (the ends of
     /// an undamped flexible member rung by a spring), so that the lock's
     /// rate `ċ⁻`, and with it its impulse and energy lost, is the
     /// vibration's phase at the lock; in a model without damping it also

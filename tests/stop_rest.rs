@@ -17,7 +17,7 @@
 
 mod common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use common::cli::{self, summary};
 use common::stop_arm::{self, WORK};
@@ -45,6 +45,33 @@ fn largest(values: &[f64]) -> f64 {
     values.iter().copied().fold(f64::NEG_INFINITY, f64::max)
 }
 
+/// What a run of the arm gives: its largest kinetic energy, the balance
+/// error of every output step, and the stop's counts and the steps from
+/// `summary.json`.
+struct Outcome {
+    kinetic: f64,
+    balance: Vec<f64>,
+    closed: u64,
+    released: u64,
+    impacts: u64,
+    steps: u64,
+}
+
+fn outcome(out: &Path) -> Outcome {
+    let energies = out.join("energies.csv");
+    let s = summary(out);
+    let d = &s["analyses"][0]["dynamic"];
+    let count = |k: &str| d[k].as_u64().unwrap();
+    Outcome {
+        kinetic: largest(&cli::column(&energies, "kinetic")),
+        balance: cli::column(&energies, "balance_error"),
+        closed: count("contacts_closed"),
+        released: count("contacts_released"),
+        impacts: count("impacts"),
+        steps: count("steps"),
+    }
+}
+
 /// Fixed steps of 0.01 s to 0.5 s: before the release of the stop was
 /// located on its load, the step on which the load fell to zero was
 /// accepted with the stop pulling the hinge node by 86 N·m (the landing
@@ -59,21 +86,16 @@ fn largest(values: &[f64]) -> f64 {
 /// created) and +5.1e-5 J, 5 closures and 4 releases, 530 steps.
 #[test]
 fn a_flexible_arm_on_a_plastic_stop_with_fixed_steps_creates_no_energy() {
-    let out = arm("fixed", false, 0.5);
-    let energies = out.join("energies.csv");
-    let kinetic = largest(&cli::column(&energies, "kinetic"));
-    let balance = cli::column(&energies, "balance_error");
+    let Outcome {
+        kinetic,
+        balance,
+        closed,
+        released,
+        impacts,
+        steps,
+    } = outcome(&arm("fixed", false, 0.5));
     let created = largest(&balance);
     let lost = -balance.iter().copied().fold(f64::INFINITY, f64::min);
-    let s = summary(&out);
-    let d = &s["analyses"][0]["dynamic"];
-    let count = |k: &str| d[k].as_u64().unwrap();
-    let (closed, released, impacts) = (
-        count("contacts_closed"),
-        count("contacts_released"),
-        count("impacts"),
-    );
-    let steps = count("steps");
     eprintln!(
         "T max {kinetic:.4e} J, E created {created:.3e} J, lost {lost:.3e} J, {closed} closed, {released} released, {impacts} impacts, {steps} steps"
     );
@@ -110,20 +132,15 @@ fn a_flexible_arm_on_a_plastic_stop_with_fixed_steps_creates_no_energy() {
 /// s a step before the arrival, 4e-6 s after it).
 #[test]
 fn a_flexible_arm_on_a_plastic_stop_with_adaptive_steps_does_not_chatter() {
-    let out = arm("adaptive", true, 0.075);
-    let energies = out.join("energies.csv");
-    let kinetic = largest(&cli::column(&energies, "kinetic"));
-    let balance = cli::column(&energies, "balance_error");
+    let Outcome {
+        kinetic,
+        balance,
+        closed,
+        released,
+        impacts,
+        steps,
+    } = outcome(&arm("adaptive", true, 0.075));
     let worst = balance.iter().fold(0.0f64, |a, e| a.max(e.abs()));
-    let s = summary(&out);
-    let d = &s["analyses"][0]["dynamic"];
-    let count = |k: &str| d[k].as_u64().unwrap();
-    let (closed, released, impacts) = (
-        count("contacts_closed"),
-        count("contacts_released"),
-        count("impacts"),
-    );
-    let steps = count("steps");
     eprintln!(
         "T max {kinetic:.4e} J, |E| max {worst:.3e} J, {closed} closed, {released} released, {impacts} impacts, {steps} steps"
     );

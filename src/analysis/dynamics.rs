@@ -64,7 +64,7 @@ use super::settings::{DynamicSettings, NewtonMethod};
 use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer, WarningInfo};
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
 use crate::elements::{ConstraintKind, ConstraintScaling, EvalContext, Need};
-use crate::linalg::{smallest_relative_pivot, SolveError, SparseLu, SparseMatrix};
+use crate::linalg::{smallest_relative_pivot, SolveError, SparseMatrix, SymmetricFirst};
 use crate::model::{Id, Model, Prescribed};
 use crate::so3::{self, Mat3, Vec3};
 use crate::state::State;
@@ -520,9 +520,10 @@ impl Work {
 /// used by the error estimate's filter (D11a).
 #[derive(Default)]
 struct IterationFactors {
-    /// The LU of [`Self::matrix`], its symbolic analysis made once per
-    /// numbering.
-    lu: Option<SparseLu>,
+    /// The factors of [`Self::matrix`] (its symmetric part, or its LU:
+    /// [`SymmetricFirst`], docs/theory.md §8), the symbolic analysis made
+    /// once per numbering.
+    lu: Option<SymmetricFirst>,
     /// The matrix factored, scaled (D8), on the solver's pattern.
     matrix: Option<SparseMatrix>,
     /// The solver's numbering of the symbolic analysis.
@@ -566,10 +567,10 @@ struct MassSystem {
     /// The elements with multipliers, for the stiffness of the
     /// projections (D13–D14).
     constraints: Option<ConstraintRows>,
-    /// The constrained mass system's matrix (scaled), and its own LU, so
-    /// that its factorisation leaves the iteration matrix's alone.
+    /// The constrained mass system's matrix (scaled), and its own factors,
+    /// so that its factorisation leaves the iteration matrix's alone.
     system: Option<SparseMatrix>,
-    lu: Option<SparseLu>,
+    lu: Option<SymmetricFirst>,
     /// Numeric factorisations so far.
     factorisations: usize,
 }
@@ -1669,7 +1670,7 @@ impl EquationKind {
 
 /// Solves the constrained mass system left in `buffers` by
 /// [`constrained_mass_system`] for the right-hand side `rhs` (in place),
-/// with the LU of its own (the iteration matrix's factors are kept).
+/// with factors of its own (the iteration matrix's are kept).
 fn solve_mass_system(
     model: &Model,
     solver: &NewtonSolver,
@@ -1685,7 +1686,7 @@ fn solve_mass_system(
     let count = &mut buffers.factorisations;
     let solved = (|| {
         if lu.is_none() {
-            *lu = Some(SparseLu::analyze(matrix)?);
+            *lu = Some(SymmetricFirst::analyze(matrix)?);
         }
         let lu = lu.as_mut().expect("analysed above");
         *count += 1;
@@ -2386,7 +2387,7 @@ impl Dynamics<'_> {
             .values_mut()
             .copy_from_slice(assembler.matrix.values());
         if factors.lu.is_none() {
-            factors.lu = Some(SparseLu::analyze(matrix)?);
+            factors.lu = Some(SymmetricFirst::analyze(matrix)?);
         }
         let lu = factors.lu.as_mut().expect("analysed above");
         factors.count += 1;

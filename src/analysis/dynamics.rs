@@ -2599,15 +2599,6 @@ impl Dynamics<'_> {
             if solved.is_err()
                 || !(dx <= RUNAWAY_CORRECTION * free_size && dth <= RUNAWAY_CORRECTION)
             {
-                // the matrix of the factors names the singular unknown
-                let run = &*self.run;
-                let failure = match &run.factors.matrix {
-                    Some(matrix) => singular(model, self.solver, matrix, &run.state, numbered),
-                    None => NewtonFailure::NonFinite {
-                        iteration: numbered,
-                        origin: "in the solution of the linear system".into(),
-                    },
-                };
                 // after iterations that drove the residual up, a singular
                 // matrix or a runaway correction is the divergence's
                 // doing, not a mechanism's
@@ -2618,8 +2609,25 @@ impl Dynamics<'_> {
                         .fold(0.0f64, f64::max),
                     _ => 0.0,
                 };
+                let diverged = numbered > 0 && growth > DIVERGED_GROWTH;
+                // the matrix of the factors names the singular unknown (a
+                // factorisation of its own: not for a correction that was
+                // solved and ran away from a diverging iterate, which a
+                // matrix singular there would not explain, docs/results.md)
+                let run = &*self.run;
+                let failure = match &run.factors.matrix {
+                    Some(_) if diverged && solved.is_ok() => NewtonFailure::NonFinite {
+                        iteration: numbered,
+                        origin: "in a diverging iterate".into(),
+                    },
+                    Some(matrix) => singular(model, self.solver, matrix, &run.state, numbered),
+                    None => NewtonFailure::NonFinite {
+                        iteration: numbered,
+                        origin: "in the solution of the linear system".into(),
+                    },
+                };
                 let failure = match forces.first().zip(forces.last()) {
-                    Some((from, to)) if numbered > 0 && growth > DIVERGED_GROWTH => {
+                    Some((from, to)) if diverged => {
                         let (from, to) = (from[0].max(from[1]), to[0].max(to[1]));
                         let what = match &failure {
                             NewtonFailure::Singular { dof, .. } => {

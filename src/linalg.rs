@@ -233,9 +233,10 @@ impl SparseMatrix {
         y.fill(0.0);
         let ptr = self.symbolic.col_ptr();
         let rows = self.symbolic.row_idx();
-        for (j, &xj) in x.iter().enumerate() {
-            for k in ptr[j]..ptr[j + 1] {
-                y[rows[k]] += self.values[k] * xj;
+        for (&xj, range) in x.iter().zip(ptr.windows(2)) {
+            let (rows, values) = (&rows[range[0]..range[1]], &self.values[range[0]..range[1]]);
+            for (&i, &a) in rows.iter().zip(values) {
+                y[i] += a * xj;
             }
         }
     }

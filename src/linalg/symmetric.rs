@@ -14,7 +14,9 @@
 //! factorisation of a matrix of the pattern of `A` ordered by AMD.
 //!
 //! [`SymmetricFirst`] therefore factors the symmetric part
-//! `S = (A + Aᵀ)/2` as `LDLᵀ` (faer's sparse Cholesky, AMD ordering),
+//! `S = (A + Aᵀ)/2` as `LDLᵀ` (faer's sparse Cholesky, AMD ordering; the
+//! pattern permuted once, at the analysis, into the triangle faer's
+//! kernel works on, so that a factorisation copies no matrix),
 //! with dynamic regularisation: a pivot smaller than `ε max|aᵢᵢ|`
 //! (ε = [`REGULARISATION`]) is replaced by `±ε max|aᵢᵢ|`, negative for the
 //! rows whose diagonal entry is zero (the multipliers', whose pivots of
@@ -58,7 +60,7 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
-    SymmetricOrdering,
+    SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
@@ -118,12 +120,19 @@ pub struct SymmetricFirst {
     /// `A` as last factored: its values are those the GMRES residuals and
     /// the fall-back LU use.
     matrix: SparseMatrix,
-    /// `S = (A + Aᵀ)/2`, lower triangle, and the positions in `A`'s values
-    /// of the two entries each of its entries is made of.
-    lower: SymbolicSparseColMat<usize>,
-    lower_values: Vec<f64>,
+    /// `S = (A + Aᵀ)/2` permuted by the AMD ordering, one triangle (that
+    /// which faer's kernel works on, `side`), and the positions in `A`'s
+    /// values of the two entries each of its entries is made of. Row `i`
+    /// of `pattern` is row `forward[i]` of `A`; `permuted` holds a vector
+    /// in that order.
+    pattern: SymbolicSparseColMat<usize>,
+    values: Vec<f64>,
+    side: Side,
+    forward: Vec<usize>,
+    permuted: Vec<f64>,
     sources: Vec<[usize; 2]>,
-    /// Position in `A`'s values of each diagonal entry.
+    /// Position in `A`'s values of each diagonal entry (in the order of
+    /// `pattern`).
     diagonal: Vec<usize>,
     signs: Vec<i8>,
     symbolic: SymbolicCholesky<usize>,
@@ -222,10 +231,53 @@ impl SymmetricFirst {
             supernodal_flop_ratio_threshold: SupernodalThreshold::AUTO,
             ..Default::default()
         };
-        let symbolic = factorize_symbolic_cholesky(
+        let ordered = factorize_symbolic_cholesky(
             lower.as_ref(),
             Side::Lower,
             SymmetricOrdering::Amd,
+            params,
+        )
+        .map_err(|e| internal(&e))?;
+        // the pattern permuted by the AMD ordering once, in the triangle
+        // faer's kernel works on (upper for the simplicial, lower for the
+        // supernodal), so that a factorisation copies no matrix
+        let (forward, inverse): (Vec<usize>, Vec<usize>) = match ordered.perm() {
+            Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
+            None => ((0..n).collect(), (0..n).collect()),
+        };
+        let side = match ordered.raw() {
+            SymbolicCholeskyRaw::Simplicial(_) => Side::Upper,
+            SymbolicCholeskyRaw::Supernodal(_) => Side::Lower,
+        };
+        let mut permuted: Vec<Vec<(usize, [usize; 2])>> = vec![Vec::new(); n];
+        for (j, column) in entries.iter().enumerate() {
+            for &(i, source) in column {
+                let (a, b) = (inverse[i], inverse[j]);
+                let (row, col) = match side {
+                    Side::Lower => (a.max(b), a.min(b)),
+                    Side::Upper => (a.min(b), a.max(b)),
+                };
+                permuted[col].push((row, source));
+            }
+        }
+        let mut p_ptr = Vec::with_capacity(n + 1);
+        let mut p_rows = Vec::with_capacity(sources.len());
+        sources.clear();
+        p_ptr.push(0);
+        for column in &mut permuted {
+            column.sort_unstable_by_key(|&(r, _)| r);
+            for &(r, source) in column.iter() {
+                p_rows.push(r);
+                sources.push(source);
+            }
+            p_ptr.push(p_rows.len());
+        }
+        let diagonal: Vec<usize> = forward.iter().map(|&old| diagonal[old]).collect();
+        let pattern = SymbolicSparseColMat::new_checked(n, n, p_ptr, None, p_rows);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            side,
+            SymmetricOrdering::Identity,
             params,
         )
         .map_err(|e| internal(&e))?;
@@ -240,8 +292,11 @@ impl SymmetricFirst {
         let m = MAX_ITERATIONS;
         Ok(Self {
             matrix: a.clone(),
-            lower_values: vec![0.0; sources.len()],
-            lower,
+            values: vec![0.0; sources.len()],
+            pattern,
+            side,
+            forward,
+            permuted: vec![0.0; n],
             sources,
             diagonal,
             signs: vec![1; n],
@@ -300,7 +355,7 @@ impl SymmetricFirst {
         // s_ij = (a_ij + a_ji)/2 (a diagonal entry's two sources are itself)
         let values = &self.matrix.values;
         let at = |k: usize| if k == NONE { 0.0 } else { values[k] };
-        for (v, &[lower, upper]) in self.lower_values.iter_mut().zip(&self.sources) {
+        for (v, &[lower, upper]) in self.values.iter_mut().zip(&self.sources) {
             *v = 0.5 * (at(lower) + at(upper));
         }
         // the multipliers' pivots negative, the others of their own sign
@@ -330,8 +385,8 @@ impl SymmetricFirst {
             .symbolic
             .factorize_numeric_ldlt(
                 &mut self.l_values,
-                SparseColMatRef::new(self.lower.as_ref(), &self.lower_values),
-                Side::Lower,
+                SparseColMatRef::new(self.pattern.as_ref(), &self.values),
+                self.side,
                 regularisation,
                 self.par,
                 MemStack::new(&mut self.mem),
@@ -401,17 +456,25 @@ impl SymmetricFirst {
             a_norm,
             krylov: k,
             counts,
+            forward,
+            permuted,
             ..
         } = self;
         let factors = LdltRef::new(symbolic, l_values);
         let mut precondition = |x: &mut [f64]| {
             counts.iterations += 1;
+            for (p, &i) in permuted.iter_mut().zip(forward.iter()) {
+                *p = x[i];
+            }
             factors.solve_in_place_with_conj(
                 Conj::No,
-                MatMut::from_column_major_slice_mut(x, n, 1),
+                MatMut::from_column_major_slice_mut(permuted, n, 1),
                 *par,
                 MemStack::new(mem),
             );
+            for (p, &i) in permuted.iter().zip(forward.iter()) {
+                x[i] = *p;
+            }
         };
         let b_norm = inf_norm(&k.b);
         precondition(x);

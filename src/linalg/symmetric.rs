@@ -622,6 +622,17 @@ mod tests {
         a
     }
 
+    /// Applies `f(row, col, value)` to every stored entry of `a`.
+    fn edit(a: &mut SparseMatrix, mut f: impl FnMut(usize, usize, &mut f64)) {
+        let rows = a.row_indices().to_vec();
+        for j in 0..a.dim() {
+            let (start, end) = (a.column_start(j), a.column_start(j + 1));
+            for (k, &i) in rows.iter().enumerate().take(end).skip(start) {
+                f(i, j, &mut a.values_mut()[k]);
+            }
+        }
+    }
+
     fn rhs(n: usize) -> Vec<f64> {
         (0..n).map(|i| ((7 * i + 3) % 13) as f64 - 6.0).collect()
     }
@@ -668,20 +679,17 @@ mod tests {
     }
 
     /// A strongly non-symmetric matrix (skew part 10 times the diagonal,
-    /// whose symmetric part is a poor preconditioner)
-    /// goes to the LU: the answer is the LU's, and the next factorisations
-    /// go straight to it.
+    /// whose symmetric part is a poor preconditioner) goes to the LU: the
+    /// answer is the LU's, and the next factorisations go straight to it.
     #[test]
     fn strongly_non_symmetric_systems_fall_back_to_the_lu() {
         let mut a = saddle(400, 0.0);
         // a convection-like skew part of 1e5 per entry
-        let pairs: Vec<(usize, usize)> = a.entries().map(|(i, j, _)| (i, j)).collect();
-        for (i, j) in pairs {
+        edit(&mut a, |i, j, v| {
             if i < 400 && j < 400 && i != j {
-                let p = a.position(i, j).unwrap();
-                a.values_mut()[p] += if i < j { 1e5 } else { -1e5 };
+                *v += if i < j { 1e5 } else { -1e5 };
             }
-        }
+        });
         let b = rhs(a.dim());
         let expected = lu_solution(&a, &b);
         let mut solver = SymmetricFirst::analyze(&a).unwrap();
@@ -711,13 +719,11 @@ mod tests {
     #[test]
     fn singular_systems_give_the_lu_error() {
         let mut a = saddle(40, 0.0);
-        let pairs: Vec<(usize, usize)> = a.entries().map(|(i, j, _)| (i, j)).collect();
-        for (i, j) in pairs {
+        edit(&mut a, |i, j, v| {
             if i == 41 || j == 41 {
-                let p = a.position(i, j).unwrap();
-                a.values_mut()[p] = 0.0;
+                *v = 0.0;
             }
-        }
+        });
         let b = rhs(a.dim());
         let mut lu = SparseLu::analyze(&a).unwrap();
         let expected = lu

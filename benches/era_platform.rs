@@ -96,6 +96,20 @@ fn measure(structure: Structure) -> Measured {
         cpu,
         1e3 * wall / (f.iterations + f.wasted_iterations).max(1) as f64,
     );
+    let s = &run.outcome.linear_solver;
+    println!(
+        "  iteration matrix: {} LDLᵀ + {} LU factorisations, {} solves, {} GMRES iterations, {} fall-backs to the LU, {} matrices preconditioned by earlier LU factors; mass system: {} LDLᵀ + {} LU, {} solves, {} GMRES iterations",
+        s.iteration_matrix.symmetric_factorisations,
+        s.iteration_matrix.lu_factorisations,
+        s.iteration_matrix.solves,
+        s.iteration_matrix.iterations,
+        s.iteration_matrix.fallbacks,
+        s.iteration_matrix.reuses,
+        s.mass_system.symmetric_factorisations,
+        s.mass_system.lu_factorisations,
+        s.mass_system.solves,
+        s.mass_system.iterations,
+    );
     Measured {
         name: geometry.name,
         cells: geometry.layout.cells.len(),

@@ -64,7 +64,9 @@ use super::settings::{DynamicSettings, NewtonMethod};
 use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer, WarningInfo};
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
 use crate::elements::{ConstraintKind, ConstraintScaling, EvalContext, Need};
-use crate::linalg::{smallest_relative_pivot, SolveError, SparseMatrix, SymmetricFirst};
+use crate::linalg::{
+    smallest_relative_pivot, SolveError, SolverCounts, SparseMatrix, SymmetricFirst,
+};
 use crate::model::{Id, Model, Prescribed};
 use crate::so3::{self, Mat3, Vec3};
 use crate::state::State;
@@ -181,6 +183,10 @@ pub const LOCK_REGROWTH: f64 = 4.0;
 /// step's motion is noted once (docs/theory.md §15.5).
 pub const FIXED_STEP_ERROR_NOTE: f64 = 1e-2;
 
+/// With fixed steps, the local error estimate is made on the first this
+/// many steps and then on one step in this many (docs/theory.md §15.5).
+pub const FIXED_STEP_CHECKS: usize = 10;
+
 /// The constants of the generalised-α method (D1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GeneralizedAlpha {
@@ -295,6 +301,16 @@ pub enum DynamicError {
     Output(#[from] std::io::Error),
 }
 
+/// Factorisations, solves and GMRES iterations of the two sparse solvers
+/// of a dynamic analysis ([`SymmetricFirst`], docs/theory.md §8).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct LinearSolverCounts {
+    /// The iteration matrix `S` (D7).
+    pub iteration_matrix: SolverCounts,
+    /// The constrained mass system (D9, D13).
+    pub mass_system: SolverCounts,
+}
+
 /// What a dynamic analysis did.
 #[derive(Debug)]
 pub struct DynamicOutcome {
@@ -322,6 +338,9 @@ pub struct DynamicOutcome {
     /// Steps whose modified Newton iterations failed with kept factors and
     /// were retried with fresh ones.
     pub newton_retries: usize,
+    /// What the sparse solvers of the iteration matrix and of the
+    /// constrained mass system did.
+    pub linear_solver: LinearSolverCounts,
     /// Constraint equations removed as redundant (the most at any time).
     pub redundant_constraints: usize,
     /// Rank analyses of the constraints run again during the analysis.
@@ -533,6 +552,9 @@ struct IterationFactors {
     made_for: Option<(f64, Scale)>,
     /// Numeric factorisations so far.
     count: usize,
+    /// What the solvers of earlier symbolic analyses did (the current
+    /// one's are in [`Self::lu`]).
+    retired: SolverCounts,
     /// Modified Newton attempts retried with fresh factors so far.
     retries: usize,
     /// Steps still to start from fresh factors after carried ones served
@@ -573,6 +595,8 @@ struct MassSystem {
     lu: Option<SymmetricFirst>,
     /// Numeric factorisations so far.
     factorisations: usize,
+    /// What the solvers of earlier symbolic analyses did.
+    retired: SolverCounts,
 }
 
 /// Work space of `Φ̇` for the velocity projection (D13), kept from one
@@ -1078,6 +1102,19 @@ impl DynamicAnalysis {
                 r.factors.retries,
             ]
         });
+        let solvers = run.as_ref().map_or(Default::default(), |r| {
+            let total = |retired: SolverCounts, lu: &Option<SymmetricFirst>| {
+                let mut c = retired;
+                if let Some(lu) = lu {
+                    c += lu.counts();
+                }
+                c
+            };
+            LinearSolverCounts {
+                iteration_matrix: total(r.factors.retired, &r.factors.lu),
+                mass_system: total(r.mass_system.retired, &r.mass_system.lu),
+            }
+        });
         let (state, counts, redundant, energies, error, locks) = match run {
             Some(r) => {
                 let mut counts = r.controller.map(|c| c.counts()).unwrap_or_default();
@@ -1112,6 +1149,7 @@ impl DynamicAnalysis {
             factorisations: factored[0],
             mass_factorisations: factored[1],
             newton_retries: factored[2],
+            linear_solver: solvers,
             redundant_constraints: redundant.max(self.solver.redundant_count()),
             rank_analyses: counts.rank_analyses,
             event_retries: counts.event_retries,
@@ -1506,7 +1544,9 @@ fn constrained_mass_system(
     }
     if !buffers.system.as_ref().is_some_and(same) {
         buffers.system = Some(assembler.matrix.clone());
-        buffers.lu = None;
+        if let Some(lu) = buffers.lu.take() {
+            buffers.retired += lu.counts();
+        }
     }
     let (stiffness, mass) = (
         buffers.stiffness.as_mut().expect("set above"),
@@ -2379,7 +2419,9 @@ impl Dynamics<'_> {
         };
         if factors.numbering != numbering || !factors.matrix.as_ref().is_some_and(same) {
             factors.matrix = Some(assembler.matrix.clone());
-            factors.lu = None;
+            if let Some(lu) = factors.lu.take() {
+                factors.retired += lu.counts();
+            }
             factors.numbering = numbering;
         }
         let matrix = factors.matrix.as_mut().expect("set above");
@@ -2926,9 +2968,12 @@ impl Stepper for Dynamics<'_> {
             .newton(size, increment, observer)
             .and_then(|converged| {
                 // before the projection, which replaces the factors of S
-                // the estimate uses (D11a); with fixed steps, until the
-                // note on a long step has been given
-                let error = (self.settings.adaptive || !self.run.watch.fixed_step_noted)
+                // the estimate uses (D11a); with fixed steps, on the first
+                // steps and then on one step in FIXED_STEP_CHECKS, until
+                // the note on a long step has been given
+                let sampled = increment <= FIXED_STEP_CHECKS || increment % FIXED_STEP_CHECKS == 0;
+                let error = (self.settings.adaptive
+                    || (sampled && !self.run.watch.fixed_step_noted))
                     .then(|| self.error_estimate(size));
                 self.project_velocities(size, error.is_some())
                     .map(|()| (converged, error))

@@ -27,7 +27,10 @@ pub mod settings;
 pub mod statics;
 
 pub use control::EventFunction;
-pub use dynamics::{Continuation, DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha};
+pub use dynamics::{
+    Continuation, DynamicAnalysis, DynamicError, DynamicOutcome, GeneralizedAlpha,
+    LinearSolverCounts,
+};
 pub use energy::{Energies, EnergyBalance};
 pub use impact::{ContactInfo, ContactKind, LatchEventKind, LockInfo};
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};

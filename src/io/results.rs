@@ -43,7 +43,7 @@ use super::number::{Sci, Shortest};
 use super::vtk;
 use crate::analysis::{
     AnalysisSettings, ContactKind, DynamicOutcome, Energies, IncrementInfo, LatchEventKind,
-    Observer, StaticAnalysis, StaticOutcome,
+    LinearSolverCounts, Observer, StaticAnalysis, StaticOutcome,
 };
 use crate::elements::{ElementKind, Need};
 use crate::model::Model;
@@ -150,6 +150,9 @@ pub struct DynamicRecord {
     /// Steps whose modified Newton iterations were retried with fresh
     /// factors.
     pub newton_retries: usize,
+    /// Factorisations, solves and GMRES iterations of the sparse solvers
+    /// (docs/results.md).
+    pub linear_solver: LinearSolverCounts,
     /// Wall-clock time, seconds.
     pub wall_time_s: f64,
     /// Energy balance error `(T + V) − (T₀ + V₀) − W + D` at the last
@@ -203,6 +206,7 @@ impl DynamicRecord {
             factorisations: outcome.factorisations,
             mass_factorisations: outcome.mass_factorisations,
             newton_retries: outcome.newton_retries,
+            linear_solver: outcome.linear_solver,
             wall_time_s: outcome.wall_time,
             energy_balance_error: outcome.energies.balance_error,
             largest_energy_balance_error: largest_error.max(outcome.energies.balance_error.abs()),

@@ -2971,7 +2971,8 @@ impl Stepper for Dynamics<'_> {
                 // the estimate uses (D11a); with fixed steps, on the first
                 // steps and then on one step in FIXED_STEP_CHECKS, until
                 // the note on a long step has been given
-                let sampled = increment <= FIXED_STEP_CHECKS || increment % FIXED_STEP_CHECKS == 0;
+                let sampled =
+                    increment <= FIXED_STEP_CHECKS || increment.is_multiple_of(FIXED_STEP_CHECKS);
                 let error = (self.settings.adaptive
                     || (sampled && !self.run.watch.fixed_step_noted))
                     .then(|| self.error_estimate(size));

@@ -403,13 +403,21 @@ impl Assembler {
         if need.inertia.is_some() && self.inertia.len() != total {
             self.inertia = vec![0.0; total];
         }
-        // evaluate elements in parallel, each into its own buffer slices
+        // evaluate elements, in parallel in a large model, each into its
+        // own buffer slices
         let inertia = need.inertia.map(|_| &mut self.inertia[..]);
+        let parallel =
+            model.elements.len() >= PARALLEL_ELEMENTS && rayon::current_num_threads() > 1;
         let layout = Layout {
             offsets: &self.offsets,
             inertia_offsets: &self.tangent_offsets,
         };
-        evaluate_range(
+        let evaluate = if parallel {
+            evaluate_range
+        } else {
+            evaluate_sequentially
+        };
+        evaluate(
             &model.elements,
             &mut self.buffer,
             inertia,
@@ -518,6 +526,14 @@ impl<'a> Layout<'a> {
 /// pool's only worker costs two context switches).
 const SEQUENTIAL_CHUNK: usize = 256;
 
+/// Elements of a model below which its evaluation runs sequentially
+/// whatever the threads. Measured on 2 cores, runs taken in turn: the
+/// ERA platform's deployment (7,788 unknowns) took 92–97 s with its
+/// assembly on two threads (its factorisations on one), 68.6 s with both
+/// on one (docs/theory.md §8); a cantilever of 100,000 beams assembles in
+/// 125–135 ms on two threads against 179–180 ms on one.
+pub const PARALLEL_ELEMENTS: usize = 10_000;
+
 /// Runs `f` on a worker thread of rayon's global pool (at once when the
 /// pool has one thread or the caller is one of its workers), so that the
 /// parallel sections of the assembly and the factorisation fork from a
@@ -528,7 +544,11 @@ const SEQUENTIAL_CHUNK: usize = 256;
 /// 400 steps, 2 threads on the 2 cores, three runs each): 2.22–2.29 s
 /// forked from the main thread, 1.96–1.97 s from a worker, 2.11–2.18 s on
 /// one thread; the heavy top and the 20-beam pendulum, which have no
-/// parallel section, the same either way. Programs driving an analysis
+/// parallel section, the same either way (models of fewer than
+/// [`PARALLEL_ELEMENTS`] elements and systems of fewer than
+/// [`crate::linalg::PARALLEL_UNKNOWNS`] unknowns have none since: the
+/// 320-beam pendulum took 1.90–2.30 s on two threads and 1.93–2.18 s on
+/// one). Programs driving an analysis
 /// call their whole run through it (`unfold run`, the examples).
 pub fn on_worker_thread<R: Send>(f: impl FnOnce() -> R + Send) -> R {
     if rayon::current_num_threads() == 1 || rayon::current_thread_index().is_some() {
@@ -551,34 +571,8 @@ fn evaluate_range(
     state: &State,
     factors: Option<&[Mat3]>,
 ) {
-    if elements.len() <= SEQUENTIAL_CHUNK || rayon::current_num_threads() == 1 {
-        let (base, ibase) = (layout.offsets[0], layout.inertia_offsets[0]);
-        let mut inertia = inertia;
-        for (k, e) in elements.iter().enumerate() {
-            let block = &mut buffer[layout.offsets[k] - base..layout.offsets[k + 1] - base];
-            let n = e.n_local();
-            let (stiffness, residual) = block.split_at_mut(n * n);
-            residual.fill(0.0);
-            let stiffness = ctx.need.stiffness.then(|| {
-                stiffness.fill(0.0);
-                stiffness
-            });
-            let local_inertia = inertia.as_deref_mut().map(|d| {
-                let d = &mut d
-                    [layout.inertia_offsets[k] - ibase..layout.inertia_offsets[k + 1] - ibase];
-                d.fill(0.0);
-                d
-            });
-            let mut out = ElementOutput {
-                residual,
-                stiffness,
-                inertia: local_inertia,
-            };
-            e.evaluate(ctx, state, &mut out);
-            if let (Some(f), Some(k)) = (factors, out.stiffness) {
-                factor_rotation_columns(k, n, e.nodes(), f);
-            }
-        }
+    if elements.len() <= SEQUENTIAL_CHUNK {
+        evaluate_sequentially(elements, buffer, inertia, layout, ctx, state, factors);
         return;
     }
     let mid = elements.len() / 2;
@@ -595,6 +589,45 @@ fn evaluate_range(
         || evaluate_range(&elements[..mid], left, il, ll, ctx, state, factors),
         || evaluate_range(&elements[mid..], right, ir, lr, ctx, state, factors),
     );
+}
+
+/// [`evaluate_range`] on the calling thread.
+fn evaluate_sequentially(
+    elements: &[Box<dyn Element>],
+    buffer: &mut [f64],
+    inertia: Option<&mut [f64]>,
+    layout: Layout,
+    ctx: &EvalContext,
+    state: &State,
+    factors: Option<&[Mat3]>,
+) {
+    let (base, ibase) = (layout.offsets[0], layout.inertia_offsets[0]);
+    let mut inertia = inertia;
+    for (k, e) in elements.iter().enumerate() {
+        let block = &mut buffer[layout.offsets[k] - base..layout.offsets[k + 1] - base];
+        let n = e.n_local();
+        let (stiffness, residual) = block.split_at_mut(n * n);
+        residual.fill(0.0);
+        let stiffness = ctx.need.stiffness.then(|| {
+            stiffness.fill(0.0);
+            stiffness
+        });
+        let local_inertia = inertia.as_deref_mut().map(|d| {
+            let d =
+                &mut d[layout.inertia_offsets[k] - ibase..layout.inertia_offsets[k + 1] - ibase];
+            d.fill(0.0);
+            d
+        });
+        let mut out = ElementOutput {
+            residual,
+            stiffness,
+            inertia: local_inertia,
+        };
+        e.evaluate(ctx, state, &mut out);
+        if let (Some(f), Some(k)) = (factors, out.stiffness) {
+            factor_rotation_columns(k, n, e.nodes(), f);
+        }
+    }
 }
 
 /// `K_{·Θᵢ} ← K_{·Θᵢ} Fᵢ` for every node `i` of an element: the three
@@ -660,6 +693,63 @@ mod tests {
         m.fix(4, &["z", "rx"]);
         m.add_load(6, [0.0, 1.0, 0.0], [0.0; 3]);
         m
+    }
+
+    /// A model of [`PARALLEL_ELEMENTS`] beams (a bent cantilever) is
+    /// assembled on two threads, its elements split over rayon tasks: the
+    /// residual, flux and matrix (stiffness and inertia, factored rotation
+    /// columns) are those of the sequential assembly, bit for bit (each
+    /// element writes its own slices, scattered in one order).
+    #[test]
+    fn parallel_assembly_of_a_large_model_equals_the_sequential_one() {
+        use crate::so3::{skew, Vec3};
+        let mut m = ModelInput::new("long cantilever");
+        m.add_node(1, [0.0; 3]);
+        m.add_node(2, [10.0, 0.0, 0.0]);
+        m.add_section("s", [2.1e8, 8.1e7, 8.1e7, 1.6e5, 2.1e5, 2.1e5]);
+        m.beam_lines.push(crate::model::input::BeamLineInput {
+            nodes: [1, 2],
+            elements: PARALLEL_ELEMENTS,
+            section: "s".into(),
+            orientation: Some([0.0, 0.0, 1.0]),
+            first_node: Some(3),
+            first_element: Some(1),
+            arc_center: None,
+            initial_strain: None,
+            initial_strain_curve: None,
+        });
+        m.fix(1, &["all"]);
+        let model = Model::from_input(&m).expect("valid model");
+        assert!(model.elements.len() >= PARALLEL_ELEMENTS);
+        let dofs = DofMap::new(&model);
+        let mut state = model.initial_state();
+        for i in 0..model.n_nodes() {
+            let s = i as f64 * 1e-3;
+            let d = Vec3::new(0.01 * s.sin(), 0.02 * s, 0.005 * s * s);
+            state.displace_node(i, &d, &Vec3::new(0.3 * s.sin(), -0.2 * s, 0.1 * s.cos()));
+        }
+        let factors: Vec<Mat3> = (0..model.n_nodes())
+            .map(|i| Mat3::identity() + skew(&Vec3::new(1e-3 * i as f64, 0.1, 0.0)) * 0.3)
+            .collect();
+        let ctx = model.context(1.0, Need::with_inertia(30.0, 900.0));
+        let assemble = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut assembler = Assembler::new(&model, &dofs);
+                assembler.assemble_factored(&model, &ctx, &state, &factors);
+                (
+                    assembler.residual.clone(),
+                    assembler.flux.clone(),
+                    assembler.matrix.values().to_vec(),
+                )
+            })
+        };
+        let (parallel, sequential) = (assemble(2), assemble(1));
+        assert!(parallel.2.iter().any(|&v| v != 0.0));
+        assert!(parallel == sequential, "the parallel assembly differs");
     }
 
     /// The block pattern is the set of equation pairs of every element plus

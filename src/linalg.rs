@@ -513,10 +513,19 @@ impl std::fmt::Debug for SparseLu {
     }
 }
 
-fn par_from_threads() -> Par {
-    let n = rayon::current_num_threads();
-    if n > 1 {
-        Par::rayon(n)
+/// Unknowns of a system below which faer factors and solves it on one
+/// thread whatever the threads of the pool. Measured on 2 cores: the ERA
+/// platform's deployment (7,788 unknowns) took 89–91 s with its
+/// factorisations on two threads and its assembly on one, 68 s with both
+/// on one (runs taken in turn); the factorisation and solve of a
+/// cantilever of 600,000 unknowns took 444–464 ms either way.
+pub const PARALLEL_UNKNOWNS: usize = 100_000;
+
+/// faer's parallelism for a system of `n` unknowns.
+fn par_for(n: usize) -> Par {
+    let threads = rayon::current_num_threads();
+    if threads > 1 && n >= PARALLEL_UNKNOWNS {
+        Par::rayon(threads)
     } else {
         Par::Seq
     }
@@ -712,7 +721,7 @@ impl SparseLu {
             LuKernel::Simplicial
         });
 
-        let par = par_from_threads();
+        let par = par_for(n);
         let lu_params: Spec<PartialPivLuParams, f64> = Default::default();
         let (factors, factor_req, solve_req) = match kernel {
             LuKernel::Dense => (

@@ -78,7 +78,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
 use super::{
-    internal, par_from_threads, workspace, SolveError, SparseLu, SparseMatrix, DENSE_UP_TO_UNKNOWNS,
+    internal, par_for, workspace, SolveError, SparseLu, SparseMatrix, DENSE_UP_TO_UNKNOWNS,
 };
 
 /// Normwise backward error that a solve must reach (module header).
@@ -340,7 +340,7 @@ impl SymmetricFirst {
             params,
         )
         .map_err(|e| internal(&e))?;
-        let par = par_from_threads();
+        let par = par_for(n);
         let mem = workspace(
             StackReq::any_of(&[
                 symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),

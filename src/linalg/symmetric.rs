@@ -743,6 +743,16 @@ mod tests {
         x
     }
 
+    /// Factors `a` and solves `a x = b` with `solver`, and checks that
+    /// `x` meets [`BACKWARD_ERROR`].
+    fn solve_to_backward_error(solver: &mut SymmetricFirst, a: &SparseMatrix, b: &[f64]) {
+        solver.factor(a).unwrap();
+        let mut x = b.to_vec();
+        solver.solve_in_place(&mut x).unwrap();
+        let eta = backward_error(a, &x, b);
+        assert!(eta <= BACKWARD_ERROR, "{eta:e}");
+    }
+
     /// `‖b − A x‖∞ / (‖A‖∞ ‖x‖∞ + ‖b‖∞)`, as the module header.
     fn backward_error(a: &SparseMatrix, x: &[f64], b: &[f64]) -> f64 {
         let mut r = vec![0.0; b.len()];
@@ -848,11 +858,7 @@ mod tests {
                 *v *= 1.01;
             }
         });
-        solver.factor(&next).unwrap();
-        let mut x = b.clone();
-        solver.solve_in_place(&mut x).unwrap();
-        let eta = backward_error(&next, &x, &b);
-        assert!(eta <= BACKWARD_ERROR, "{eta:e}");
+        solve_to_backward_error(&mut solver, &next, &b);
         let counts = solver.counts();
         assert_eq!(counts.symmetric_factorisations, 1, "{counts:?}");
         assert_eq!(counts.lu_factorisations, 1, "{counts:?}");
@@ -863,11 +869,7 @@ mod tests {
                 *v = -*v;
             }
         });
-        solver.factor(&next).unwrap();
-        let mut x = b.clone();
-        solver.solve_in_place(&mut x).unwrap();
-        let eta = backward_error(&next, &x, &b);
-        assert!(eta <= BACKWARD_ERROR, "{eta:e}");
+        solve_to_backward_error(&mut solver, &next, &b);
         let counts = solver.counts();
         assert_eq!(counts.lu_factorisations, 2, "{counts:?}");
         assert_eq!(counts.reuses, 2, "{counts:?}");

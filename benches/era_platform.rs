@@ -8,7 +8,8 @@
 //! reports the unknowns, the mean bandwidth, the steps (accepted,
 //! rejected, retried to land on a lock), the Newton iterations, the lock
 //! instants, the wall time and the processor time of the process over the
-//! deployment, and the growth of these from the cell.
+//! deployment (and the wall time to the last lock: deployed and locked),
+//! and the growth of these from the cell.
 
 #[allow(dead_code)]
 #[path = "../examples/era.rs"]
@@ -96,6 +97,12 @@ fn measure(structure: Structure) -> Measured {
         cpu,
         1e3 * wall / (f.iterations + f.wasted_iterations).max(1) as f64,
     );
+    if let Some(w) = f.wall_time_to_last_lock {
+        println!(
+            "  deployed and locked: the last mid-hinge locked at t = {last:.4} s, {w:.2} s of wall time into the analysis (the rest of the wall time follows the locked structure to t = {:.3} s)",
+            run.outcome.time
+        );
+    }
     let s = &run.outcome.linear_solver;
     println!(
         "  iteration matrix: {} LDLᵀ + {} LU factorisations, {} solves, {} GMRES iterations, {} fall-backs to the LU, {} matrices preconditioned by earlier LU factors; mass system: {} LDLᵀ + {} LU, {} solves, {} GMRES iterations",

@@ -196,6 +196,9 @@ pub struct Figures {
     pub peak_latch_moment: f64,
     /// Wall time of the analysis (s).
     pub wall_time: f64,
+    /// Wall time from the start of the analysis to the last lock (s;
+    /// `None` without locks).
+    pub wall_time_to_last_lock: Option<f64>,
 }
 
 /// A deployment run.
@@ -220,6 +223,10 @@ struct DeployObserver<'a> {
     records: Vec<Record>,
     energies: Option<Energies>,
     log: bool,
+    /// When the analysis started, and the wall time (s) from then to the
+    /// last lock so far.
+    started: std::time::Instant,
+    last_lock_wall: Option<f64>,
 }
 
 impl DeployObserver<'_> {
@@ -309,6 +316,7 @@ impl Observer for DeployObserver<'_> {
     }
 
     fn lock(&mut self, info: &LockInfo) {
+        self.last_lock_wall = Some(self.started.elapsed().as_secs_f64());
         if self.log {
             println!(
                 "  t = {:.4} s: latch {} locks (rate {:+.3} rad/s, impulse {:.3e} N·m·s, {:.3e} J lost)",
@@ -390,6 +398,8 @@ pub fn run(
         records: Vec::new(),
         energies: None,
         log,
+        started: std::time::Instant::now(),
+        last_lock_wall: None,
     };
     let outcome = analysis.run(model.initial_state(), &mut observer);
     if let Some(mut recorder) = observer.recorder.take() {
@@ -400,6 +410,7 @@ pub fn run(
             return Err(e.into());
         }
     }
+    let observer_last_lock_wall = observer.last_lock_wall;
     let records = observer.records;
     let hinges: Vec<_> = built.parts.hinges().collect();
     let locks = hinges
@@ -478,6 +489,7 @@ pub fn run(
         hinge_law_work: last.spring_work,
         peak_latch_moment,
         wall_time: outcome.wall_time,
+        wall_time_to_last_lock: observer_last_lock_wall,
     };
     Ok(Run {
         records,

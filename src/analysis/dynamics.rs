@@ -2481,14 +2481,20 @@ impl Dynamics<'_> {
             // S with the residual where a correction with new factors is
             // sure to follow (the predictor without factors kept), or
             // expected to (full Newton whose last contraction, repeated,
-            // leaves the residual above tolerance); else the residual
-            // alone, S assembled after it if needed
+            // leaves the residual above tolerance, or at the first
+            // corrected iterate when the last step needed more than one
+            // correction); else the residual alone, S assembled after it
+            // if needed
             let expected = match progress[..] {
                 [.., previous, now] if previous > 0.0 => now * now / previous,
                 _ => 0.0,
             };
             let with_tangent = match method {
-                NewtonMethod::Full => iteration == 0 || expected > 1.0,
+                NewtonMethod::Full => {
+                    iteration == 0
+                        || expected > 1.0
+                        || (iteration == 1 && self.run.factors.fresh_iterations >= 2)
+                }
                 NewtonMethod::Modified => iteration == 0 && self.run.factors.made_for.is_none(),
             };
             self.assemble_iterate(h, with_tangent, iteration == 0);

@@ -28,6 +28,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::cli::{self, summary};
+use unfold::analysis::dynamics::{LOCK_REGROWTH, RESTART_FLOOR};
 
 /// Length of an arm (m).
 const L: f64 = 0.2;
@@ -201,6 +202,28 @@ fn a_rigid_latch_s_peak_does_not_depend_on_another_lock() {
             .map(|w| w[1] - w[0])
             .fold(f64::NEG_INFINITY, f64::max);
         assert!(rise <= 0.02 * work, "{name}: a step created {rise} J");
+        if offset.is_none() {
+            // the steps grow back from at least RESTART_FLOOR of the
+            // largest step (1e-6 s here), not from the step that landed
+            // on the lock: the step after it is at least 4 times that
+            // (LOCK_REGROWTH; docs/theory.md §16, "Regrowth")
+            let (times, sizes) = (
+                column(&out.join("steps.csv"), "time"),
+                column(&out.join("steps.csv"), "step_size"),
+            );
+            // the lock's step (times written to 13 digits)
+            let k = times
+                .iter()
+                .position(|&t| (t - locked).abs() <= 1e-12 * locked.abs().max(1.0))
+                .expect("the lock's step");
+            let floor = LOCK_REGROWTH * RESTART_FLOOR * 0.01;
+            assert!(
+                // (sizes written to 7 digits)
+                sizes[k + 1] >= floor * (1.0 - 1e-6),
+                "{name}: the step after the lock {} s, the floor {floor} s",
+                sizes[k + 1]
+            );
+        }
         peaks.push(peak);
     }
     // the same peak with and without the second arm, to the sampling of

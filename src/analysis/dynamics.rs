@@ -179,6 +179,11 @@ pub const ENERGY_JUMP: f64 = 0.05;
 /// 1 when each step is at most 4 times the one before.
 pub const LOCK_REGROWTH: f64 = 4.0;
 
+/// The steps after a restart grow back from at least this fraction of
+/// the largest step, however short the step that landed on the event
+/// (docs/theory.md §16, "Regrowth").
+pub const RESTART_FLOOR: f64 = 1e-4;
+
 /// With fixed steps, a local error estimate above this fraction of the
 /// step's motion is noted once (docs/theory.md §15.5).
 pub const FIXED_STEP_ERROR_NOTE: f64 = 1e-2;
@@ -973,8 +978,9 @@ impl DynamicAnalysis {
             controller.resume_after_landing();
         }
         if let (true, Some(step)) = (run.regrowing, step) {
-            // after a lock, at most LOCK_REGROWTH times the step accepted
-            let cap = LOCK_REGROWTH * step;
+            // after a lock, at most LOCK_REGROWTH times the step accepted,
+            // or than RESTART_FLOOR of the largest step
+            let cap = LOCK_REGROWTH * step.max(RESTART_FLOOR * self.settings.max_step);
             if controller.size() > cap {
                 controller.set_size(cap);
             } else {

@@ -372,6 +372,11 @@ impl StepController {
         self.size
     }
 
+    /// The largest step the controller takes (for fixed steps, the step).
+    pub fn largest(&self) -> f64 {
+        self.bounds.max
+    }
+
     /// Sets the size the next step will try (within the bounds), as after
     /// an impact whose rebound must be seen at its top (docs/theory.md
     /// §16.4); the error estimate and the events size the steps after it.

@@ -180,8 +180,8 @@ pub const ENERGY_JUMP: f64 = 0.05;
 pub const LOCK_REGROWTH: f64 = 4.0;
 
 /// The steps after a restart grow back from at least this fraction of
-/// the largest step, however short the step that landed on the event
-/// (docs/theory.md §16, "Regrowth").
+/// the largest step (the step, with fixed steps), however short the step
+/// that landed on the event (docs/theory.md §16, "Regrowth").
 pub const RESTART_FLOOR: f64 = 1e-4;
 
 /// With fixed steps, a local error estimate above this fraction of the
@@ -980,7 +980,7 @@ impl DynamicAnalysis {
         if let (true, Some(step)) = (run.regrowing, step) {
             // after a lock, at most LOCK_REGROWTH times the step accepted,
             // or than RESTART_FLOOR of the largest step
-            let cap = LOCK_REGROWTH * step.max(RESTART_FLOOR * self.settings.max_step);
+            let cap = LOCK_REGROWTH * step.max(RESTART_FLOOR * controller.largest());
             if controller.size() > cap {
                 controller.set_size(cap);
             } else {

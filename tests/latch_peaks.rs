@@ -204,7 +204,7 @@ fn a_rigid_latch_s_peak_does_not_depend_on_another_lock() {
         assert!(rise <= 0.02 * work, "{name}: a step created {rise} J");
         if offset.is_none() {
             // the steps grow back from at least RESTART_FLOOR of the
-            // largest step (1e-6 s here), not from the step that landed
+            // largest step (1e-5 s here), not from the step that landed
             // on the lock: the step after it is at least 4 times that
             // (LOCK_REGROWTH; docs/theory.md §16, "Regrowth")
             let (times, sizes) = (

@@ -57,7 +57,9 @@ use super::{IterationInfo, Observer};
 use crate::assembly::Assembler;
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
 use crate::elements::{ConstraintKind, ElementOutput, Need};
-use crate::linalg::{smallest_relative_pivot, DeterminantSign, LuKernel, SolveError, SparseLu};
+use crate::linalg::{
+    smallest_relative_pivot, DeterminantSign, LuKernel, SolveError, SparseLu, SymmetricFirst,
+};
 use crate::model::{Model, COMPONENT_NAMES};
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -285,6 +287,9 @@ pub struct NewtonSolver {
     pub dofs: DofMap,
     assembler: Assembler,
     lu: Option<SparseLu>,
+    /// Factors of the nearly symmetric systems that the dynamic analysis
+    /// forms on the same pattern (the impacts of locks, docs/theory.md §16).
+    symmetric: Option<SymmetricFirst>,
     rhs: Vec<f64>,
     /// Round-off unit `ε Σⱼ |Kᵢⱼ| sⱼ` of each equation's residual at the
     /// last assessment (the floor is [`FLOOR_FACTOR`] times it).
@@ -357,6 +362,7 @@ impl NewtonSolver {
             dofs,
             assembler,
             lu: None,
+            symmetric: None,
             rhs: vec![0.0; n],
             floor: vec![0.0; n],
             size: vec![0.0; n],
@@ -443,6 +449,7 @@ impl NewtonSolver {
         self.dofs = DofMap::with_suppressed(model, &self.redundant);
         self.assembler = Assembler::new(model, &self.dofs);
         self.lu = None;
+        self.symmetric = None;
         self.numbering += 1;
         self.newton_sign = None;
         self.held_entries = None;
@@ -499,13 +506,14 @@ impl NewtonSolver {
         self.closest_approach_count
     }
 
-    /// The numbering, the assembler and the sparse LU of the current
-    /// numbering, for an analysis that forms its own iteration matrix on
-    /// the same pattern (dynamics). The LU's symbolic analysis is kept
-    /// between calls and dropped when the numbering changes.
-    pub(crate) fn system(&mut self) -> (&DofMap, &mut Assembler, &mut Option<SparseLu>) {
+    /// The numbering, the assembler and a solver of nearly symmetric
+    /// systems of the current numbering, for an analysis that forms its
+    /// own matrices on the same pattern (dynamics). The solver's symbolic
+    /// analysis is kept between calls and dropped when the numbering
+    /// changes.
+    pub(crate) fn system(&mut self) -> (&DofMap, &mut Assembler, &mut Option<SymmetricFirst>) {
         self.fresh = false;
-        (&self.dofs, &mut self.assembler, &mut self.lu)
+        (&self.dofs, &mut self.assembler, &mut self.symmetric)
     }
 
     /// Which numbering of the unknowns is current: it changes whenever the

@@ -52,8 +52,15 @@
 //! indefinite matrix, a singular one), the matrix is factored by the
 //! pivoted LU of [`SparseLu`] and solved with it: the answer is that of
 //! the LU, and so are the errors of a singular matrix. After such a
-//! fall-back the next matrices go to the LU (8, doubled at each further
-//! fall-back up to 64), then the symmetric part is tried again. An LU
+//! fall-back the next 8 matrices ([`SKIP`]) go to the LU, then the
+//! symmetric part is tried again. That number was first doubled at each
+//! further fall-back, up to 64: on the ERA platform the fall-backs come
+//! in bursts (four in its first 0.03 s, whose first steps Newton cuts
+//! back, four after its last lock), and 264 of its 2,360 matrices went to
+//! the LU; with 8 each time, 16 fall-backs and 122 LU factorisations, the
+//! same steps, 44.7 s to 2.5 s instead of 57.6 s and the last lock 31.9 s
+//! into the run instead of 40.1 s (side by side, one thread each; 4 each
+//! time: 24 fall-backs, 111 LU factorisations, slower). An LU
 //! factorisation costing ten of the symmetric part, the LU factors of one
 //! of these matrices serve the next ones as the preconditioner of GMRES
 //! (the same iterations, to the same backward error) until a solve takes
@@ -99,11 +106,9 @@ pub const STALE_ITERATIONS: usize = 12;
 /// took more GMRES iterations than this has the next matrix factored.
 const REFRESH_AFTER: usize = 6;
 
-/// Factorisations sent straight to the LU after the first fall-back.
-const FIRST_SKIP: usize = 8;
-
-/// Largest number of factorisations sent straight to the LU.
-const MAX_SKIP: usize = 64;
+/// Factorisations sent straight to the LU after a fall-back (module
+/// header).
+const SKIP: usize = 8;
 
 /// Positions in `A`'s values of `a_ij` and `a_ji`, [`NONE`] if not stored.
 const NONE: usize = usize::MAX;
@@ -184,10 +189,8 @@ pub struct SymmetricFirst {
     stale: bool,
     /// The next matrix is factored afresh.
     refresh: bool,
-    /// Factorisations still to send straight to the LU, and how many the
-    /// next fall-back sends.
+    /// Factorisations still to send straight to the LU.
     skip: usize,
-    next_skip: usize,
     krylov: Krylov,
     counts: SolverCounts,
 }
@@ -370,7 +373,6 @@ impl SymmetricFirst {
             stale: false,
             refresh: false,
             skip: 0,
-            next_skip: FIRST_SKIP,
             krylov: Krylov {
                 v: vec![0.0; n * (m + 1)],
                 z: vec![0.0; n * m],
@@ -505,8 +507,7 @@ impl SymmetricFirst {
             lu.solve_in_place(rhs)?;
             // the LU solved what GMRES did not: send the next matrices to
             // it (a matrix that neither solves is no reason to)
-            self.skip = self.next_skip;
-            self.next_skip = (2 * self.next_skip).min(MAX_SKIP);
+            self.skip = SKIP;
             return Ok(());
         }
         let lu = self.lu.as_mut().expect("factored by the LU");

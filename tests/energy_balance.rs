@@ -77,10 +77,12 @@ rho_infinity = {rho_infinity:?}"#
 /// Reference: `ρ∞ = 1` (the trapezoidal rule: no numerical dissipation,
 /// and D12a is then the midpoint rule, exact for the linear damper),
 /// `D` = 0.3844 J, `E` = 4e-5 J. Tolerances: `|E|` below 1 % of `D`
-/// (measured 0.45 %; the trapezoidal rule on the power gave 38 %), `D`
-/// within 2 % of the reference (measured 0.28 %), and the trapezoidal
-/// rule on the power over-counting by more than 0.1 J in the same run (so
-/// that the test tells the two quadratures apart).
+/// (measured 0.03 %, 0.45 % before the steps anticipated the lock,
+/// docs/theory.md §13; the trapezoidal rule on the power gave 38 %), `D`
+/// within 2 % of the reference (measured 0.14 %), and the trapezoidal
+/// rule on the power over-counting by more than 10 % of `D` in the same
+/// run (measured 16 %; 62 % before the steps anticipated the lock), so
+/// that the test tells the two quadratures apart.
 #[test]
 fn damping_of_vibrations_the_steps_do_not_resolve_is_not_over_counted() {
     let (run_, trapezoid) = run(&flexible_hinge(0.9));
@@ -109,7 +111,7 @@ fn damping_of_vibrations_the_steps_do_not_resolve_is_not_over_counted() {
         r.dissipated
     );
     assert!(
-        trapezoid - e.dissipated > 0.1,
+        trapezoid - e.dissipated > 0.1 * e.dissipated,
         "trapezoidal rule {trapezoid:.4e} J, D12a {:.4e} J",
         e.dissipated
     );

@@ -150,6 +150,13 @@ pub trait EventFunction: Send {
     fn value(&self, model: &Model, state: &State) -> f64;
     /// `|g|` at or below which a step has landed on the event.
     fn tolerance(&self) -> f64;
+    /// `g` varies smoothly with the motion, so that its rate over the
+    /// last accepted step tells when it will cross (docs/theory.md §13,
+    /// "Anticipation"); not for a function that jumps (a spring latch's
+    /// watch, ±1).
+    fn anticipated(&self) -> bool {
+        false
+    }
 }
 
 /// Why the controller stopped an analysis.
@@ -269,6 +276,9 @@ pub struct StepMemory {
     crossing: Option<Crossing>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     approach: Option<f64>,
+    /// The time and the event functions of the accepted state before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    previous_events: Option<(f64, Vec<f64>)>,
 }
 
 impl StepMemory {
@@ -301,6 +311,9 @@ pub struct StepController {
     /// The size of the step that first crossed the event being located
     /// (or last landed on), before it was shortened to land.
     approach: Option<f64>,
+    /// The time and the event functions of the accepted state before the
+    /// current one: their rates over the last step.
+    previous_events: Option<(f64, Vec<f64>)>,
     /// The size of the next step is set by the error estimate.
     error_controlled: bool,
     /// Error estimate of the last accepted step (at least
@@ -337,6 +350,7 @@ impl StepController {
             event_sides: Vec::new(),
             crossing: None,
             approach: None,
+            previous_events: None,
             error_controlled: false,
             last_error: None,
             rejected: false,
@@ -409,6 +423,7 @@ impl StepController {
             event_sides: self.event_sides.clone(),
             crossing: self.crossing,
             approach: self.approach,
+            previous_events: self.previous_events.clone(),
         }
     }
 
@@ -428,6 +443,10 @@ impl StepController {
             self.event_sides.clone_from(&memory.event_sides);
             self.crossing = memory.crossing.filter(|c| c.event < self.events.len());
             self.approach = memory.approach;
+            self.previous_events = memory
+                .previous_events
+                .clone()
+                .filter(|(_, g)| g.len() == self.events.len());
         }
     }
 
@@ -451,6 +470,32 @@ impl StepController {
             .iter()
             .map(|&g| if g < 0.0 { -1.0 } else { 1.0 })
             .collect();
+        self.previous_events = None;
+    }
+
+    /// The time from `t` (the accepted state) to the first crossing that
+    /// the event functions' rates over the last step bring, if any: the
+    /// zero of the line through their values at the last two accepted
+    /// states, for each function moving towards its zero and farther
+    /// from it than its tolerance.
+    fn anticipated_crossing(&self, t: f64) -> Option<f64> {
+        let (t0, before) = self.previous_events.as_ref()?;
+        let dt = t - t0;
+        if dt <= 0.0 {
+            return None;
+        }
+        self.events
+            .iter()
+            .zip(&self.event_values)
+            .zip(&self.event_sides)
+            .zip(before)
+            .filter(|(((event, _), _), _)| event.anticipated())
+            .filter_map(|(((event, &g), &side), &g0)| {
+                let rate = (g - g0) / dt;
+                (g * side > event.tolerance() && rate * side < 0.0).then(|| -g / rate)
+            })
+            .filter(|d| d.is_finite())
+            .reduce(f64::min)
     }
 
     /// The next time to land on after `t`: an output time or `end_time`.
@@ -516,13 +561,21 @@ impl StepController {
             let (target, output_time) = self.target(t);
             let snap = LANDING_SNAP * self.end_time.abs().max(t.abs());
             let mut size = self.size;
+            let in_time = stepper.sized_in_time();
             if let Some(c) = self.crossing {
                 // never below min_step: a crossing grazed by a slow motion
                 // would otherwise shrink each landing step by 1/0.02
                 let landing = c.span * c.fraction(self.event_values[c.event]);
                 size = size.min(landing.max(self.landing_floor()));
+            } else if in_time {
+                // a step that the events' rates bring to a crossing ends
+                // where they bring it (docs/theory.md §13, "Anticipation")
+                if let Some(d) = self.anticipated_crossing(t) {
+                    if d < size {
+                        size = d.max(self.landing_floor());
+                    }
+                }
             }
-            let in_time = stepper.sized_in_time();
             let mut lands = false;
             if in_time {
                 size = size.min(target - t);
@@ -660,6 +713,13 @@ impl StepController {
                 for &i in &landed {
                     // the accepted state counts as past the crossing
                     self.event_sides[i] = -self.event_sides[i];
+                }
+                match &mut self.previous_events {
+                    Some((t0, before)) => {
+                        *t0 = t;
+                        before.clone_from(&self.event_values);
+                    }
+                    None => self.previous_events = Some((t, self.event_values.clone())),
                 }
                 for (i, &g) in values.iter().enumerate() {
                     self.event_values[i] = g;
@@ -1029,6 +1089,50 @@ mod tests {
         let at = steps.iter().find(|i| i.time == e.time).unwrap();
         assert!(at.output);
         assert!(c.counts().event_retries >= 1);
+        assert_eq!(steps.last().unwrap().time, 1.0);
+    }
+
+    /// A step that the event's rate over the last step brings to its
+    /// zero ends there: `g = √x − 0.55 = t − 0.55` moves at a constant
+    /// rate, so the step from t = 0.5 is cut to 0.05 and lands on the
+    /// crossing without a retry (docs/theory.md §13, "Anticipation").
+    #[test]
+    fn a_crossing_the_rates_predict_is_landed_on_without_a_retry() {
+        struct Linear;
+        impl EventFunction for Linear {
+            fn name(&self) -> String {
+                "t = 0.55".into()
+            }
+            fn value(&self, _: &Model, s: &State) -> f64 {
+                s.x[1].x.sqrt() - 0.55
+            }
+            fn tolerance(&self) -> f64 {
+                1e-10
+            }
+            fn anticipated(&self) -> bool {
+                true
+            }
+        }
+        let bounds = StepBounds {
+            initial: 0.1,
+            min: 1e-9,
+            max: 0.1,
+        };
+        let mut c = StepController::new(bounds, 1.0)
+            .with_events(vec![Box::new(Linear)])
+            .with_output_every(1000);
+        let mut s = Scalar::new(1.0, None);
+        let steps = run(&mut c, &mut s);
+        assert_eq!(c.counts().event_retries, 0);
+        let k = steps
+            .iter()
+            .position(|i| (i.time - 0.55).abs() <= 1e-12)
+            .expect("a step ends on the crossing");
+        assert!((steps[k].step - 0.05).abs() <= 1e-12, "{}", steps[k].step);
+        assert!(steps[k].output, "the landing is written");
+        // the steps before it were not shortened: the rate is taken over
+        // accepted steps only
+        assert!(steps[..k].iter().all(|i| (i.step - 0.1).abs() <= 1e-12));
         assert_eq!(steps.last().unwrap().time, 1.0);
     }
 

@@ -138,6 +138,7 @@ pub struct LatchEvent {
     element: usize,
     name: String,
     tolerance: f64,
+    rigid: bool,
 }
 
 impl EventFunction for LatchEvent {
@@ -156,6 +157,11 @@ impl EventFunction for LatchEvent {
     fn tolerance(&self) -> f64 {
         self.tolerance
     }
+    /// A rigid latch's `g = s (c − c_L)` follows the motion; a spring
+    /// latch's watch jumps between ±1.
+    fn anticipated(&self) -> bool {
+        self.rigid
+    }
 }
 
 /// The event functions of the model's latches.
@@ -166,6 +172,7 @@ pub fn latch_events(model: &Model) -> Vec<Box<dyn EventFunction>> {
             events.push(Box::new(LatchEvent {
                 element,
                 name: format!("latch {}", e.id()),
+                rigid: l.spring().is_none(),
                 tolerance: if l.spring().is_some() {
                     1.0
                 } else {

@@ -143,7 +143,13 @@ pub enum SolveError {
 pub struct SparseMatrix {
     symbolic: SymbolicSparseColMat<usize>,
     values: Vec<f64>,
+    /// Which pattern this is: unique to each pattern built, kept by its
+    /// clones ([`Self::same_pattern`]).
+    pattern: u64,
 }
+
+/// The identity of the next pattern built.
+static NEXT_PATTERN: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl SparseMatrix {
     /// Builds the pattern from `(row, col)` pairs (duplicates allowed) of an
@@ -191,7 +197,17 @@ impl SparseMatrix {
         Self {
             symbolic,
             values: vec![0.0; nnz],
+            pattern: NEXT_PATTERN.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
+    }
+
+    /// Whether `other` has this matrix's pattern because it is a clone of
+    /// it (or of its clones): a check in O(1) where comparing the row
+    /// indices costs a pass over them. Two patterns built apart are not
+    /// the same, even if equal.
+    #[inline]
+    pub fn same_pattern(&self, other: &SparseMatrix) -> bool {
+        self.pattern == other.pattern
     }
 
     /// Start of column `j` in the value array.

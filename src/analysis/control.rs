@@ -56,6 +56,10 @@ pub const PI_PROPORTIONAL: f64 = 0.4;
 /// after a stretch of steps with nearly no error (at rest, before a load)
 /// the first step with a finite error is not taken for a steep trend.
 pub const ERROR_MEMORY_FLOOR: f64 = 1e-2;
+/// A crossing that an event function's rate at the accepted state puts
+/// within this fraction of the last step is anticipated from that rate
+/// rather than from the chord of the last step (docs/theory.md §13).
+pub const NEAR_CROSSING: f64 = 0.1;
 /// Retries of one step to land on an event before the event is taken as
 /// happening within the step where it was found.
 pub const MAX_EVENT_RETRIES: usize = 30;
@@ -156,6 +160,13 @@ pub trait EventFunction: Send {
     /// watch, ±1).
     fn anticipated(&self) -> bool {
         false
+    }
+    /// `dg/dt` at `state`, for an [`Self::anticipated`] function that
+    /// knows it: near its zero, the crossing is anticipated from it
+    /// rather than from the rate over the last step (docs/theory.md §13,
+    /// "Anticipation").
+    fn rate(&self, _model: &Model, _state: &State) -> Option<f64> {
+        None
     }
 }
 
@@ -478,12 +489,19 @@ impl StepController {
     /// zero of the line through their values at the last two accepted
     /// states, for each function moving towards its zero and farther
     /// from it than its tolerance.
-    fn anticipated_crossing(&self, t: f64) -> Option<f64> {
+    ///
+    /// A crossing that the function's own rate at the accepted state
+    /// brings within [`NEAR_CROSSING`] of the last step is anticipated
+    /// from that rate instead (Newton's step on `g`): so near, the chord
+    /// of the last step misses by `½ g̈ d (d + Δt)` where the tangent
+    /// misses by `½ g̈ d²`.
+    fn anticipated_crossing<S: Stepper + ?Sized>(&self, t: f64, stepper: &S) -> Option<f64> {
         let (t0, before) = self.previous_events.as_ref()?;
         let dt = t - t0;
         if dt <= 0.0 {
             return None;
         }
+        let (model, state) = stepper.current();
         self.events
             .iter()
             .zip(&self.event_values)
@@ -491,8 +509,16 @@ impl StepController {
             .zip(before)
             .filter(|(((event, _), _), _)| event.anticipated())
             .filter_map(|(((event, &g), &side), &g0)| {
-                let rate = (g - g0) / dt;
-                (g * side > event.tolerance() && rate * side < 0.0).then(|| -g / rate)
+                if g * side <= event.tolerance() {
+                    return None;
+                }
+                let tangent = event
+                    .rate(model, state)
+                    .filter(|&r| r * side < 0.0)
+                    .map(|r| -g / r)
+                    .filter(|&d| d <= NEAR_CROSSING * dt);
+                let chord = (g - g0) / dt;
+                tangent.or_else(|| (chord * side < 0.0).then(|| -g / chord))
             })
             .filter(|d| d.is_finite())
             .reduce(f64::min)
@@ -570,7 +596,7 @@ impl StepController {
             } else if in_time {
                 // a step that the events' rates bring to a crossing ends
                 // where they bring it (docs/theory.md §13, "Anticipation")
-                if let Some(d) = self.anticipated_crossing(t) {
+                if let Some(d) = self.anticipated_crossing(t, stepper) {
                     if d < size {
                         size = d.max(self.landing_floor());
                     }

@@ -187,6 +187,10 @@ pub const LOCK_REGROWTH: f64 = 4.0;
 /// follows within 0.2 % (at 1e-2 the peak falls 18 % short).
 pub const RESTART_FLOOR: f64 = 1e-3;
 
+/// The first step of an analysis is at most the one over which the
+/// initial angular accelerations turn a node by this (rad).
+pub const START_ROTATION: f64 = 0.1;
+
 /// With fixed steps, a local error estimate above this fraction of the
 /// step's motion is noted once (docs/theory.md §15.5).
 pub const FIXED_STEP_ERROR_NOTE: f64 = 1e-2;
@@ -895,6 +899,16 @@ impl DynamicAnalysis {
                         .collect(),
                 ),
         );
+        if !self.continued {
+            if let (Some(h), Some(c)) = (
+                start_step(&self.solver.dofs, &run.state),
+                run.controller.as_mut(),
+            ) {
+                if h < c.size() {
+                    c.set_size(h);
+                }
+            }
+        }
         // a continued run goes on with what the run that wrote its state
         // knew there: the controller's next size and memory, the regrowth
         // after a lock, a_{n−1} and the mass scales
@@ -1540,11 +1554,7 @@ fn constrained_mass_system(
 ) -> Result<[f64; 2], NewtonFailure> {
     let t = state.time;
     let (dofs, assembler, _) = solver.system();
-    let same = |m: &SparseMatrix| {
-        m.dim() == assembler.matrix.dim()
-            && m.nnz() == assembler.matrix.nnz()
-            && m.row_indices() == assembler.matrix.row_indices()
-    };
+    let same = |m: &SparseMatrix| m.same_pattern(&assembler.matrix);
     let mut mass_assembled = mass_assembled;
     if !buffers.stiffness.as_ref().is_some_and(same) {
         buffers.stiffness = Some(assembler.matrix.clone());
@@ -1917,6 +1927,19 @@ fn restart_after_impact(
     initial_accelerations(model, solver, run, end_time)
 }
 
+/// The step whose rotations the initial angular accelerations predict,
+/// `½ |Ω̇₀| h²`, reach [`START_ROTATION`]: `None` when no free node turns.
+fn start_step(dofs: &DofMap, state: &State) -> Option<f64> {
+    let largest = (0..state.n_nodes())
+        .filter(|&node| (3..6).any(|c| dofs.equation(6 * node + c) != NO_EQUATION))
+        .map(|node| {
+            let a = &state.acceleration[node];
+            (a[3] * a[3] + a[4] * a[4] + a[5] * a[5]).sqrt()
+        })
+        .fold(0.0f64, f64::max);
+    (largest > 0.0 && largest.is_finite()).then(|| (2.0 * START_ROTATION / largest).sqrt())
+}
+
 /// The failure of a singular or nearly singular iteration matrix: the
 /// unknown without stiffness or mass.
 /// `matrix` is the one that failed to factor or solve.
@@ -2102,7 +2125,7 @@ impl Dynamics<'_> {
             if buffers
                 .damping
                 .as_ref()
-                .is_none_or(|c| c.row_indices() != assembler.matrix.row_indices())
+                .is_none_or(|c| !c.same_pattern(&assembler.matrix))
             {
                 buffers.damping = Some(assembler.matrix.clone());
                 buffers.damping_rest = Some(assembler.matrix.clone());
@@ -2423,9 +2446,7 @@ impl Dynamics<'_> {
         scale.apply(&run.work, &mut assembler.matrix);
         let factors = &mut run.factors;
         factors.made_for = None;
-        let same = |m: &SparseMatrix| {
-            m.nnz() == assembler.matrix.nnz() && m.row_indices() == assembler.matrix.row_indices()
-        };
+        let same = |m: &SparseMatrix| m.same_pattern(&assembler.matrix);
         if factors.numbering != numbering || !factors.matrix.as_ref().is_some_and(same) {
             factors.matrix = Some(assembler.matrix.clone());
             if let Some(lu) = factors.lu.take() {
@@ -2825,11 +2846,7 @@ impl Dynamics<'_> {
         work.kept.clone_from(&assembler.residual);
         work.kept_flux.clone_from(&assembler.flux);
         let buffers = &mut run.mass_system;
-        let same = |m: &SparseMatrix| {
-            m.dim() == assembler.matrix.dim()
-                && m.nnz() == assembler.matrix.nnz()
-                && m.row_indices() == assembler.matrix.row_indices()
-        };
+        let same = |m: &SparseMatrix| m.same_pattern(&assembler.matrix);
         if !buffers.stiffness.as_ref().is_some_and(same) {
             buffers.stiffness = Some(assembler.matrix.clone());
             buffers.mass = Some(assembler.matrix.clone());
@@ -3042,7 +3059,6 @@ impl Stepper for Dynamics<'_> {
             &run.accepted,
             &mut run.state,
             info.increment,
-            self.settings.end_time,
         )? {
             Some(i) => {
                 run.lock_rank_analyses += 1;

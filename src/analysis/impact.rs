@@ -15,11 +15,12 @@
 //! ```
 //!
 //! `M` the assembled mass matrix, `B` the gradients of the constraints,
-//! `kπ` the impulses, so that `Φ̇⁺ = 0`. It is solved in two stages
-//! ([`lock_latches`]): the velocities made consistent with the constraints
-//! already active (their rates `Φ̇⁻`, which index-3 integration leaves
-//! slightly off zero), then the lock (`Φ̇⁻ = ċ⁻` on the latch's row, the
-//! others kept). The energy lost is the second stage's `½ Δvᵀ M Δv`
+//! `kπ` the impulses, so that `Φ̇⁺ = 0`. For a latch's lock
+//! ([`lock_latches`]) `Φ̇⁻ = ċ⁻` on the latch's row, the constraints
+//! already active keeping their rates, which the projection of every
+//! accepted step's velocities (D13) leaves at round-off; a stop's impact
+//! ([`stop_events_at`]) is solved in two stages, the velocities made
+//! consistent with the constraints active first. The energy lost is `½ Δvᵀ M Δv`
 //! (Carnot's loss, docs/theory.md §16, LK3), momentum is conserved (the
 //! impulses are internal), and the integrator restarts from the
 //! post-impact state with consistent accelerations (D9).
@@ -111,15 +112,11 @@ pub struct LockInfo {
     /// spring latch that releases, the energy its spring held (it leaves
     /// the model with the latch); 0 when a spring latch latches.
     pub energy_lost: f64,
-    /// `T⁻ − T⁺`, the drop of the kinetic energy: the energy lost plus
-    /// [`Self::velocity_correction`] (when no constraint depends on time),
-    /// up to round-off.
+    /// `T⁻ − T⁺`, the drop of the kinetic energy: for a latch's lock the
+    /// energy lost (when no constraint depends on time), up to round-off;
+    /// for a stop's impact, also the energy of the correction of the
+    /// velocities before it (`T⁻ − T₁`, docs/theory.md §16.4).
     pub kinetic_energy_drop: f64,
-    /// `T⁻ − T₁`: the kinetic energy of the joints' velocity error at the
-    /// lock (index-3 integration satisfies the constraints at position
-    /// level only), removed before the impact; an error of the
-    /// integration, left in the energy balance's error.
-    pub velocity_correction: f64,
 }
 
 /// `|g|` at or below which a step has landed on `latch`'s lock.
@@ -161,6 +158,13 @@ impl EventFunction for LatchEvent {
     /// latch's watch jumps between ±1.
     fn anticipated(&self) -> bool {
         self.rigid
+    }
+    /// `ġ = s ċ` of an open rigid latch.
+    fn rate(&self, model: &Model, state: &State) -> Option<f64> {
+        match model.elements[self.element].as_latch() {
+            Some(l) if self.rigid && !l.is_locked(state) => Some(l.gap_rate(state)),
+            _ => None,
+        }
     }
 }
 
@@ -444,15 +448,11 @@ fn jump(
 /// to their value from the side of approach (`g` from below `−tol` to at
 /// least `−tol`), runs the rank analysis of the constraints again, and
 /// applies the impact to the velocities of `state` (see the module
-/// documentation), in two stages:
-///
-/// 1. the velocities are made consistent with the constraints already
-///    active (`Φ̇ = 0`; index-3 integration satisfies them at position
-///    level only), the latches still open: an M-orthogonal projection whose
-///    energy, `T⁻ − T₁`, is an error of the integration, reported apart;
-/// 2. the impact of the locks from those velocities, `B_L Δv = −ċ`, the
-///    other constraints keeping their rates: its `½ ΔvᵀMΔv` is the energy
-///    lost (Carnot's, exactly, for the velocities of stage 1).
+/// documentation): `B_L Δv = −ċ` on the locks, the other constraints
+/// keeping their rates, whose `½ ΔvᵀMΔv` is the energy lost (Carnot's).
+/// The velocities of `state` are those of an accepted step, projected on
+/// the constraints active at it (D13), which the open latches are not
+/// part of: their rates are round-off.
 ///
 /// `None` if no latch locked. The accelerations are left to the caller
 /// (D9 at the post-impact state).
@@ -462,7 +462,6 @@ pub fn lock_latches(
     before: &State,
     state: &mut State,
     increment: usize,
-    end_time: f64,
 ) -> Result<Option<Impact>, DynamicError> {
     let reached: Vec<&Latch> = model
         .elements
@@ -506,18 +505,7 @@ pub fn lock_latches(
     };
     let kinetic_before = energy::energies(model, state).kinetic;
 
-    // 1. velocities consistent with the constraints already active
-    let correction = if solver.dofs.first_multiplier() < solver.dofs.n_dofs() {
-        let (rates, _) = constraint_rates(model, solver, state, end_time);
-        jump(model, solver, state, &|_, d| -rates[d], &[])
-            .map_err(failed)?
-            .energy
-    } else {
-        0.0
-    };
-    let kinetic_consistent = energy::energies(model, state).kinetic;
-
-    // 2. the locks: the active set changes, rank analysis again
+    // the locks: the active set changes, rank analysis again
     let struck: Vec<(f64, Vec<f64>)> = reached.iter().map(|l| l.rate(state)).collect();
     for l in &reached {
         l.lock(state);
@@ -568,14 +556,13 @@ pub fn lock_latches(
             },
             energy_lost: j.energy,
             kinetic_energy_drop: kinetic_before - kinetic_after,
-            velocity_correction: correction,
         })
         .collect();
     Ok(Some(Impact {
         locks,
         redundant: rank.redundant.len(),
-        // T⁺ − T₁ = W − ½ΔvᵀMΔv
-        work: kinetic_after - kinetic_consistent + j.energy,
+        // T⁺ − T⁻ = W − ½ΔvᵀMΔv
+        work: kinetic_after - kinetic_before + j.energy,
     }))
 }
 
@@ -689,7 +676,6 @@ fn spring_event(l: &Latch, state: &State, kind: LatchEventKind, increment: usize
         impulse: 0.0,
         energy_lost: 0.0,
         kinetic_energy_drop: 0.0,
-        velocity_correction: 0.0,
     }
 }
 

@@ -418,6 +418,11 @@ impl Latch {
         self.approach * (self.coordinate(state) - self.value)
     }
 
+    /// `ġ = s ċ`, the rate of [`Self::gap`].
+    pub fn gap_rate(&self, state: &State) -> f64 {
+        self.approach * self.rate(state).0
+    }
+
     /// `ċ = B v`: the rate of the coordinate at the state's velocities,
     /// and its gradient `B` over the pair's local unknowns (6 per node:
     /// `Δx` global, `ΔΘ` material, conjugate to `(ẋ, Ω)`).

@@ -188,7 +188,8 @@ pub const LOCK_REGROWTH: f64 = 4.0;
 pub const RESTART_FLOOR: f64 = 1e-3;
 
 /// The first step of an analysis is at most the one over which the
-/// initial angular accelerations turn a node by this (rad).
+/// initial angular accelerations turn a node by this (rad; docs/theory.md
+/// §15.5, "First step").
 pub const START_ROTATION: f64 = 0.1;
 
 /// With fixed steps, a local error estimate above this fraction of the

@@ -112,10 +112,8 @@ pub struct LockInfo {
     /// spring latch that releases, the energy its spring held (it leaves
     /// the model with the latch); 0 when a spring latch latches.
     pub energy_lost: f64,
-    /// `T⁻ − T⁺`, the drop of the kinetic energy: for a latch's lock the
-    /// energy lost (when no constraint depends on time), up to round-off;
-    /// for a stop's impact, also the energy of the correction of the
-    /// velocities before it (`T⁻ − T₁`, docs/theory.md §16.4).
+    /// `T⁻ − T⁺`, the drop of the kinetic energy: the energy lost (when
+    /// no constraint depends on time), up to round-off.
     pub kinetic_energy_drop: f64,
 }
 

@@ -477,6 +477,7 @@ fn first_motion(plan: &[AnalysisSettings]) -> Option<&DynamicSettings> {
 fn dynamic_exit_code(error: &DynamicError) -> u8 {
     match error {
         DynamicError::InconsistentVelocity { .. }
+        | DynamicError::NoMass
         | DynamicError::StartsBeyondLimit { .. }
         | DynamicError::Initial {
             failure: NewtonFailure::Singular { .. },

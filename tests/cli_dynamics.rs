@@ -189,6 +189,45 @@ fn pendulum_run_writes_velocities_and_a_small_energy_balance() {
         .starts_with("completed: 121 steps, 0 rejected"));
 }
 
+/// The same sequence with its load given no curve: the default ramp
+/// f = t of a sequence that starts static goes on growing through the
+/// dynamic analysis (docs/model-format.md, "Loads in time"), which `check`
+/// and `run` warn about, naming the load and the analysis; with the curve
+/// written, no such warning.
+#[test]
+fn a_load_ramped_through_the_motion_after_a_preload_is_warned_about() {
+    let dir = scratch("ramped");
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/boom_release.toml"),
+    )
+    .unwrap();
+    assert!(text.contains("curve = \"preload_release\""));
+    for (name, text, warned) in [
+        (
+            "ramped",
+            text.replace("curve = \"preload_release\"", ""),
+            true,
+        ),
+        (
+            "confirmed",
+            text.replace("curve = \"preload_release\"", "curve = \"ramp\""),
+            false,
+        ),
+        ("held", text.clone(), false),
+    ] {
+        let model = dir.join(format!("{name}.toml"));
+        std::fs::write(&model, text).unwrap();
+        let check = Command::new(env!("CARGO_BIN_EXE_unfold"))
+            .args(["check", model.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let err = stderr(&check);
+        assert!(check.status.success(), "{name}: {err}");
+        let warning = "loads[1] (node 11): follows the default ramp f = t, which goes on growing through the dynamic analysis[2] (t = 1 to 2.5)";
+        assert_eq!(err.contains(warning), warned, "{name}: {err}");
+    }
+}
+
 /// Static preload, release (dynamic), modes about the final state
 /// (examples/boom_release.toml): one set of files, steps numbered on, the
 /// free vibration at the frequency the modal analysis finds.
@@ -483,6 +522,67 @@ fn a_restart_into_its_own_results_directory_is_refused() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// A dynamic analysis of a model without mass (a cantilever whose section
+/// has no `mass_per_length`) has no motion to follow: refused by `check`
+/// and by `run` with exit 2, as a modal analysis of it is, instead of a
+/// run of Newton iterations on a state that does not move.
+#[test]
+fn a_dynamic_analysis_of_a_model_without_mass_is_refused() {
+    let dir = scratch("massless");
+    let model = dir.join("massless.toml");
+    std::fs::write(
+        &model,
+        "[analysis]
+type = \"dynamic\"
+end_time = 1.0
+time_step = 0.02
+
+[[sections]]
+name = \"s\"
+EA = 1.0e6
+GA2 = 4.0e5
+GA3 = 4.0e5
+GJ = 50.0
+EI2 = 50.0
+EI3 = 50.0
+
+[[nodes]]
+id = 1
+x = [0.0, 0.0, 0.0]
+
+[[nodes]]
+id = 2
+x = [1.0, 0.0, 0.0]
+
+[[beam_lines]]
+nodes = [1, 2]
+elements = 4
+section = \"s\"
+
+[[supports]]
+node = 1
+fixed = [\"all\"]
+
+[[loads]]
+node = 2
+force = [0.0, 0.0, -1.0]
+",
+    )
+    .unwrap();
+    let check = Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args(["check", model.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(check.status.code(), Some(2), "{}", stderr(&check));
+    let o = run(&model, &dir.join("out"), &[]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("massless.toml") && err.contains("the model has no mass"),
+        "{err}"
+    );
+}
+
 /// Bad input is refused before any step, exit 2, naming the analysis or
 /// the entity and what is wrong.
 #[test]
@@ -556,6 +656,14 @@ fn bad_dynamic_input_is_refused_with_exit_2() {
             assert!(err.contains(w), "{name}: {w:?} not in {err}");
         }
         assert!(err.contains(&format!("{name}.toml")), "{name}: {err}");
+        if name == "step" {
+            // min_step and max_step were not given: their defaults, derived
+            // from time_step, are not reported as errors of their own
+            assert!(
+                !err.contains("min_step") && !err.contains("max_step"),
+                "{err}"
+            );
+        }
     }
 }
 

@@ -195,6 +195,7 @@ fn sigint_stops_after_a_step_with_consistent_files() {
     );
     assert_eq!(s["output_steps"].as_u64().unwrap() as usize, steps);
     assert!(s["message"].as_str().unwrap().contains("SIGINT"));
+    assert_counts_include_the_last_step(&out, &s);
     let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
     assert!(
         log.lines().last().unwrap().starts_with("interrupted:"),
@@ -225,13 +226,65 @@ fn a_second_signal_ends_the_run_at_once() {
     let run = Run::start(&model, &out);
     wait_for_steps(&out, 1);
     run.signal(libc::SIGINT);
-    std::thread::sleep(Duration::from_millis(200));
+    // later than unfold::io::run::SAME_REQUEST (250 ms): a second request
+    std::thread::sleep(Duration::from_millis(600));
     run.signal(libc::SIGINT);
     let (code, err) = run.finish();
     assert_eq!(code, 130, "{err}");
     assert!(err.contains("stopping at once"), "{err}");
     assert_eq!(assert_consistent(&out).0, 1);
     assert_eq!(summary(&out)["status"], "running");
+}
+
+/// GNU `timeout -s INT` sends its signal to the run and then to the
+/// run's process group: two signals microseconds apart are one request
+/// (`unfold::io::run::SAME_REQUEST`), and the run stops cleanly after its
+/// step, with its summary and its restart file.
+#[test]
+fn a_signal_sent_twice_at_once_is_one_request() {
+    let dir = scratch("doubled");
+    let model = dir.join("long.toml");
+    std::fs::write(&model, rollup(200, 2e-4)).unwrap();
+    let out = dir.join("out");
+    let run = Run::start(&model, &out);
+    wait_for_steps(&out, 3);
+    run.signal(libc::SIGINT);
+    run.signal(libc::SIGINT);
+    let (code, err) = run.finish();
+    assert_eq!(code, 130, "{err}");
+    assert!(!err.contains("stopping at once"), "{err}");
+    assert!(err.contains("interrupted by SIGINT"), "{err}");
+    let (steps, _) = assert_consistent(&out);
+    let s = summary(&out);
+    assert_eq!(s["status"], "interrupted");
+    assert_eq!(s["output_steps"].as_u64().unwrap() as usize, steps);
+    assert!(out.join("restart.json").exists());
+    assert_counts_include_the_last_step(&out, &s);
+}
+
+/// The summary's counts of an interrupted run include the step finished
+/// after the signal, the last one written: its number is the last row's
+/// `increment` in `steps.csv`, and its iterations are the sum of those of
+/// `increment_log`.
+fn assert_counts_include_the_last_step(out: &Path, s: &serde_json::Value) {
+    let steps = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    let last: u64 = steps
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(s["increments"].as_u64().unwrap(), last, "{steps}");
+    let logged: u64 = s["increment_log"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i["iterations"].as_u64().unwrap())
+        .sum();
+    assert_eq!(s["iterations"].as_u64().unwrap(), logged);
 }
 
 /// Another run holding the directory: refused at once, naming the

@@ -92,6 +92,13 @@ pub trait Stepper {
     /// converged step, an observer's error).
     type Error;
 
+    /// Whether `error`, returned by [`Self::accept`], stopped the analysis
+    /// after the step was recorded (an observer's interruption: the step
+    /// is written and counts), not before.
+    fn recorded(&self, _error: &Self::Error) -> bool {
+        false
+    }
+
     /// The model and the current state: the last accepted one, or the
     /// attempted one between an attempt and its acceptance or rejection.
     fn current(&self) -> (&Model, &State);
@@ -791,9 +798,14 @@ impl StepController {
             if error.is_none() && iterations <= EASY_ITERATIONS && !self.error_controlled {
                 self.size = (self.size * GROWTH).min(self.bounds.max);
             }
-            stepper
-                .accept(&info, observer)
-                .map_err(ControlStop::Stepper)?;
+            if let Err(e) = stepper.accept(&info, observer) {
+                if stepper.recorded(&e) {
+                    self.counts.increments += 1;
+                    self.counts.iterations += iterations;
+                    self.increment += 1;
+                }
+                return Err(ControlStop::Stepper(e));
+            }
             for &i in &landed {
                 observer.event(&EventInfo {
                     increment,

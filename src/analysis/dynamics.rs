@@ -270,6 +270,11 @@ pub enum DynamicError {
         /// flux) at the last iteration, with its element.
         location: String,
     },
+    /// No free unknown has mass: the equations of motion have no inertia
+    /// to integrate (a static or kinematic analysis is what such a model
+    /// takes).
+    #[error("the model has no mass on its free unknowns, so a dynamic analysis has no motion to follow: give its beam sections a mass_per_length (and inertia_per_length), or add rigid bodies or point masses; for a load history without inertia run a static analysis")]
+    NoMass,
     /// The initial velocities move the joints apart.
     #[error("the initial velocities violate {constraint}: its rate is {rate:.3e} (tolerance {tolerance:.1e}); give the connected nodes velocities of one rigid motion, or velocities the joint allows")]
     InconsistentVelocity {
@@ -847,6 +852,11 @@ impl DynamicAnalysis {
                 self.run = Some(run);
                 return Step::Stopped;
             }
+        }
+        if run.mass_scale == [0.0; 2] {
+            run.error = Some(DynamicError::NoMass);
+            self.run = Some(run);
+            return Step::Stopped;
         }
         if let Some(kept) = kept {
             run.state = kept;
@@ -2944,6 +2954,10 @@ impl Dynamics<'_> {
 
 impl Stepper for Dynamics<'_> {
     type Error = DynamicError;
+
+    fn recorded(&self, error: &DynamicError) -> bool {
+        matches!(error, DynamicError::Output(e) if e.kind() == std::io::ErrorKind::Interrupted)
+    }
 
     fn current(&self) -> (&Model, &State) {
         (self.model, &self.run.state)

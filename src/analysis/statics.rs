@@ -487,6 +487,10 @@ fn watches_stability(s: &StaticSettings) -> bool {
 impl Stepper for Statics<'_> {
     type Error = StaticError;
 
+    fn recorded(&self, error: &StaticError) -> bool {
+        matches!(error, StaticError::Output(e) if e.kind() == std::io::ErrorKind::Interrupted)
+    }
+
     fn current(&self) -> (&Model, &State) {
         (self.model, &self.run.state)
     }

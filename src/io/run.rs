@@ -213,12 +213,19 @@ pub enum SignalEvent {
     Ending(i32),
 }
 
+/// A signal within this time of the first is the same request, not a
+/// second one: GNU `timeout` sends its signal to the run and then to its
+/// whole process group, so that the run receives it twice within
+/// microseconds; a person's second Ctrl-C comes after reading the first
+/// message.
+pub const SAME_REQUEST: std::time::Duration = std::time::Duration::from_millis(250);
+
 /// Handles SIGINT, SIGTERM and SIGHUP from now on (Unix): the first sets
-/// `stop`, a second ends the process at once (status `128 + signal`)
-/// after the step being written. `report` is called on each, from the
-/// handling thread. It also makes a write past the file-size limit
-/// (`ulimit -f`) fail with an error instead of killing the process
-/// (SIGXFSZ).
+/// `stop`, a second one (more than [`SAME_REQUEST`] after the first) ends
+/// the process at once (status `128 + signal`) after the step being
+/// written. `report` is called on each, from the handling thread. It also
+/// makes a write past the file-size limit (`ulimit -f`) fail with an
+/// error instead of killing the process (SIGXFSZ).
 #[cfg(unix)]
 pub fn stop_on_signals(
     stop: &StopRequest,
@@ -231,15 +238,21 @@ pub fn stop_on_signals(
     std::thread::Builder::new()
         .name("signals".into())
         .spawn(move || {
+            let mut first: Option<std::time::Instant> = None;
             for signal in signals.forever() {
-                if stop.requested().is_none() {
-                    stop.request(Some(signal));
-                    report(SignalEvent::Stopping(signal));
-                } else {
-                    report(SignalEvent::Ending(signal));
-                    let _writing = stop.output();
-                    std::process::exit(128 + signal);
+                match first {
+                    None => {
+                        first = Some(std::time::Instant::now());
+                        stop.request(Some(signal));
+                        report(SignalEvent::Stopping(signal));
+                        continue;
+                    }
+                    Some(at) if at.elapsed() < SAME_REQUEST => continue,
+                    Some(_) => {}
                 }
+                report(SignalEvent::Ending(signal));
+                let _writing = stop.output();
+                std::process::exit(128 + signal);
             }
         })?;
     Ok(())

@@ -1,7 +1,7 @@
 //! `[[loads]]` and `[gravity]`: nodal forces and moments, and the uniform
 //! gravity field, each following a curve.
 
-use super::Builder;
+use super::{num, Builder};
 use crate::curves::CurveIndex;
 use crate::elements::load::NodalLoad;
 use crate::model::input::Id;
@@ -42,6 +42,9 @@ impl Builder<'_> {
                     Vec3::from(m).amax(),
                     c,
                 );
+            }
+            if ok && l.curve.is_none() {
+                self.ramp_through_dynamics(&entity);
             }
             if let (Some(node), Some(curve), true) = (node, curve, ok) {
                 self.elements.push(Box::new(NodalLoad::new(
@@ -100,6 +103,34 @@ impl Builder<'_> {
                 "follows the default ramp f = t while drivers move the model: their loads before the end include only f(t) of the gravity; write curve = \"ramp\" to confirm, or curve = \"constant\" for the full gravity throughout",
             );
         }
+        if a.norm() > 0.0 && g.curve.is_none() {
+            self.ramp_through_dynamics("gravity");
+        }
         Some((a, curve))
+    }
+
+    /// A warning for a load or gravity (`entity`) without a curve in a
+    /// sequence whose first analysis is static and a later one dynamic:
+    /// the default ramp `f = t` goes on growing through the motion
+    /// (docs/model-format.md, "Loads in time").
+    fn ramp_through_dynamics(&mut self, entity: &str) {
+        let Some((analysis, start, end)) = self.plan.dynamic_after_static.clone() else {
+            return;
+        };
+        if self.plan.first_dynamic || self.plan.kinematic || start <= 0.0 {
+            return;
+        }
+        self.ck.warn(
+            entity,
+            format!(
+                "follows the default ramp f = t, which goes on growing through the dynamic {analysis} (t = {} to {}): the load there grows from {} to {} times its full value; give it a curve (a preload held: points = [[0, 0], [{}, 1], [{}, 1]]), or write curve = \"ramp\" to confirm",
+                num(start),
+                num(end),
+                num(start),
+                num(end),
+                num(start),
+                num(end),
+            ),
+        );
     }
 }

@@ -66,6 +66,10 @@ pub(super) struct Plan {
     /// The first analysis is dynamic (loads and gravity act in full from
     /// the start by default).
     pub first_dynamic: bool,
+    /// The first dynamic analysis after a static one (a preload, then the
+    /// motion): its entity (`analysis[2]`), start and end. Loads and
+    /// gravity without a curve follow the ramp through it.
+    pub dynamic_after_static: Option<(String, f64, f64)>,
 }
 
 impl Plan {
@@ -82,6 +86,13 @@ impl Plan {
             max_increment: load.map(|s| s.max_increment).reduce(f64::max),
             no_statics: statics().next().is_none(),
             first_dynamic: settings.first().is_some_and(|s| s.as_dynamic().is_some()),
+            dynamic_after_static: settings
+                .iter()
+                .enumerate()
+                .skip(1)
+                .find_map(|(k, s)| s.as_dynamic().map(|d| (k, d)))
+                .filter(|_| settings.first().is_some_and(|s| s.as_static().is_some()))
+                .map(|(k, d)| (format!("analysis[{}]", k + 1), d.start_time, d.end_time)),
         }
     }
 }
@@ -549,9 +560,18 @@ fn dynamic_settings(
             ),
         );
     }
-    let mut steps_ok = ck.positive(entity, "time_step", s.time_step)
-        & ck.positive(entity, "min_step", s.min_step)
-        & ck.positive(entity, "max_step", s.max_step);
+    // min_step and max_step not given are derived from time_step: only a
+    // time_step of its own is then reported
+    // (and time_step not given from the span: end_time is reported)
+    let time_ok = if a.time_step.is_some() || span > 0.0 {
+        ck.positive(entity, "time_step", s.time_step)
+    } else {
+        false
+    };
+    let derived_ok = |given: bool| given || time_ok;
+    let mut steps_ok = time_ok
+        & (!derived_ok(a.min_step.is_some()) || ck.positive(entity, "min_step", s.min_step))
+        & (!derived_ok(a.max_step.is_some()) || ck.positive(entity, "max_step", s.max_step));
     if steps_ok && s.time_step < round_off {
         ck.push(
             ModelErrorKind::Invalid,

@@ -433,7 +433,7 @@ fn check(path: &Path) -> ExitCode {
             }
             if report.redundant_constraints > 0 {
                 println!(
-                    "note: {} redundant constraint equation(s) will be removed (over-constrained loops)",
+                    "note: {} redundant constraint equation(s) will be removed (over-constrained: joints, supports or drivers that repeat one another)",
                     report.redundant_constraints
                 );
             }

@@ -1417,7 +1417,8 @@ fn an_over_driven_mechanism_is_warned_about() {
     assert_eq!(code, 0, "{out}{err}");
     let warning = "driver 11: equation 1 is redundant with the joints and the other drivers at t = 0: the driver repeats or contradicts what they impose";
     assert!(
-        err.contains(warning) && err.contains("the run stops at its first increment"),
+        err.contains(warning)
+            && err.contains("the run stops at the first increment where they disagree"),
         "{err}"
     );
     let dir = scratch("over_driven");

@@ -275,6 +275,18 @@ pub enum DynamicError {
     /// takes).
     #[error("the model has no mass on its free unknowns, so a dynamic analysis has no motion to follow: give its beam sections a mass_per_length (and inertia_per_length), or add rigid bodies or point masses; for a load history without inertia run a static analysis")]
     NoMass,
+    /// Constraints removed as redundant turned out violated: they
+    /// contradict the others (a driver pushing a joint through a locked
+    /// latch, two drivers of one coordinate).
+    #[error("inconsistent constraints at t = {time:.6}: {constraint} was found redundant but is now violated ({violation:.1e} × its tolerance); two joints, drivers or latches impose incompatible motions")]
+    Inconsistent {
+        /// Time of the step that violated it (not kept).
+        time: f64,
+        /// The violated constraint.
+        constraint: String,
+        /// Violation relative to the tolerance.
+        violation: f64,
+    },
     /// The initial velocities move the joints apart.
     #[error("the initial velocities violate {constraint}: its rate is {rate:.3e} (tolerance {tolerance:.1e}); give the connected nodes velocities of one rigid motion, or velocities the joint allows")]
     InconsistentVelocity {
@@ -826,7 +838,7 @@ impl DynamicAnalysis {
         }
         if !rank.redundant.is_empty() {
             observer.note(&format!(
-                "{} redundant constraint equation(s) removed (over-constrained loops); their multipliers are zero and the others carry the loads",
+                "{} redundant constraint equation(s) removed (over-constrained: joints, supports or drivers that repeat one another); their multipliers are zero and the others carry the loads",
                 rank.redundant.len()
             ));
         }
@@ -3055,6 +3067,22 @@ impl Stepper for Dynamics<'_> {
         info: &IncrementInfo,
         observer: &mut dyn Observer,
     ) -> Result<(), DynamicError> {
+        // a constraint left out as redundant and violated by the step: the
+        // constraints contradict each other, and the step is not kept
+        // (docs/joints.md §5, "Consistency")
+        let motion = self.step_motion(info.step).0;
+        if let Some((constraint, violation)) = self.solver.violated_redundant_within(
+            self.model,
+            &self.run.state,
+            self.settings.displacement_tolerance * motion,
+            self.settings.rotation_tolerance,
+        ) {
+            return Err(DynamicError::Inconsistent {
+                time: info.time,
+                constraint,
+                violation,
+            });
+        }
         let (model, run) = (self.model, &mut *self.run);
         // the controller may snap t onto a landing time within round-off
         run.state.time = info.time;

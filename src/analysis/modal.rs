@@ -218,7 +218,7 @@ impl ModalAnalysis {
         }
         if !rank.redundant.is_empty() {
             observer.note(&format!(
-                "{} redundant constraint equation(s) left out of the modal analysis (over-constrained loops)",
+                "{} redundant constraint equation(s) left out of the modal analysis (over-constrained: joints, supports or drivers that repeat one another)",
                 rank.redundant.len()
             ));
         }

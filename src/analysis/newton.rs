@@ -571,6 +571,20 @@ impl NewtonSolver {
         state: &State,
         settings: &StaticSettings,
     ) -> Option<(String, f64)> {
+        let distance = settings.displacement_tolerance * self.last_motion;
+        self.violated_redundant_within(model, state, distance, settings.rotation_tolerance)
+    }
+
+    /// [`Self::violated_redundant`] with the tolerances of distance and
+    /// angle equations given (a dynamic step's: `ε_u` times the step's
+    /// largest translation, `ε_θ`).
+    pub fn violated_redundant_within(
+        &self,
+        model: &Model,
+        state: &State,
+        distance_tolerance: f64,
+        angle_tolerance: f64,
+    ) -> Option<(String, f64)> {
         if self.redundant.is_empty() {
             return None;
         }
@@ -613,8 +627,8 @@ impl NewtonSolver {
                 let kind = e.multiplier_kind(k);
                 let scale = ctx.scaling.of(kind).0;
                 let tol = match kind {
-                    ConstraintKind::Angle => settings.rotation_tolerance,
-                    ConstraintKind::Distance => settings.displacement_tolerance * self.last_motion,
+                    ConstraintKind::Angle => angle_tolerance,
+                    ConstraintKind::Distance => distance_tolerance,
                 };
                 let row = nq + nc + k;
                 // tangent in column-major order: K_ij at j·n + i

@@ -125,7 +125,7 @@ fn redundant_drivers(model: &Model, redundant: &[usize]) -> Vec<ModelWarning> {
                 warnings.push(ModelWarning {
                     entity: format!("driver {}", e.id()),
                     message: format!(
-                        "equation {} is redundant with the joints and the other drivers at t = 0: the driver repeats or contradicts what they impose (an over-driven mechanism); if it contradicts them the run stops at its first increment (\"inconsistent constraints\"): remove the driver or free the motion it drives",
+                        "equation {} is redundant with the joints and the other drivers at t = 0: the driver repeats or contradicts what they impose (an over-driven mechanism); if it contradicts them the run stops at the first increment where they disagree (\"inconsistent constraints\"): remove the driver or free the motion it drives",
                         k - offset + 1
                     ),
                 });

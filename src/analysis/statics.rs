@@ -284,7 +284,7 @@ impl StaticAnalysis {
         run.redundant = rank.redundant.len();
         if !rank.redundant.is_empty() {
             observer.note(&format!(
-                "{} redundant constraint equation(s) removed (over-constrained loops); their multipliers are zero and the others carry the loads",
+                "{} redundant constraint equation(s) removed (over-constrained: joints, supports or drivers that repeat one another); their multipliers are zero and the others carry the loads",
                 rank.redundant.len()
             ));
         }

@@ -314,6 +314,13 @@ pub fn dynamic_error_message(model: &Model, state: &State, error: &DynamicError)
             ),
         };
     }
+    // a driver whose curve starts moving while the bodies are at rest
+    if let Some(rest) = constraint.strip_prefix("driver ") {
+        let id = rest.split(' ').next().unwrap_or("");
+        return format!(
+            "the initial velocities violate driver {id}: its curve moves the joint at the start (the constraint's rate is {rate:.3e}, tolerance {tolerance:.1e}) while the initial velocities do not; start the driver's curve with zero rate (function = \"smooth_step\", or a table whose first segment is flat), or give the driven bodies the initial velocities of that motion"
+        );
+    }
     let latch = model.elements.iter().find_map(|e| {
         let l = e.as_latch()?;
         (*constraint == format!("{} {} equation 1", e.kind().name(), e.id())).then_some((e.id(), l))

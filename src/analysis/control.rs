@@ -610,11 +610,18 @@ impl StepController {
                 }
             }
             let mut lands = false;
+            // the size planned before an output time cut it short (None if
+            // it did not): the next step goes on from it
+            let mut planned = None;
             if in_time {
+                let before = size;
                 size = size.min(target - t);
                 if target - (t + size) <= snap {
                     size = target - t;
                     lands = true;
+                }
+                if output_time && lands && size < before {
+                    planned = Some(before);
                 }
             }
             let reach = if in_time { t + size } else { t };
@@ -678,19 +685,32 @@ impl StepController {
                     self.size = next;
                     continue;
                 }
-                let mut factor = self.error_factor(e, self.last_error, stepper.error_order());
-                if self.rejected {
-                    // no growth straight after a rejection or a cut-back
-                    factor = factor.min(1.0);
-                }
-                self.last_error = Some(e.max(ERROR_MEMORY_FLOOR));
                 self.error_controlled = true;
-                let grown = (size * factor).clamp(self.bounds.min, self.bounds.max);
-                self.size = if iterations <= EASY_ITERATIONS {
-                    grown
+                if let Some(planned) = planned {
+                    // cut short to land on an output time: its estimate,
+                    // scaled to the planned size (e ∝ hᵏ), may shorten the
+                    // next step but not lengthen it, and the PI memory
+                    // keeps the last full step's (a sliver before an
+                    // output time would otherwise make the steps grow back
+                    // from it, by at most ERROR_FACTORS.1 a step)
+                    let k = stepper.error_order() + 1.0;
+                    let scaled = e * (planned / size).powf(k);
+                    let factor = self.error_factor(scaled, None, stepper.error_order());
+                    self.size = (planned * factor.min(1.0)).clamp(self.bounds.min, self.bounds.max);
                 } else {
-                    grown.min(size)
-                };
+                    let mut factor = self.error_factor(e, self.last_error, stepper.error_order());
+                    if self.rejected {
+                        // no growth straight after a rejection or a cut-back
+                        factor = factor.min(1.0);
+                    }
+                    self.last_error = Some(e.max(ERROR_MEMORY_FLOOR));
+                    let grown = (size * factor).clamp(self.bounds.min, self.bounds.max);
+                    self.size = if iterations <= EASY_ITERATIONS {
+                        grown
+                    } else {
+                        grown.min(size)
+                    };
+                }
             }
             self.rejected = false;
 

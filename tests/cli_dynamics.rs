@@ -217,12 +217,9 @@ fn a_load_ramped_through_the_motion_after_a_preload_is_warned_about() {
     ] {
         let model = dir.join(format!("{name}.toml"));
         std::fs::write(&model, text).unwrap();
-        let check = Command::new(env!("CARGO_BIN_EXE_unfold"))
-            .args(["check", model.to_str().unwrap()])
-            .output()
-            .unwrap();
-        let err = stderr(&check);
-        assert!(check.status.success(), "{name}: {err}");
+        let checked = check(&model);
+        let err = stderr(&checked);
+        assert!(checked.status.success(), "{name}: {err}");
         let warning = "loads[1] (node 11): follows the default ramp f = t, which goes on growing through the dynamic analysis[2] (t = 1 to 2.5)";
         assert_eq!(err.contains(warning), warned, "{name}: {err}");
     }
@@ -667,11 +664,8 @@ force = [0.0, 0.0, -1.0]
 ",
     )
     .unwrap();
-    let check = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .args(["check", model.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert_eq!(check.status.code(), Some(2), "{}", stderr(&check));
+    let checked = check(&model);
+    assert_eq!(checked.status.code(), Some(2), "{}", stderr(&checked));
     let o = run(&model, &dir.join("out"), &[]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");

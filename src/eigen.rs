@@ -674,14 +674,22 @@ pub fn solve_dense(pencil: &Pencil, settings: &EigenSettings) -> Result<ModalSol
         active.push(eq);
     }
 
+    let row_norm: Vec<f64> = rows
+        .iter()
+        .map(|r| r.iter().map(|&(_, v)| v * v).sum::<f64>().sqrt())
+        .collect();
     // null space of B: Bᵀ P = Q R, N = the last nu − rank columns of Q
     let null_space = if active.is_empty() {
         None
     } else {
+        // each constraint row scaled to unit norm, so that the rank does
+        // not depend on the scaling `k` of its kind of constraint (a force
+        // against a moment: the units chosen); μ is scaled back below
         let mut bt = Mat::<f64>::zeros(nu, active.len());
         for (j, &eq) in active.iter().enumerate() {
+            let norm = row_norm[eq];
             for &(i, v) in &rows[eq] {
-                bt[(i, j)] = v;
+                bt[(i, j)] = v / norm;
             }
         }
         let qr = bt.col_piv_qr();
@@ -808,7 +816,8 @@ pub fn solve_dense(pencil: &Pencil, settings: &EigenSettings) -> Result<ModalSol
         let (fwd, _) = qr.P().arrays();
         for (j, mu) in mus.iter_mut().enumerate() {
             for p in 0..*rank {
-                mu[active[fwd[p]]] = t[(p, j)];
+                let eq = active[fwd[p]];
+                mu[eq] = t[(p, j)] / row_norm[eq];
             }
         }
     }

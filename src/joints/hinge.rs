@@ -221,6 +221,10 @@ impl Hysteresis {
         }
     }
 
+    /// Relative difference below which two end slopes are taken as equal
+    /// ([`Hysteresis::crossing`]).
+    pub const SLOPE_TOLERANCE: f64 = 1e-9;
+
     /// Where `f_load < f_unload`, if anywhere: the first abscissa found.
     /// Both branches are piecewise quadratic, so their difference is
     /// checked exactly: at every break of either, at the minimum of the
@@ -263,11 +267,15 @@ impl Hysteresis {
         let (lo_l, hi_l) = self.load.end_slopes();
         let (lo_u, hi_u) = self.unload.end_slopes();
         let (first, last) = (x[0], x[x.len() - 1]);
-        // beyond the ends the difference is linear
-        if lo_l > lo_u {
+        // beyond the ends the difference is linear: its slope decides,
+        // compared to a relative tolerance for the round-off of slopes
+        // computed from the points of two branches that share their end
+        // segment (the locked branch of a tape spring, in any units)
+        let below = |a: f64, b: f64| a < b - Self::SLOPE_TOLERANCE * a.abs().max(b.abs());
+        if below(lo_u, lo_l) {
             return Some(first - 1.0);
         }
-        if hi_l < hi_u {
+        if below(hi_l, hi_u) {
             return Some(last + 1.0);
         }
         None
@@ -457,6 +465,43 @@ mod tests {
     /// corner at c = 1 (slopes −1 → 1), the loading one sharp, the
     /// unloading one rounded with h = 0.2, whose parabola reaches
     /// −0.01 + 2·0.2/4 = 0.09 > 0 at c = 1.
+    /// A tape spring in kN·mm-like magnitudes (M_d = 3e-4, M_L = 0.01,
+    /// K = 5e-3): both bounds end on the same locked line K (c − c_L),
+    /// whose slopes computed from two different pairs of points differ by
+    /// round-off. The law is valid (it was refused as crossing), and it is
+    /// the N·m law scaled by 1e-3, which is accepted too.
+    #[test]
+    fn a_tape_spring_in_small_units_is_not_refused_by_round_off() {
+        for scale in [1.0, 1e-3, 1e-6, 1e3] {
+            for (cl, w) in [(1.5, 0.1), (1.5707963, 0.05), (3.0, 0.5), (2.0, 0.2)] {
+                let t = TapeSpring {
+                    deployment_moment: 0.3 * scale,
+                    locking_angle: cl,
+                    locking_peak: 10.0 * scale,
+                    locked_stiffness: 5.0 * scale,
+                    snap_width: w,
+                    rounding: 0.25 * w.min(0.3 / 5.0),
+                };
+                let (load, unload) = t.branches();
+                let law = Hysteresis {
+                    load,
+                    unload,
+                    elastic: 10.0 * scale,
+                };
+                assert_eq!(law.crossing(), None, "scale {scale}, c_L {cl}, w {w}");
+            }
+        }
+        // a real difference of the end slopes is still found
+        let load = Branch::new(vec![(0.0, 0.0), (1.0, 1.0)], 0.0);
+        let unload = Branch::new(vec![(0.0, -1.0), (1.0, 1.0 - 1e-6)], 0.0);
+        let law = Hysteresis {
+            load,
+            unload,
+            elastic: 10.0,
+        };
+        assert!(law.crossing().is_some());
+    }
+
     #[test]
     fn crossing_is_found_inside_a_rounded_corner() {
         let load = Branch::new(vec![(0.0, 1.0), (1.0, 0.0), (2.0, 1.0)], 0.0);

@@ -18,7 +18,8 @@ impl Builder<'_> {
         let input = self.input;
         // a gap below −tol in the reference configuration is a penetration
         // (tol: the event tolerance of the analysis, of the model's size)
-        let tolerance = EVENT_TOLERANCE * super::length_scale(self.nodes.iter().map(|n| &n.x));
+        let tolerance =
+            EVENT_TOLERANCE * super::length_scale(input, self.nodes.iter().map(|n| &n.x));
         for c in &input.contacts {
             let entity = format!("contact {}", c.id);
             let id_ok = self.claim_id(&entity, c.id);

@@ -211,21 +211,96 @@ fn num(v: f64) -> String {
     }
 }
 
-/// The model's size: the diagonal of the box around the nodes at `x`, 1
-/// for a model of one point ([`Model::length_scale`]).
-fn length_scale<'a>(x: impl Iterator<Item = &'a Vec3>) -> f64 {
+/// The model's size ([`Model::length_scale`]): the diagonal of the box
+/// around the nodes at `x`; for a model of one point, the largest length
+/// the model gives otherwise ([`own_length`]); 1 only for a model without
+/// any length.
+fn length_scale<'a>(input: &ModelInput, x: impl Iterator<Item = &'a Vec3>) -> f64 {
     let mut lo = Vec3::repeat(f64::INFINITY);
     let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+    let mut first = None;
     for x in x {
         lo = lo.inf(x);
         hi = hi.sup(x);
+        first.get_or_insert(*x);
     }
     let d = (hi - lo).norm();
     if d > 0.0 && d.is_finite() {
-        d
+        return d;
+    }
+    let l = own_length(input, first.unwrap_or_else(Vec3::zeros));
+    if l > 0.0 && l.is_finite() {
+        l
     } else {
         1.0
     }
+}
+
+/// The largest length of a model whose nodes are all at one point `x0`,
+/// in its own units: where its joints and contact planes are, the radii
+/// of its spheres and the radii of gyration and centres of mass of its
+/// rigid bodies, the pitch of its screws, and the limits of stops and the
+/// lock values of latches on joint coordinates that are lengths (a ball
+/// on a prismatic stop). Values that are not finite are left out (their
+/// entity's own check reports them).
+fn own_length(input: &ModelInput, x0: Vec3) -> f64 {
+    let mut l = 0.0f64;
+    let mut add = |v: f64| {
+        if v.is_finite() {
+            l = l.max(v.abs());
+        }
+    };
+    let from = |p: [f64; 3]| (Vec3::from(p) - x0).norm();
+    for j in &input.joints {
+        j.position.map(|p| add(from(p)));
+        j.offset.map(|o| add(Vec3::from(o).norm()));
+        j.pitch.map(&mut add);
+    }
+    for b in &input.rigid_bodies {
+        if let Some(c) = b.center_of_mass {
+            add(Vec3::from(c).norm());
+        }
+        let largest = match &b.inertia {
+            Some(InertiaInput::Diagonal(d)) => d.iter().fold(0.0f64, |a, v| a.max(v.abs())),
+            Some(InertiaInput::Full(f)) => (0..3).fold(0.0f64, |a, i| a.max(f[i][i].abs())),
+            None => 0.0,
+        };
+        if b.mass > 0.0 {
+            add((largest / b.mass).sqrt());
+        }
+    }
+    for c in &input.contacts {
+        c.point.map(|p| add(from(p)));
+        c.radius.map(&mut add);
+        c.radii.iter().flatten().for_each(|&r| add(r));
+    }
+    // the coordinate a stop or latch acts on, when it is a length
+    let is_length = |joint: Id, name: &Option<String>| {
+        input
+            .joints
+            .iter()
+            .find(|j| j.id == joint)
+            .is_some_and(|j| {
+                let cs = j.kind.coordinates();
+                let c = match name {
+                    Some(n) => cs.iter().find(|c| c.name() == n.as_str()),
+                    None => cs.first(),
+                };
+                c.is_some_and(|c| !c.is_angle())
+            })
+    };
+    for s in &input.stops {
+        if is_length(s.joint, &s.coordinate) {
+            s.lower.map(&mut add);
+            s.upper.map(&mut add);
+        }
+    }
+    for t in &input.latches {
+        if is_length(t.joint, &t.coordinate) {
+            add(t.value);
+        }
+    }
+    l
 }
 
 /// A node being built: reference position and orientation.
@@ -427,7 +502,7 @@ impl Model {
             return Err(ModelErrors(ck.errors));
         }
 
-        let length_scale = length_scale(nodes.iter().map(|n| &n.x));
+        let length_scale = length_scale(input, nodes.iter().map(|n| &n.x));
         let mut model = Model {
             title: input.title.clone().unwrap_or_default(),
             node_ids,

@@ -473,7 +473,12 @@ mod tests {
     #[test]
     fn a_tape_spring_in_small_units_is_not_refused_by_round_off() {
         for scale in [1.0, 1e-3, 1e-6, 1e3] {
-            for (cl, w) in [(1.5, 0.1), (1.5707963, 0.05), (3.0, 0.5), (2.0, 0.2)] {
+            for (cl, w) in [
+                (1.5, 0.1),
+                (std::f64::consts::FRAC_PI_2 - 2.7e-8, 0.05),
+                (3.0, 0.5),
+                (2.0, 0.2),
+            ] {
                 let t = TapeSpring {
                     deployment_moment: 0.3 * scale,
                     locking_angle: cl,

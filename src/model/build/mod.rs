@@ -252,8 +252,12 @@ fn own_length(input: &ModelInput, x0: Vec3) -> f64 {
     };
     let from = |p: [f64; 3]| (Vec3::from(p) - x0).norm();
     for j in &input.joints {
-        j.position.map(|p| add(from(p)));
-        j.offset.map(|o| add(Vec3::from(o).norm()));
+        if let Some(p) = j.position {
+            add(from(p));
+        }
+        if let Some(o) = j.offset {
+            add(Vec3::from(o).norm());
+        }
         j.pitch.map(&mut add);
     }
     for b in &input.rigid_bodies {
@@ -270,7 +274,9 @@ fn own_length(input: &ModelInput, x0: Vec3) -> f64 {
         }
     }
     for c in &input.contacts {
-        c.point.map(|p| add(from(p)));
+        if let Some(p) = c.point {
+            add(from(p));
+        }
         c.radius.map(&mut add);
         c.radii.iter().flatten().for_each(|&r| add(r));
     }

@@ -102,17 +102,29 @@ fn plate(
 /// Runs a static analysis in one increment; the final state and the
 /// Newton iterations of that increment.
 fn statics(model: &Arc<Model>) -> (unfold::state::State, usize) {
+    let (state, iterations) = statics_in(model, 1);
+    (state, iterations[0])
+}
+
+/// Runs a static analysis in `n` equal increments; the final state and
+/// the Newton iterations of each increment.
+fn statics_in(model: &Arc<Model>, n: usize) -> (unfold::state::State, Vec<usize>) {
+    let h = 1.0 / n as f64;
     let settings = Analysis::statics()
-        .initial_increment(1.0)
+        .initial_increment(h)
+        .max_increment(h)
         .settings()
         .unwrap();
     let mut rec = History::new();
     let outcome = StaticAnalysis::new(model.clone(), settings).run(model.initial_state(), &mut rec);
     assert!(outcome.error.is_none(), "{:?}", outcome.error);
-    let last = rec.increments.last().unwrap();
-    println!("residuals {:?}", last.residuals);
-    assert_eq!(last.time, 1.0);
-    (outcome.state, last.iterations)
+    let increments: Vec<_> = rec.increments.iter().filter(|i| i.increment > 0).collect();
+    assert_eq!(increments.len(), n);
+    assert_eq!(increments[n - 1].time, 1.0);
+    (
+        outcome.state,
+        increments.iter().map(|i| i.iterations).collect(),
+    )
 }
 
 /// The section of a specially orthotropic laminate that Navier's solution
@@ -333,9 +345,27 @@ fn clamped_square_plate_against_timoshenko() {
     }
 }
 
+/// The linear element converges in one Newton iteration per increment:
+/// the clamped plate in one increment and in four (whose predictor
+/// continues the last increment's motion on the group, exact for
+/// proportional loading), to the same deflection within 1e-10.
+#[test]
+fn one_newton_iteration_per_increment() {
+    let one = clamped_deflection_in(0.01, 8, 1);
+    let four = clamped_deflection_in(0.01, 8, 4);
+    println!("one increment {one:.12e}, four {four:.12e}");
+    assert!(relative(four, one) < 1e-10);
+}
+
 /// `w D/(q a⁴)` at the centre of the clamped square plate of thickness `t`
 /// (a = 1) on `n × n` elements.
 fn clamped_deflection(t: f64, n: usize) -> f64 {
+    clamped_deflection_in(t, n, 1)
+}
+
+/// [`clamped_deflection`] in `increments` load increments, each of which
+/// must take one Newton iteration.
+fn clamped_deflection_in(t: f64, n: usize, increments: usize) -> f64 {
     let (e, nu) = (70e9, 0.3);
     let d = e * t.powi(3) / (12.0 * (1.0 - nu * nu));
     // a load that deflects the plate by ~1e-5 of its side
@@ -345,7 +375,8 @@ fn clamped_deflection(t: f64, n: usize) -> f64 {
     let lam = m.add(Laminate::plies([(mat, t, 0.0)]));
     let panel = plate(&mut m, [1.0, 1.0], [n, n], lam, q, true);
     let model = Arc::new(m.build().unwrap());
-    let (state, _) = statics(&model);
+    let (state, iterations) = statics_in(&model, increments);
+    assert!(iterations.iter().all(|&k| k == 1), "{iterations:?}");
     state.x[model.node(panel.node(n / 2, n / 2))].z * d / q
 }
 

@@ -281,7 +281,12 @@ impl Builder<'_> {
             }
             None
         };
-        let (b, t) = (face(self, &bottom), face(self, &top));
+        let b = face(self, &bottom);
+        let t = if top == bottom {
+            b.clone()
+        } else {
+            face(self, &top)
+        };
         let unit = l.unit.map_or(1.0, |u| u.radians());
         let angle = core.angle.unwrap_or(0.0);
         if l.unit.is_none() && angle.is_finite() {
@@ -460,10 +465,11 @@ impl Builder<'_> {
         let input = self.input;
         for p in &input.panels {
             let entity = format!("panel \"{}\"", p.name);
-            if let Some(plan) = self.panel_plan(&entity, p) {
-                if mesh {
-                    self.mesh_panel(&entity, p, plan);
-                }
+            match self.panel_plan(&entity, p) {
+                Some(plan) if mesh => self.mesh_panel(&entity, p, plan),
+                Some(_) => {}
+                // its nodes are not reported again where they are used
+                None => self.invalid_panel_nodes(p),
             }
         }
         // the pressures of shells and panels, as nodal loads numbered
@@ -479,6 +485,30 @@ impl Builder<'_> {
                 false,
                 curve,
             )));
+        }
+    }
+
+    /// Marks the nodes a panel with errors would have made (its named
+    /// nodes, and its grid when its size is known) as invalid, so that a
+    /// support or a joint on them is not reported again.
+    fn invalid_panel_nodes(&mut self, p: &PanelInput) {
+        if let Some(ids) = &p.node_ids {
+            self.invalid_nodes
+                .extend(PanelPoint::ALL.iter().filter_map(|&k| ids.get(k)));
+        }
+        let [nx, ny] = p.elements;
+        let count = nx.saturating_add(1).saturating_mul(ny.saturating_add(1));
+        if count <= MAX_MODEL_SIZE {
+            let first = p.first_node.unwrap_or_else(|| {
+                self.node_ids
+                    .iter()
+                    .chain(&self.invalid_nodes)
+                    .copied()
+                    .max()
+                    .map_or(1, |m| m.saturating_add(1))
+            });
+            self.invalid_nodes
+                .extend((0..count as Id).filter_map(|k| first.checked_add(k)));
         }
     }
 

@@ -652,3 +652,71 @@ fn large_rotations_stop_the_analyses() {
         other => panic!("{other:?}"),
     }
 }
+
+/// A model with every shell entity written by the builder reads back from
+/// its model file to the same definition (ply materials, stacks and
+/// sandwiches, shells, a panel with zones, stiffeners, named node ids and
+/// a pressure curve), and builds.
+#[test]
+fn shell_entities_round_trip_through_the_model_file() {
+    let mut m = ModelBuilder::new("round trip");
+    let c = carbon(&mut m);
+    let al = m.add(
+        PlyMaterial::isotropic(70e9, 0.33)
+            .density(2800.0)
+            .named("aluminium"),
+    );
+    let face = m.add(Laminate::plies([(c, 0.25e-3, 0.0), (c, 0.25e-3, 45.0)]).unit(AngleUnit::Deg));
+    let sheet = m.add(Laminate::plies([(al, 1e-3, 0.0)]).named("sheet"));
+    let sandwich = m.add(
+        Laminate::sandwich(
+            face,
+            Core::new(20e-3, 190e6, 90e6)
+                .density(32.0)
+                .in_plane(1e6, 0.3)
+                .angle(90.0),
+            face,
+        )
+        .unit(AngleUnit::Deg),
+    );
+    let rail =
+        m.section(Section::diagonal(4.2e6, 1.3e6, 1.3e6, 7.0, 5.6, 78.75).mass_per_length(0.16));
+    let curve = m.curve(LoadCurve::linear(0.0, 2.0));
+    let panel = m.add(
+        Panel::new([1.2, 0.8], [6, 4], sandwich)
+            .zone([0.0, 0.0], [0.2, 0.8], sheet)
+            .stiffener(PanelSide::North, rail, 0.012)
+            .node_id(PanelPoint::West, 900)
+            .pressure(5.0)
+            .pressure_curve(curve)
+            .named("p1"),
+    );
+    let (a, b) = (m.node([0.0, -1.0, 0.0]), m.node([1.0, -1.0, 0.0]));
+    let shell = m.add(
+        Shell::new(
+            [
+                a,
+                b,
+                panel.point(PanelPoint::SouthEast),
+                panel.point(PanelPoint::SouthWest),
+            ],
+            sheet,
+        )
+        .material_axis([1.0, 1.0, 0.0])
+        .pressure(-2.0),
+    );
+    m.fix(panel.point(PanelPoint::West), Dofs::ALL);
+    m.fix(a, Dofs::ALL);
+    let text = m.to_toml().unwrap();
+    let back = unfold::io::model_file::parse_model(&text, std::path::Path::new("round_trip.toml"))
+        .unwrap();
+    assert_eq!(&back, m.input());
+    let model = Model::from_input(&back).unwrap();
+    assert_eq!(model.shell(shell).laminate().thickness(), 1e-3);
+    assert_eq!(panel.stiffeners[0].len(), 6);
+    assert_eq!(panel.point(PanelPoint::West).id(), 900);
+    assert_eq!(
+        model.reference_position(panel.point(PanelPoint::West)).y,
+        0.4
+    );
+}

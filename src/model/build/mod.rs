@@ -478,8 +478,10 @@ impl Model {
         b.build_beams();
         b.ply_materials();
         b.laminates();
-        b.shells();
+        // panels first: single shells may join their nodes
         b.panels(mesh);
+        b.shells();
+        b.pressure_loads();
         b.masses();
         b.springs();
         b.loads();

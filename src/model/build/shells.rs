@@ -472,9 +472,12 @@ impl Builder<'_> {
                 None => self.invalid_panel_nodes(p),
             }
         }
-        // the pressures of shells and panels, as nodal loads numbered
-        // after the [[loads]]
-        let mut id = input.loads.len() as Id;
+    }
+
+    /// The pressures of shells and panels, as nodal loads numbered after
+    /// the `[[loads]]` (once both are built).
+    pub(super) fn pressure_loads(&mut self) {
+        let mut id = self.input.loads.len() as Id;
         for ((node, curve), f) in std::mem::take(&mut self.shell_tables.pressure) {
             id += 1;
             self.elements.push(Box::new(NodalLoad::new(

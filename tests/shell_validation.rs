@@ -207,7 +207,12 @@ impl Plate {
                 let k = d[(0, 0)] * al.powi(4)
                     + 2.0 * (d[(0, 1)] + 2.0 * d[(2, 2)]) * al * al * be * be
                     + d[(1, 1)] * be.powi(4);
-                w += qmn / k * ((m / 2 + n / 2) % 2 == 0).then_some(1.0).unwrap_or(-1.0);
+                w += qmn / k
+                    * if (m / 2 + n / 2usize).is_multiple_of(2) {
+                        1.0
+                    } else {
+                        -1.0
+                    };
             }
         }
         w

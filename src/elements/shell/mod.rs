@@ -108,8 +108,8 @@ pub enum ShellGeometryError {
         /// The element's normal.
         normal: [f64; 3],
     },
-    /// Positions that are not finite.
-    #[error("its node positions are not finite")]
+    /// Positions or a material axis that are not finite.
+    #[error("its node positions or its material axis are not finite")]
     NotFinite,
 }
 
@@ -174,7 +174,8 @@ impl Shell {
         material_axis: Option<Vec3>,
         laminate: Arc<Laminate>,
     ) -> Result<Self, ShellGeometryError> {
-        if x.iter().any(|p| !p.iter().all(|v| v.is_finite())) {
+        let finite = |p: &Vec3| p.iter().all(|v| v.is_finite());
+        if !x.iter().all(finite) || !material_axis.as_ref().is_none_or(finite) {
             return Err(ShellGeometryError::NotFinite);
         }
         // mean plane from the diagonals
@@ -182,7 +183,7 @@ impl Shell {
         let (d1, d2) = (x[2] - x[0], x[3] - x[1]);
         let scale = d1.norm().max(d2.norm());
         let cross = d1.cross(&d2);
-        if !(cross.norm() > 1e-12 * scale * scale) {
+        if cross.norm() <= 1e-12 * scale * scale {
             return Err(ShellGeometryError::ZeroArea);
         }
         let normal = cross.normalize();
@@ -202,7 +203,7 @@ impl Shell {
         let e1 = match material_axis {
             Some(a) => {
                 let p = project(&a);
-                if !(p.norm() > 1e-3 * a.norm()) {
+                if p.norm() <= 1e-3 * a.norm() {
                     return Err(ShellGeometryError::AxisNormal {
                         axis: [a.x, a.y, a.z],
                         normal: [normal.x, normal.y, normal.z],
@@ -230,7 +231,7 @@ impl Shell {
         let det = geometry.corner_determinants();
         let area = geometry.area();
         for (k, d) in det.iter().enumerate() {
-            if !(*d > 1e-8 * area) {
+            if *d <= 1e-8 * area {
                 return Err(ShellGeometryError::NotConvex {
                     corner: k + 1,
                     node: node_ids[k],
@@ -504,7 +505,7 @@ impl Element for Shell {
     /// `½ dᵀ K d`.
     fn strain_energy(&self, _ctx: &EvalContext, state: &State) -> f64 {
         let (d, _) = self.unknowns(state);
-        0.5 * d.dot(&(&*self.stiffness * d))
+        0.5 * d.dot(&(*self.stiffness * d))
     }
 
     /// `½ vᵀ M v`.

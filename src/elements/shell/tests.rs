@@ -490,7 +490,7 @@ fn drilling_penalty_leaves_the_membrane_alone() {
     let node = |i: usize, j: usize| j * (nx + 1) + i;
     let pos = |i: usize, j: usize| {
         let shift = if i > 0 && i < nx && j > 0 && j < ny {
-            0.15 * (if (i + j) % 2 == 0 { 1.0 } else { -1.0 })
+            0.15 * (if (i + j).is_multiple_of(2) { 1.0 } else { -1.0 })
         } else {
             0.0
         };

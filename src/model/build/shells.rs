@@ -522,7 +522,7 @@ impl Builder<'_> {
             ok &= self.ck.positive(entity, ["size a", "size b"][k], *v);
         }
         let [nx, ny] = p.elements;
-        if nx < 2 || ny < 2 || nx % 2 == 1 || ny % 2 == 1 {
+        if nx < 2 || ny < 2 || !nx.is_multiple_of(2) || !ny.is_multiple_of(2) {
             self.ck.push(
                 ModelErrorKind::Invalid,
                 entity,
@@ -547,13 +547,13 @@ impl Builder<'_> {
         let mut axes = None;
         if axes_ok {
             let (a, b) = (Vec3::from(a), Vec3::from(b));
-            if !(a.norm() > 0.0) {
+            if a.norm() == 0.0 {
                 self.ck
                     .push(ModelErrorKind::Invalid, entity, "axis_a is zero");
             } else {
                 let ea = a.normalize();
                 let bn = b - ea * b.dot(&ea);
-                if !(bn.norm() > 1e-3 * b.norm()) {
+                if bn.norm() <= 1e-3 * b.norm() {
                     self.ck.push(
                         ModelErrorKind::Invalid,
                         entity,

@@ -406,6 +406,10 @@ pub fn describe(model: &Model) -> String {
         0 => String::new(),
         n => format!(", {n} hinge laws"),
     };
+    let shells = match count(ElementKind::Shell) {
+        0 => String::new(),
+        n => format!(", {n} shells"),
+    };
     format!(
         "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
         model.n_nodes(),
@@ -418,6 +422,7 @@ pub fn describe(model: &Model) -> String {
         count(ElementKind::Driver),
         count(ElementKind::NodalLoad),
     ) + &hinge_laws
+        + &shells
 }
 
 /// `log.txt`: a line per increment, iteration, cut-back and note. A write

@@ -32,6 +32,7 @@ pub mod inertia;
 mod kind;
 pub mod load;
 pub mod mass;
+pub mod shape;
 pub mod spring;
 
 use crate::curves::Curve;
@@ -400,6 +401,13 @@ pub trait Element: Send + Sync {
     /// How the element is drawn in VTK files.
     fn cell_shape(&self) -> CellShape {
         CellShape::None
+    }
+
+    /// The solid drawn for the element, carried by its first node (a
+    /// rigid body's box, plate or cylinder), in place of its
+    /// [`Element::cell_shape`]; none by default.
+    fn body_shape(&self) -> Option<&shape::BodyShape> {
+        None
     }
 
     /// Mass carried by the element (for model summaries and checks).

@@ -51,7 +51,9 @@ pub use super::handles::{
     HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle,
     PointMassHandle, RigidBodyHandle, RollingDiscHandle, SpringHandle, StopHandle,
 };
-pub use super::input::{AngleUnit, Approach, StartBranch, TapeSpringInput as TapeSpring};
+pub use super::input::{
+    AngleUnit, Approach, ShapeInput as Shape, StartBranch, TapeSpringInput as TapeSpring,
+};
 pub use super::{Id, Model, ModelErrors};
 pub use crate::joints::{Coordinate, JointType};
 

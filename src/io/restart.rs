@@ -207,9 +207,8 @@ pub struct Resume {
 
 /// The fingerprint of a model input: the 64-bit FNV-1a hash of its JSON
 /// form without the analyses, the outputs and the bodies' drawn shapes,
-/// with the type, constraint
-/// scale and penalty of the first analysis (module documentation), as
-/// `fnv1a64:` and 16 hex digits. Two inputs that build the same model with
+/// with the type, constraint scale and penalty of the first analysis
+/// (module documentation), as `fnv1a64:` and 16 hex digits. Two inputs that build the same model with
 /// the same scaling have the same fingerprint.
 pub fn fingerprint(input: &ModelInput) -> String {
     let first = &*input.analysis;

@@ -313,6 +313,10 @@ fn the_page_holds_the_steps_fields_histories_and_events_of_the_run() {
     assert!(page.html.contains("Copyright © 2010-2026 three.js authors"));
     assert!(page.html.contains("Copyright (c) 2022 Leon Sorokin"));
     println!("page: {} bytes", page.html.len());
+
+    // a new run in the directory removes the page of the earlier results
+    deployment(&dir);
+    assert!(!page_path.exists());
 }
 
 /// Fewer frames than steps: evenly spaced ones, the first, the last and

@@ -220,7 +220,7 @@ class Viewer {
   classify() {
     const tubes = []; // [cell, a, b, radius, colour]
     const spheres = []; // [cell or -1, point, radius, colour]
-    const triangles = []; // [cell, p, q, r]
+    const triangles = []; // [cell, p, q, r, colour of its kind]
     const faces = []; // polygons (point lists) for the edges
     const beamPoint = new Map(); // point → a beam cell through it
     const nCells = this.types.length;
@@ -249,7 +249,8 @@ class Viewer {
       }
     }
     for (const [c, poly] of faces) {
-      for (let k = 1; k + 1 < poly.length; k++) triangles.push([c, poly[0], poly[k], poly[k + 1]]);
+      const hex = this.kindName(c) === 'rigid body' ? KIND_COLOURS['rigid body'] : SURFACE_COLOUR;
+      for (let k = 1; k + 1 < poly.length; k++) triangles.push([c, poly[0], poly[k], poly[k + 1], hex]);
     }
     // spheres at the beams' nodes join their tubes
     for (const [point, c] of beamPoint) spheres.push([c, point, 1.0, KIND_COLOURS.beam, true]);
@@ -365,6 +366,7 @@ class Viewer {
     this.scale = new T.Vector3();
     this.up = new T.Vector3(0, 1, 0);
     this.colour = new T.Color();
+    this.white = new T.Color(0xffffff);
     this.resize();
     this.fit('iso');
   }
@@ -484,7 +486,7 @@ class Viewer {
   /// Colour of a kind, pale when another field colours the view.
   kindColour(hex) {
     this.colour.setHex(hex);
-    if (this.field >= 0) this.colour.lerp(new THREE.Color(0xffffff), 0.55);
+    if (this.field >= 0) this.colour.lerp(this.white, 0.55);
     return this.colour;
   }
 
@@ -554,11 +556,9 @@ class Viewer {
     const sp = this.surfaceGeometry.attributes.position.array;
     const sc = this.surfaceGeometry.attributes.color.array;
     let v = 0;
-    for (const [c, ...corners] of this.triangles) {
-      const name = this.kindName(c);
-      const hex = name === 'rigid body' ? KIND_COLOURS['rigid body'] : SURFACE_COLOUR;
+    for (const [c, p0, p1, p2, hex] of this.triangles) {
       const cellRgb = onPoints ? null : this.fieldColour(c, -1);
-      for (const p of corners) {
+      for (const p of [p0, p1, p2]) {
         const at = frameAt + 3 * p;
         sp[3 * v] = pos[at];
         sp[3 * v + 1] = pos[at + 1];

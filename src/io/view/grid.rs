@@ -252,7 +252,7 @@ impl Appended<'_> {
 /// Little-endian values of VTK type `ty`, as `f64`.
 fn decode(ty: &str, raw: &[u8]) -> Result<Vec<f64>, String> {
     fn each<const N: usize>(raw: &[u8], f: impl Fn([u8; N]) -> f64) -> Result<Vec<f64>, String> {
-        if raw.len() % N != 0 {
+        if !raw.len().is_multiple_of(N) {
             return Err(format!(
                 "{} bytes is not a whole number of values",
                 raw.len()

@@ -66,7 +66,7 @@ impl Blob {
     /// frame), as differences between frames in two byte planes (module
     /// documentation).
     pub fn frames(&mut self, codes: &[u16], width: usize) -> Value {
-        assert!(width > 0 && codes.len() % width == 0);
+        assert!(width > 0 && codes.len().is_multiple_of(width));
         let offset = self.start();
         let n = codes.len();
         self.bytes.resize(offset + 2 * n, 0);
@@ -139,7 +139,6 @@ pub fn deflate_base64(bytes: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use base64::Engine as _;
     use std::io::Read as _;
 
     /// Codes span `[0, 65534]` over the range; the frames' differences

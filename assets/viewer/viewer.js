@@ -450,8 +450,10 @@ class Viewer {
       ctx.fillStyle = `rgb(${255 * r},${255 * g},${255 * b})`;
       ctx.fillRect(x, 0, 1, canvas.height);
     }
-    document.getElementById('legend-min').textContent = fmt(lo);
-    document.getElementById('legend-max').textContent = fmt(hi);
+    // round-off about zero (a joint's load at rest, 1e-37) shows as 0
+    const tiny = 1e-9 * Math.max(Math.abs(lo), Math.abs(hi));
+    document.getElementById('legend-min').textContent = fmt(Math.abs(lo) < tiny ? 0 : lo);
+    document.getElementById('legend-max').textContent = fmt(Math.abs(hi) < tiny ? 0 : hi);
     document.getElementById('legend-name').textContent = f.name + (this.rangeOfFrame ? ' (this step)' : '');
   }
 

@@ -5,7 +5,11 @@
 //! unfold check MODEL.toml [--threads N]
 //! unfold plot RESULTS_DIR [joints|moments|energies|hinge_laws ...] [--joint ID ...] [--format png|svg|both]
 //!             [--out DIR] [--degrees] [--units si|model] [--model MODEL.toml]
+//! unfold view RESULTS_DIR [--out FILE] [--open | --no-open] [--histories FILES] [--max-frames N]
 //! ```
+//! `unfold view` writes one self-contained HTML page that animates the run
+//! in 3-D in a web browser (docs/viewer.md), and opens it when asked or
+//! when run in a terminal on a display.
 //! `unfold plot` draws the time histories of a run from its result files
 //! (docs/plots.md): joint coordinates with the lock instants, moments
 //! along the joint coordinates, energies and the energy balance error.
@@ -146,6 +150,32 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         model: Option<PathBuf>,
     },
+    /// Write one HTML page that animates the run in 3-D in a web browser,
+    /// with a time line, its events and a time-history plot
+    /// (docs/viewer.md); it works offline.
+    View {
+        /// Results directory of a run (`unfold run MODEL --out DIR`).
+        results: PathBuf,
+        /// The page to write (default: RESULTS/view.html).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+        /// Open the page in a web browser (by default it is opened when the
+        /// command runs in a terminal on a display).
+        #[arg(long, conflicts_with = "no_open")]
+        open: bool,
+        /// Do not open the page.
+        #[arg(long)]
+        no_open: bool,
+        /// The history files to embed for the plot, comma-separated
+        /// (`joints,energies`; `all` for every CSV file; default: every one
+        /// but nodes, nodes_velocities and beams).
+        #[arg(long, value_delimiter = ',', value_name = "FILES")]
+        histories: Vec<String>,
+        /// At most this many frames (evenly spaced output steps, and the
+        /// steps of the events).
+        #[arg(long, default_value_t = unfold::io::view::MAX_FRAMES, value_name = "N")]
+        max_frames: usize,
+    },
 }
 
 /// `--format` of `unfold plot`.
@@ -213,6 +243,27 @@ fn main() -> ExitCode {
             };
             let out = out.unwrap_or_else(|| results.join("plots"));
             plot(&results, model.as_deref(), &request, &out, format)
+        }
+        Command::View {
+            results,
+            out,
+            open,
+            no_open,
+            histories,
+            max_frames,
+        } => {
+            let options = unfold::io::view::ViewOptions {
+                histories,
+                max_frames,
+            };
+            let open = if open {
+                Some(true)
+            } else if no_open {
+                Some(false)
+            } else {
+                None
+            };
+            view(&results, out, open, &options)
         }
         Command::Run {
             model,
@@ -351,6 +402,109 @@ fn plot(
             ExitCode::from(code)
         }
     }
+}
+
+/// `unfold view`: writes the page of the results in `dir` to `out`
+/// (default `dir/view.html`) and opens it if `open` says so (by default
+/// when run in a terminal on a display); exit code 2 for results that
+/// cannot be read, 1 if the page cannot be written.
+fn view(
+    dir: &Path,
+    out: Option<PathBuf>,
+    open: Option<bool>,
+    options: &unfold::io::view::ViewOptions,
+) -> ExitCode {
+    if options.max_frames < 2 {
+        eprintln!(
+            "error: --max-frames {}: give at least 2 (the first and the last step)",
+            options.max_frames
+        );
+        return ExitCode::from(EXIT_INPUT);
+    }
+    let out = out.unwrap_or_else(|| dir.join("view.html"));
+    if out.is_dir() {
+        eprintln!(
+            "error: --out {}: is a directory; give the file of the page (e.g. {})",
+            out.display(),
+            out.join("view.html").display()
+        );
+        return ExitCode::from(EXIT_INPUT);
+    }
+    let start = std::time::Instant::now();
+    let report = match unfold::io::view::write_view(dir, &out, options) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(if e.is_input() {
+                EXIT_INPUT
+            } else {
+                EXIT_FAILED
+            });
+        }
+    };
+    for note in &report.notes {
+        eprintln!("note: {note}");
+    }
+    println!(
+        "{}: {} frames of {} output steps, {} points, {} cells, {} colour fields, {} history series, {} events; {:.2} MB, written in {:.2} s",
+        out.display(),
+        report.frames,
+        report.steps,
+        report.points,
+        report.cells,
+        report.fields.len(),
+        report.series,
+        report.events,
+        report.bytes as f64 / 1e6,
+        start.elapsed().as_secs_f64()
+    );
+    let open = open.unwrap_or_else(|| {
+        use std::io::IsTerminal as _;
+        std::io::stdout().is_terminal() && has_display()
+    });
+    if open {
+        match open_in_browser(&out) {
+            Ok(how) => eprintln!("opened with {how}"),
+            Err(e) => eprintln!("note: {e}; open {} in a web browser", out.display()),
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// Whether pages can be shown: a graphical session (X11 or Wayland on
+/// Linux and the like; always on macOS and Windows).
+fn has_display() -> bool {
+    if cfg!(any(target_os = "macos", target_os = "windows")) {
+        return true;
+    }
+    ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|d| !d.is_empty()))
+}
+
+/// Opens `page` in the web browser (`$BROWSER`, else `xdg-open`, `open` on
+/// macOS, `start` on Windows), without waiting for it; the command used.
+fn open_in_browser(page: &Path) -> Result<String, String> {
+    let mut command = if let Some(b) = std::env::var_os("BROWSER").filter(|b| !b.is_empty()) {
+        std::process::Command::new(b)
+    } else if cfg!(target_os = "macos") {
+        std::process::Command::new("open")
+    } else if cfg!(target_os = "windows") {
+        let mut c = std::process::Command::new("cmd");
+        c.args(["/C", "start", ""]);
+        c
+    } else {
+        std::process::Command::new("xdg-open")
+    };
+    let how = format!("{:?}", command.get_program());
+    command
+        .arg(page)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .map(|_| how.clone())
+        .map_err(|e| format!("no web browser could be started ({how}: {e})"))
 }
 
 fn describe(model: &Model) -> String {

@@ -52,8 +52,9 @@ use crate::state::State;
 
 /// Result files in the output directory that unfold writes besides the
 /// tables of the element kinds ([`ElementKind::results_file`]) and the
-/// grids `vtk/step_NNNNN.vtu`.
-const RUN_FILES: [&str; 9] = [
+/// grids `vtk/step_NNNNN.vtu`; `view.html` is the page `unfold view`
+/// makes of them (docs/viewer.md).
+const RUN_FILES: [&str; 10] = [
     "log.txt",
     "steps.csv",
     "nodes.csv",
@@ -63,6 +64,7 @@ const RUN_FILES: [&str; 9] = [
     "reactions.csv",
     "unfold.pvd",
     "summary.json",
+    "view.html",
 ];
 
 /// Result files in the output directory that unfold writes (besides the
@@ -984,6 +986,8 @@ impl ResultWriter {
             "nodes_velocities.csv" | "energies.csv" | "events.csv" => dynamics,
             // written again by whoever writes the summary
             "summary.json" => false,
+            // the page of earlier results: `unfold view` makes it again
+            "view.html" => false,
             _ => ElementKind::ALL
                 .into_iter()
                 .find(|k| k.results_file() == Some(name))

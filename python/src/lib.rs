@@ -22,6 +22,7 @@ pub mod model;
 pub mod observe;
 pub mod reference;
 pub mod results;
+pub mod so3;
 
 /// The extension module.
 #[pymodule]
@@ -31,6 +32,7 @@ fn _unfold(m: &Bound<'_, PyModule>) -> PyResult<()> {
     model::register(m)?;
     results::register(m)?;
     reference::register(m)?;
+    so3::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

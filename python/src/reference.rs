@@ -14,6 +14,10 @@ use pyo3::types::PyDict;
 #[path = "../../examples/era.rs"]
 mod era;
 
+#[allow(dead_code, clippy::all)]
+#[path = "../../examples/mast_cell.rs"]
+mod mast_cell;
+
 use era::design::Design;
 use era::geometry::{Geometry, Structure};
 
@@ -25,6 +29,16 @@ fn era_cell_model(gravity: f64) -> PyResult<String> {
     let built = era::deploy::model(&geometry, &era::case(Structure::Cell, gravity));
     built
         .input
+        .to_toml()
+        .map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
+/// The mast cell's model in `increments` increments, as the Rust example
+/// builds it (examples/mast_cell.rs, `build`): the model file (TOML).
+#[pyfunction]
+fn mast_cell_model(py: Python<'_>, increments: usize) -> PyResult<String> {
+    let cell = py.detach(|| mast_cell::build(increments));
+    cell.input
         .to_toml()
         .map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
@@ -67,6 +81,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let r = PyModule::new(m.py(), "_reference")?;
     r.add_function(wrap_pyfunction!(era_cell_model, &r)?)?;
     r.add_function(wrap_pyfunction!(era_cell_deployment, &r)?)?;
+    r.add_function(wrap_pyfunction!(mast_cell_model, &r)?)?;
     m.add_submodule(&r)?;
     Ok(())
 }

@@ -45,3 +45,9 @@ def __getattr__(name):
 
         return importlib.import_module(".study", __name__)
     raise AttributeError(f"module 'unfold' has no attribute {name!r}")
+
+
+import sys as _sys
+
+# `import unfold.so3` finds the submodule of the extension
+_sys.modules[__name__ + ".so3"] = _unfold.so3

@@ -13,6 +13,12 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 sys.path.insert(0, str(ROOT / "python" / "examples"))
+# the workers of a local Dask cluster import the tests' modules and the
+# examples by name
+os.environ["PYTHONPATH"] = os.pathsep.join(
+    [str(ROOT / "python" / "examples"), str(Path(__file__).parent)]
+    + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])
+)
 
 
 @pytest.fixture(scope="session")

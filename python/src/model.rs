@@ -216,13 +216,13 @@ impl PyModel {
         let first_static = plan.first().and_then(|a| a.as_static());
         let checked = first_static.map(|first| preflight::check(model, first));
         if let (Some(Err(e)), Some(first)) = (&checked, first_static) {
-            let message = e.to_string();
+            let message = format!("{label}: {e}");
             if let Some(dir) = out {
                 let analysis = StaticAnalysis::new(model.clone(), first.clone());
                 let _ = write_rejected(
                     dir,
                     Summary::start(&label, model, &analysis, plan),
-                    &message,
+                    &e.to_string(),
                     None,
                 );
             }
@@ -236,10 +236,11 @@ impl PyModel {
         if let Some(settings) = first_motion {
             if let Err(e) = preflight::check_motion(model, settings) {
                 if dynamic_input_error(&e) {
-                    let message = format!(
+                    let bare = format!(
                         "dynamic analysis at t = 0: {}",
                         dynamic_error_message(model, &model.initial_state(), &e)
                     );
+                    let message = format!("{label}: {bare}");
                     if let Some(dir) = out {
                         let analysis = DynamicAnalysis::new(model.clone(), settings.clone());
                         let end_time = plan.last().map_or(settings.end_time, |a| a.end_time());
@@ -250,7 +251,7 @@ impl PyModel {
                             analysis.nnz(),
                             end_time,
                         );
-                        let _ = write_rejected(dir, summary, &message, None);
+                        let _ = write_rejected(dir, summary, &bare, None);
                     }
                     return fail(Failure::Input(message), recorded);
                 }

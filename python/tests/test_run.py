@@ -51,7 +51,7 @@ def test_rollup_arrays_match_the_result_files(tmp_path):
         np.testing.assert_array_equal(q, results.quaternions[s, i])
         assert abs(float(row["time"]) - results.times[s]) <= 1e-12
     for row in read_csv(tmp_path / "beams.csv"):
-        s, e = int(row["step"]), ids.index(int(row["beam"]))
+        s, e = int(row["step"]), ids.index(int(row["element"]))
         for k, name in enumerate(names):
             v = float(row[name])
             assert abs(v - beams[s, e, k]) <= 1e-9 * max(1.0, abs(v)), (name, v, beams[s, e, k])
@@ -129,10 +129,11 @@ def test_exception_in_callback_stops_the_run_keeping_results(tmp_path):
     assert isinstance(e.value, KeyboardInterrupt)
     results = e.value.results
     assert results.status == "interrupted"
-    # the step during which the stop was asked is kept: steps 0..10
-    assert list(results.increments) == list(range(11))
+    # the step during which the stop was asked is kept, after the output
+    # steps before it (every 5 steps, `output_every`)
+    assert list(results.increments) == [0, 5, 10]
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert summary["status"] == "interrupted" and summary["output_steps"] == 11
+    assert summary["status"] == "interrupted" and summary["output_steps"] == 3
     assert "interrupted" in str(e.value) and "results up to t = " in str(e.value)
 
     def fail(p):
@@ -141,7 +142,7 @@ def test_exception_in_callback_stops_the_run_keeping_results(tmp_path):
 
     with pytest.raises(ValueError, match="no more") as e:
         model.run(progress=fail)
-    assert len(e.value.results) == 4 and e.value.results.status == "interrupted"
+    assert list(e.value.results.increments) == [0, 3] and e.value.results.status == "interrupted"
 
 
 def test_ctrl_c_stops_the_run_keeping_results(tmp_path):

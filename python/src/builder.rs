@@ -55,8 +55,8 @@ macro_rules! element_handle {
             /// The kind of element, as the result files name it
             /// (`beam`, `joint`, `latch`...).
             #[getter]
-            fn kind(&self) -> &'static str {
-                unfold::model::builder::ElementRef::kind(self.0).name()
+            fn kind(&self) -> String {
+                kind_name(unfold::model::builder::ElementRef::kind(self.0))
             }
 
             fn __repr__(&self) -> String {
@@ -71,6 +71,25 @@ macro_rules! element_handle {
             }
         }
     };
+}
+
+/// The Python name of a kind of element: the library's name with
+/// underscores (`hinge_law`, `rigid_body`), as its result file is named.
+pub fn kind_name(kind: unfold::elements::ElementKind) -> String {
+    kind.name().replace(' ', "_")
+}
+
+/// The kind of element of a Python name (`hinge_law`, or `hinge law`).
+pub fn kind_of(name: &str) -> PyResult<unfold::elements::ElementKind> {
+    unfold::elements::ElementKind::ALL
+        .into_iter()
+        .find(|k| k.name() == name || kind_name(*k) == name)
+        .ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "no kind of element is named {name:?} (kinds: {})",
+                unfold::elements::ElementKind::ALL.map(kind_name).join(", ")
+            ))
+        })
 }
 
 /// What a handle of an element tells: its kind and id.

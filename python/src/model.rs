@@ -497,17 +497,7 @@ impl PyModel {
             Some(names) => Some(
                 names
                     .iter()
-                    .map(|n| {
-                        ElementKind::ALL
-                            .into_iter()
-                            .find(|k| k.name() == n)
-                            .ok_or_else(|| {
-                                PyValueError::new_err(format!(
-                                    "no kind of element is named {n:?} (kinds: {})",
-                                    ElementKind::ALL.map(|k| k.name()).join(", ")
-                                ))
-                            })
-                    })
+                    .map(|n| builder::kind_of(n))
                     .collect::<PyResult<_>>()?,
             ),
         };
@@ -641,11 +631,11 @@ impl PyModel {
 
     /// The elements: `(kind, id)` in the model's order.
     #[getter]
-    fn elements(&self) -> Vec<(&'static str, u64)> {
+    fn elements(&self) -> Vec<(String, u64)> {
         self.model
             .elements
             .iter()
-            .map(|e| (e.kind().name(), e.id() as u64))
+            .map(|e| (builder::kind_name(e.kind()), e.id() as u64))
             .collect()
     }
 

@@ -62,8 +62,8 @@ pub struct PyElementHistory {
 impl PyElementHistory {
     /// The kind of element (`joint`, `latch`...).
     #[getter]
-    fn kind(&self) -> &'static str {
-        self.history.kind.name()
+    fn kind(&self) -> String {
+        builder::kind_name(self.history.kind)
     }
 
     /// Its id.
@@ -249,11 +249,7 @@ impl PyResults {
             builder::PyRollingDiscHandle
         );
         if let Ok((kind, id)) = element.extract::<(String, u64)>() {
-            let k = ElementKind::ALL
-                .into_iter()
-                .find(|k| k.name() == kind)
-                .ok_or_else(|| PyKeyError::new_err(format!("no kind of element is named {kind:?}")))?;
-            return Ok((k, id as Id));
+            return Ok((builder::kind_of(&kind)?, id as Id));
         }
         Err(PyTypeError::new_err(
             "an element: its handle, or (kind, id) such as (\"joint\", 5)",
@@ -428,13 +424,15 @@ impl PyResults {
     /// The elements whose results were kept: `(kind, id)` in the model's
     /// order, of `kind` only if given.
     #[pyo3(signature = (kind=None))]
-    fn elements(&self, kind: Option<&str>) -> Vec<(&'static str, u64)> {
-        self.recorded
+    fn elements(&self, kind: Option<&str>) -> PyResult<Vec<(String, u64)>> {
+        let kind = kind.map(builder::kind_of).transpose()?;
+        Ok(self
+            .recorded
             .elements
             .iter()
-            .filter(|h| kind.is_none_or(|k| h.kind.name() == k))
-            .map(|h| (h.kind.name(), h.id as u64))
-            .collect()
+            .filter(|h| kind.is_none_or(|k| h.kind == k))
+            .map(|h| (builder::kind_name(h.kind), h.id as u64))
+            .collect())
     }
 
     /// The history of an element (its handle, or `(kind, id)`): its
@@ -450,7 +448,7 @@ impl PyResults {
             .ok_or_else(|| {
                 PyKeyError::new_err(format!(
                     "{} {id} has no results kept (not in the model, or left out by `elements`)",
-                    kind.name()
+                    builder::kind_name(kind)
                 ))
             })?;
         Ok(PyElementHistory {
@@ -468,11 +466,12 @@ impl PyResults {
         py: Python<'py>,
         kind: &str,
     ) -> PyResult<(Vec<u64>, Vec<&'static str>, Bound<'py, PyArray3<f64>>)> {
+        let kind = builder::kind_of(kind)?;
         let hs: Vec<&ElementHistory> = self
             .recorded
             .elements
             .iter()
-            .filter(|h| h.kind.name() == kind)
+            .filter(|h| h.kind == kind)
             .collect();
         let names: Vec<&'static str> = hs
             .iter()

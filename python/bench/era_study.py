@@ -17,6 +17,6 @@ def era_figures(results, cell):
 
 def variants(n, seed=1):
     return [
-        dict(end_time=0.5, **p)
+        dict(end_time=1.2, **p)
         for p in study.monte_carlo(n, seed=seed, deployment_moment=(0.18, 0.22), rayleigh_beta=(0.0, 2e-5))
     ]

@@ -14,7 +14,8 @@ A variant is a dictionary of parameters. The model of a variant is made by
   (``Model.to_dict``): a key is a path of fields separated by dots, a
   number picks an entry of a list and ``*`` every entry, e.g.
   ``{"hinge_laws.*.tape_spring.deployment_moment": 0.3,
-  "analysis.0.rho_infinity": 0.6}``.
+  "analysis.rho_infinity": 0.6}`` (in a sequence of analyses
+  ``"analysis.1.rho_infinity"``).
 
 Each finished variant is a row: its index, its parameters, ``status``
 (``completed``, ``failed``, ``interrupted``, ``rejected``: an invalid

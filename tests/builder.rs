@@ -202,7 +202,10 @@ fn dynamic_step_controls_reach_the_settings() {
         .newton("modified");
     let settings = a.clone().analysis_settings().unwrap();
     let d = settings.as_dynamic().unwrap();
-    assert_eq!((d.min_step, d.max_step, d.error_tolerance), (1e-6, 0.02, 1e-5));
+    assert_eq!(
+        (d.min_step, d.max_step, d.error_tolerance),
+        (1e-6, 0.02, 1e-5)
+    );
     assert_eq!(d.newton, unfold::analysis::NewtonMethod::Modified);
     let input = a.into_input();
     assert_eq!(input.max_step, Some(0.02));

@@ -101,7 +101,14 @@ pub trait ElementLike {
 // ---------------------------------------------------------------- enums
 
 /// A unit of angles.
-#[pyclass(name = "AngleUnit", module = "unfold", eq, eq_int, frozen, from_py_object)]
+#[pyclass(
+    name = "AngleUnit",
+    module = "unfold",
+    eq,
+    eq_int,
+    frozen,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PyAngleUnit {
     /// Radians.
@@ -120,7 +127,14 @@ impl From<PyAngleUnit> for b::AngleUnit {
 }
 
 /// How a latch's coordinate reaches its locking value.
-#[pyclass(name = "Approach", module = "unfold", eq, eq_int, frozen, from_py_object)]
+#[pyclass(
+    name = "Approach",
+    module = "unfold",
+    eq,
+    eq_int,
+    frozen,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PyApproach {
     /// The coordinate increases to the value.
@@ -139,7 +153,14 @@ impl From<PyApproach> for b::Approach {
 }
 
 /// The bound a hinge law starts on.
-#[pyclass(name = "StartBranch", module = "unfold", eq, eq_int, frozen, from_py_object)]
+#[pyclass(
+    name = "StartBranch",
+    module = "unfold",
+    eq,
+    eq_int,
+    frozen,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PyStartBranch {
     /// The loading bound.
@@ -158,7 +179,14 @@ impl From<PyStartBranch> for b::StartBranch {
 }
 
 /// The side of the locking value a spring latch's spring acts on.
-#[pyclass(name = "LatchSide", module = "unfold", eq, eq_int, frozen, from_py_object)]
+#[pyclass(
+    name = "LatchSide",
+    module = "unfold",
+    eq,
+    eq_int,
+    frozen,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PyLatchSide {
     /// Both sides.
@@ -180,7 +208,14 @@ impl From<PyLatchSide> for LatchSide {
 }
 
 /// The type of a joint.
-#[pyclass(name = "JointType", module = "unfold", eq, eq_int, frozen, from_py_object)]
+#[pyclass(
+    name = "JointType",
+    module = "unfold",
+    eq,
+    eq_int,
+    frozen,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PyJointType {
     /// Hinge.
@@ -224,7 +259,14 @@ impl From<PyJointType> for b::JointType {
 }
 
 /// A relative coordinate of a joint (docs/joints.md).
-#[pyclass(name = "Coordinate", module = "unfold", eq, eq_int, frozen, from_py_object)]
+#[pyclass(
+    name = "Coordinate",
+    module = "unfold",
+    eq,
+    eq_int,
+    frozen,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PyCoordinate {
     /// The angle about the joint axis.
@@ -260,7 +302,14 @@ impl From<PyCoordinate> for b::Coordinate {
 
 /// One component of a node's motion: a translation along a global axis
 /// or an incremental rotation about a material axis.
-#[pyclass(name = "Component", module = "unfold", eq, eq_int, frozen, from_py_object)]
+#[pyclass(
+    name = "Component",
+    module = "unfold",
+    eq,
+    eq_int,
+    frozen,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PyComponent {
     /// Translation along global x.
@@ -294,7 +343,9 @@ impl From<PyComponent> for b::Component {
 #[pymethods]
 impl PyComponent {
     fn __or__(&self, other: &Bound<'_, PyAny>) -> PyResult<PyDofs> {
-        Ok(PyDofs(b::Dofs::from(b::Component::from(*self)) | dofs(other)?))
+        Ok(PyDofs(
+            b::Dofs::from(b::Component::from(*self)) | dofs(other)?,
+        ))
     }
 
     /// Name in model files (`x`, …, `rz`).
@@ -374,7 +425,14 @@ fn dofs(obj: &Bound<'_, PyAny>) -> PyResult<b::Dofs> {
 // -------------------------------------------------------------- handles
 
 /// A node of the model.
-#[pyclass(name = "NodeHandle", module = "unfold", frozen, eq, hash, from_py_object)]
+#[pyclass(
+    name = "NodeHandle",
+    module = "unfold",
+    frozen,
+    eq,
+    hash,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct PyNodeHandle(pub b::NodeHandle);
 
@@ -515,7 +573,14 @@ impl PyBeamLineHandle {
 }
 
 /// A section of the model.
-#[pyclass(name = "SectionHandle", module = "unfold", frozen, eq, hash, from_py_object)]
+#[pyclass(
+    name = "SectionHandle",
+    module = "unfold",
+    frozen,
+    eq,
+    hash,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct PySectionHandle(pub b::SectionHandle);
 
@@ -528,7 +593,14 @@ impl PySectionHandle {
 
 /// A curve of the model: one added, or a built-in one
 /// (`CurveHandle.RAMP`, `CurveHandle.CONSTANT`).
-#[pyclass(name = "CurveHandle", module = "unfold", frozen, eq, hash, from_py_object)]
+#[pyclass(
+    name = "CurveHandle",
+    module = "unfold",
+    frozen,
+    eq,
+    hash,
+    from_py_object
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct PyCurveHandle(pub CurveHandle);
 
@@ -730,7 +802,12 @@ wrapper!(
 impl PyBeamLine {
     /// `elements` beams of `section` from `a` to `b`.
     #[staticmethod]
-    fn between(a: PyNodeHandle, b: PyNodeHandle, elements: usize, section: PySectionHandle) -> Self {
+    fn between(
+        a: PyNodeHandle,
+        b: PyNodeHandle,
+        elements: usize,
+        section: PySectionHandle,
+    ) -> Self {
         Self(b::BeamLine::between(a.0, b.0, elements, section.0))
     }
 
@@ -830,7 +907,11 @@ impl PySpring {
     /// Resists the relative displacement along the global axes: one
     /// stiffness, or one per axis.
     #[staticmethod]
-    fn translational(a: PyNodeHandle, b: &Bound<'_, PyAny>, stiffness: Stiffness) -> PyResult<Self> {
+    fn translational(
+        a: PyNodeHandle,
+        b: &Bound<'_, PyAny>,
+        stiffness: Stiffness,
+    ) -> PyResult<Self> {
         Ok(Self(b::Spring::translational(a.0, body(b)?, stiffness)))
     }
 
@@ -1480,7 +1561,11 @@ impl PyPrescribedMotion {
     /// The translation `component` (`X`, `Y` or `Z`) of `node`.
     #[staticmethod]
     fn translation(node: PyNodeHandle, component: PyComponent, value: f64) -> Self {
-        Self(b::PrescribedMotion::translation(node.0, component.into(), value))
+        Self(b::PrescribedMotion::translation(
+            node.0,
+            component.into(),
+            value,
+        ))
     }
 
     /// The rotation of `node`, `R(t) = exp(f(t) ψ~) R₀`.

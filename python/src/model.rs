@@ -226,7 +226,9 @@ impl PyModel {
                     None,
                 );
             }
-            recorded.warnings.extend(model.warnings.iter().map(|w| w.to_string()));
+            recorded
+                .warnings
+                .extend(model.warnings.iter().map(|w| w.to_string()));
             return fail(Failure::Input(message), recorded);
         }
         let first_motion = plan
@@ -272,9 +274,8 @@ impl PyModel {
                     d.clone(),
                 ))))
             } else {
-                a.as_modal().map(|m| {
-                    Planned::Modal(Box::new(ModalAnalysis::new(model.clone(), m.clone())))
-                })
+                a.as_modal()
+                    .map(|m| Planned::Modal(Box::new(ModalAnalysis::new(model.clone(), m.clone()))))
             }
         });
         let Some(first_planned) = analyses.next() else {
@@ -407,8 +408,7 @@ impl PyModel {
                     observer.modes(k, &outcome);
                     state = std::mem::take(&mut outcome.state);
                     if let Some(e) = outcome.error.take() {
-                        let message =
-                            format!("{label}: modal analysis at t = {}: {e}", state.time);
+                        let message = format!("{label}: modal analysis at t = {}: {e}", state.time);
                         failure = Some(match e {
                             ModalError::NoMass => Failure::Input(message),
                             _ => Failure::Analysis(message),
@@ -516,9 +516,13 @@ impl PyModel {
             Some(t) => format!("results up to t = {} are kept", format_time(*t)),
             None => "no result step was kept".to_string(),
         };
-        let interrupted_message = outcome
-            .interrupted
-            .map(|i| format!("{}: {i} at t = {}; {kept}", self.label(), format_time(outcome.state.time)));
+        let interrupted_message = outcome.interrupted.map(|i| {
+            format!(
+                "{}: {i} at t = {}; {kept}",
+                self.label(),
+                format_time(outcome.state.time)
+            )
+        });
         let results = PyResults::new(
             self.model.clone(),
             outcome.recorded,
@@ -551,7 +555,11 @@ impl PyModel {
         }
         if check {
             let err = match outcome.failure {
-                Some(Failure::Input(m)) => Some(errors::model_error(py, m.clone(), vec![("model".into(), m)])),
+                Some(Failure::Input(m)) => Some(errors::model_error(
+                    py,
+                    m.clone(),
+                    vec![("model".into(), m)],
+                )),
                 Some(Failure::Analysis(m)) => Some(AnalysisError::new_err(m)),
                 Some(Failure::Output(m)) => Some(OutputError::new_err(m)),
                 None => None,

@@ -262,7 +262,12 @@ impl Progress {
     fn __repr__(&self) -> String {
         format!(
             "Progress(time={}, step={}, iterations={}, analysis={} ({}), wall_time={:.3})",
-            self.time, self.step, self.iterations, self.analysis, self.analysis_type, self.wall_time
+            self.time,
+            self.step,
+            self.iterations,
+            self.analysis,
+            self.analysis_type,
+            self.wall_time
         )
     }
 }
@@ -369,7 +374,9 @@ impl<'a> PyObserver<'a> {
         self.steps_since_call += 1;
         let now = Instant::now();
         let call = self.callback.filter(|c| {
-            let steps = c.every_steps.is_some_and(|n| self.steps_since_call >= n.max(1));
+            let steps = c
+                .every_steps
+                .is_some_and(|n| self.steps_since_call >= n.max(1));
             let seconds = c.every_seconds.is_some_and(|s| {
                 self.last_call
                     .is_none_or(|t| now.duration_since(t).as_secs_f64() >= s)

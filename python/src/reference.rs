@@ -54,7 +54,8 @@ fn era_cell_deployment<'py>(py: Python<'py>, gravity: f64) -> PyResult<Bound<'py
         let geometry = Geometry::new(&Design::default(), Structure::Cell);
         let built = era::deploy::model(&geometry, &era::case(Structure::Cell, gravity));
         let nominal = era::deploy::nominal(&geometry).map_err(|e| e.to_string())?;
-        let run = era::deploy::run(&built, &nominal, None, 1.0, false).map_err(|e| e.to_string())?;
+        let run =
+            era::deploy::run(&built, &nominal, None, 1.0, false).map_err(|e| e.to_string())?;
         let latches: Vec<Option<u64>> = built
             .parts
             .hinges()

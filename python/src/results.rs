@@ -35,7 +35,11 @@ pub const ENERGY_NAMES: [&str; 8] = [
 
 /// A `steps × a × b` array from its rows.
 fn array3<'py>(py: Python<'py>, values: &[f64], a: usize, b: usize) -> Bound<'py, PyArray3<f64>> {
-    let steps = if a * b == 0 { 0 } else { values.len() / (a * b) };
+    let steps = if a * b == 0 {
+        0
+    } else {
+        values.len() / (a * b)
+    };
     numpy::ndarray::Array3::from_shape_vec((steps, a, b), values.to_vec())
         .expect("steps × a × b values")
         .into_pyarray(py)
@@ -100,7 +104,9 @@ impl PyElementHistory {
                     self.history.names.join(", ")
                 ))
             })?;
-        let column: Vec<f64> = (0..self.steps).map(|s| self.history.values[s * n + k]).collect();
+        let column: Vec<f64> = (0..self.steps)
+            .map(|s| self.history.values[s * n + k])
+            .collect();
         Ok(column.into_pyarray(py))
     }
 
@@ -161,7 +167,13 @@ impl PyModes {
     /// Effective masses along x, y, z: modes × 3.
     #[getter]
     fn effective_masses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let flat: Vec<f64> = self.record.effective_masses.iter().flatten().copied().collect();
+        let flat: Vec<f64> = self
+            .record
+            .effective_masses
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
         array2(py, &flat, 3)
     }
 
@@ -395,7 +407,11 @@ impl PyResults {
 
     /// The history of node `node` (a handle or an id): its positions,
     /// steps × 3.
-    fn position<'py>(&self, py: Python<'py>, node: &Bound<'_, PyAny>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn position<'py>(
+        &self,
+        py: Python<'py>,
+        node: &Bound<'_, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let i = self.node_index(node)?;
         let n = self.recorded.nodes;
         let v: Vec<f64> = (0..self.steps())
@@ -540,10 +556,20 @@ impl PyResults {
     #[getter]
     fn peaks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        let err = |e: pythonize::PythonizeError| pyo3::exceptions::PyValueError::new_err(e.to_string());
-        d.set_item("latches", pythonize::pythonize(py, &self.peaks.latches()).map_err(err)?)?;
-        d.set_item("stops", pythonize::pythonize(py, &self.peaks.stops()).map_err(err)?)?;
-        d.set_item("contacts", pythonize::pythonize(py, &self.peaks.contacts()).map_err(err)?)?;
+        let err =
+            |e: pythonize::PythonizeError| pyo3::exceptions::PyValueError::new_err(e.to_string());
+        d.set_item(
+            "latches",
+            pythonize::pythonize(py, &self.peaks.latches()).map_err(err)?,
+        )?;
+        d.set_item(
+            "stops",
+            pythonize::pythonize(py, &self.peaks.stops()).map_err(err)?,
+        )?;
+        d.set_item(
+            "contacts",
+            pythonize::pythonize(py, &self.peaks.contacts()).map_err(err)?,
+        )?;
         Ok(d)
     }
 

@@ -441,7 +441,7 @@ impl PyNodeHandle {
     /// The node's id in the model file.
     #[getter]
     fn id(&self) -> u64 {
-        self.0.id() as u64
+        self.0.id()
     }
 
     fn __repr__(&self) -> String {

@@ -622,7 +622,7 @@ impl PyModel {
     /// The node ids, in the order of the results' node axis.
     #[getter]
     fn node_ids(&self) -> Vec<u64> {
-        self.model.node_ids.iter().map(|&i| i as u64).collect()
+        self.model.node_ids.clone()
     }
 
     /// The reference positions of the nodes (nodes × 3).
@@ -643,7 +643,7 @@ impl PyModel {
         self.model
             .elements
             .iter()
-            .map(|e| (builder::kind_name(e.kind()), e.id() as u64))
+            .map(|e| (builder::kind_name(e.kind()), e.id()))
             .collect()
     }
 

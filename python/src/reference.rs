@@ -59,7 +59,7 @@ fn era_cell_deployment<'py>(py: Python<'py>, gravity: f64) -> PyResult<Bound<'py
         let latches: Vec<Option<u64>> = built
             .parts
             .hinges()
-            .map(|h| h.latch.map(|l| l.id() as u64))
+            .map(|h| h.latch.map(|l| l.id()))
             .collect();
         Ok::<_, String>((run, latches))
     });

@@ -35,11 +35,7 @@ pub const ENERGY_NAMES: [&str; 8] = [
 
 /// A `steps × a × b` array from its rows.
 fn array3<'py>(py: Python<'py>, values: &[f64], a: usize, b: usize) -> Bound<'py, PyArray3<f64>> {
-    let steps = if a * b == 0 {
-        0
-    } else {
-        values.len() / (a * b)
-    };
+    let steps = values.len().checked_div(a * b).unwrap_or(0);
     numpy::ndarray::Array3::from_shape_vec((steps, a, b), values.to_vec())
         .expect("steps × a × b values")
         .into_pyarray(py)
@@ -73,7 +69,7 @@ impl PyElementHistory {
     /// Its id.
     #[getter]
     fn id(&self) -> u64 {
-        self.history.id as u64
+        self.history.id
     }
 
     /// The names of its results.
@@ -348,7 +344,7 @@ impl PyResults {
     /// The node ids, in the order of the node axis of the arrays.
     #[getter]
     fn node_ids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
-        let v: Vec<u64> = self.recorded.node_ids.iter().map(|&i| i as u64).collect();
+        let v: Vec<u64> = self.recorded.node_ids.clone();
         v.into_pyarray(py)
     }
 
@@ -447,7 +443,7 @@ impl PyResults {
             .elements
             .iter()
             .filter(|h| kind.is_none_or(|k| h.kind == k))
-            .map(|h| (builder::kind_name(h.kind), h.id as u64))
+            .map(|h| (builder::kind_name(h.kind), h.id))
             .collect())
     }
 
@@ -506,7 +502,7 @@ impl PyResults {
                 }
             }
         }
-        let ids = hs.iter().map(|h| h.id as u64).collect();
+        let ids = hs.iter().map(|h| h.id).collect();
         Ok((ids, names, array3(py, &values, hs.len(), width)))
     }
 
@@ -524,9 +520,9 @@ impl PyResults {
             d.set_item("increment", e.increment)?;
             d.set_item("time", e.time)?;
             d.set_item("element_kind", e.element_kind)?;
-            d.set_item("element", e.element as u64)?;
+            d.set_item("element", e.element)?;
             d.set_item("kind", e.kind)?;
-            d.set_item("joint", e.joint.map(|j| j as u64))?;
+            d.set_item("joint", e.joint)?;
             d.set_item("coordinate", e.coordinate)?;
             d.set_item("rate_before", e.rate_before)?;
             d.set_item("rate_after", e.rate_after)?;
@@ -543,7 +539,7 @@ impl PyResults {
         let mut m = std::collections::BTreeMap::new();
         for e in &self.recorded.events {
             if e.element_kind == "latch" && e.kind == "lock" {
-                m.entry(e.element as u64).or_insert(e.time);
+                m.entry(e.element).or_insert(e.time);
             }
         }
         m

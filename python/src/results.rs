@@ -193,7 +193,8 @@ impl PyModes {
     }
 }
 
-/// The results of a run (see the module documentation).
+/// The results of a run: its output steps as numpy arrays with their
+/// times, its events, peak loads and modes (docs/python.md, "Results").
 #[pyclass(name = "Results", module = "unfold", frozen)]
 pub struct PyResults {
     model: Arc<Model>,

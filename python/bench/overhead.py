@@ -1,18 +1,19 @@
-"""The cost of Python: the same models run from a Python-built model and
-from their model file by the `unfold` command (the Rust library alone),
-analysis wall time and whole-process time, best of `repeats` (the machine
-is shared: the smallest time is the least disturbed).
+"""The cost of Python: the same models built with the Python builders and
+run from Python, against their model file run by the `unfold` command (the
+Rust program alone), both writing the same result files; best of
+`repeats` runs, alternated (the machine is shared: the smallest time is
+the least disturbed). The Python time includes building the model in
+Python (and, for the mast cell, its assembly run); the command's, starting
+the process and reading the file.
 
     python python/bench/overhead.py [repeats]
 
 Models: the ERA cell's deployment (python/examples/era_cell.py; dynamic,
 265 steps) and the mast cell's folding (python/examples/mast_cell.py;
-kinetostatic, 96 increments). From Python the run keeps every element's
-results in memory as well as writing nothing (`out=None`); the command
-line writes its result files: both are timed as each is used.
+kinetostatic, 96 increments). The last column runs without result files
+(every element's results kept in memory).
 """
 
-import json
 import os
 import subprocess
 import sys
@@ -44,33 +45,30 @@ def main(repeats: int) -> None:
         "ERA cell (dynamic)": lambda: era_cell.build(0.0).builder,
         "mast cell (kinetostatic)": lambda: mast_cell.build(96)[0],
     }
-    rows = []
+    print(f"{'model':26} {'unfold run MODEL':>18} {'Python: build, run(out)':>24} {'overhead':>9} {'Python: build, run()':>21}")
     for name, make in cases.items():
         with tempfile.TemporaryDirectory() as tmp:
-            builder = make()
             path = Path(tmp) / "model.toml"
-            path.write_text(builder.to_toml())
-
-            def python_run():
-                return make().build().run()
-
-            def python_files():
-                return unfold.load_model(path).run(out=Path(tmp) / "py")
-
-            analysis = []
+            path.write_text(make().to_toml())
 
             def cli_run():
                 subprocess.run([cli, "run", str(path), "--out", str(Path(tmp) / "cli"), "--quiet"], check=True)
-                analysis.append(json.loads((Path(tmp) / "cli" / "summary.json").read_text())["wall_time_s"])
 
-            py = best(python_run, repeats)
-            py_files = best(python_files, repeats)
-            cl = best(cli_run, repeats)
-            rows.append((name, py, py_files, cl, min(analysis)))
-    print(f"{'model':28} {'Python, built, in memory':>26} {'Python, file, with files':>26} {'unfold run (process)':>22} {'unfold run (analysis)':>22}")
-    for name, py, pf, cl, an in rows:
-        print(f"{name:28} {py:24.3f} s {pf:24.3f} s {cl:20.3f} s {an:20.3f} s   overhead {100 * (py / an - 1):+.1f} % / {100 * (pf / cl - 1):+.1f} %")
+            def python_files():
+                make().build().run(out=Path(tmp) / "py")
+
+            def python_memory():
+                make().build().run()
+
+            # alternated, so that a change of the machine's load falls on both
+            cl, pf, pm = [], [], []
+            for _ in range(repeats):
+                cl.append(best(cli_run, 1))
+                pf.append(best(python_files, 1))
+                pm.append(best(python_memory, 1))
+            c, f, m = min(cl), min(pf), min(pm)
+            print(f"{name:26} {c:16.3f} s {f:22.3f} s {100 * (f / c - 1):+8.1f} % {m:19.3f} s")
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 3)
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 5)

@@ -11,7 +11,8 @@ the process and reading the file.
 Models: the ERA cell's deployment (python/examples/era_cell.py; dynamic,
 265 steps) and the mast cell's folding (python/examples/mast_cell.py;
 kinetostatic, 96 increments). The last column runs without result files
-(every element's results kept in memory).
+(every element's results kept in memory); `elements=[]` keeps the
+nodes alone in memory besides the files.
 """
 
 import os
@@ -45,29 +46,38 @@ def main(repeats: int) -> None:
         "ERA cell (dynamic)": lambda: era_cell.build(0.0).builder,
         "mast cell (kinetostatic)": lambda: mast_cell.build(96)[0],
     }
-    print(f"{'model':26} {'unfold run MODEL':>18} {'Python: build, run(out)':>24} {'overhead':>9} {'Python: build, run()':>21}")
+    print(
+        f"{'model':26} {'unfold run MODEL':>18} {'Python: run(out)':>24} {'overhead':>9} "
+        f"{'run(out, elements=[])':>19} {'overhead':>9} {'Python: run()':>21}"
+    )
     for name, make in cases.items():
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / "model.toml"
             path.write_text(make().to_toml())
 
             def cli_run():
-                subprocess.run([cli, "run", str(path), "--out", str(Path(tmp) / "cli"), "--quiet"], check=True)
+                subprocess.run([cli, "run", str(path), "--out", str(Path(tmp) / "cli"), "--quiet"], check=True, stdout=subprocess.DEVNULL)
 
             def python_files():
                 make().build().run(out=Path(tmp) / "py")
+
+            def python_files_only():
+                make().build().run(out=Path(tmp) / "py", elements=[])
 
             def python_memory():
                 make().build().run()
 
             # alternated, so that a change of the machine's load falls on both
-            cl, pf, pm = [], [], []
+            cl, pf, po, pm = [], [], [], []
             for _ in range(repeats):
                 cl.append(best(cli_run, 1))
                 pf.append(best(python_files, 1))
+                po.append(best(python_files_only, 1))
                 pm.append(best(python_memory, 1))
-            c, f, m = min(cl), min(pf), min(pm)
-            print(f"{name:26} {c:16.3f} s {f:22.3f} s {100 * (f / c - 1):+8.1f} % {m:19.3f} s")
+            c, f, o, m = min(cl), min(pf), min(po), min(pm)
+            print(
+                f"{name:26} {c:16.3f} s {f:22.3f} s {100 * (f / c - 1):+8.1f} % {o:17.3f} s {100 * (o / c - 1):+8.1f} % {m:19.3f} s"
+            )
 
 
 if __name__ == "__main__":

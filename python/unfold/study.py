@@ -314,8 +314,9 @@ def _numeric(rows: List[Row], name: str) -> List[float]:
 
 def plot(rows: List[Row], directory: Path, fmt: str = "png", key: Optional[Sequence[str]] = None) -> List[Path]:
     """Histograms of every figure that varies, and for each parameter the
-    key figures against it (``key``: by default the lock times, the peaks
-    and the largest final displacement), into ``directory/plots``."""
+    key figures against it (``key``: by default the last lock, the largest
+    latch and hinge loads and the largest final displacement, then the
+    figures of each latch, six at most), into ``directory/plots``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -343,7 +344,10 @@ def plot(rows: List[Row], directory: Path, fmt: str = "png", key: Optional[Seque
         plt.close(fig)
         written.append(path)
     if key is None:
-        key = [n for n in varying if n.startswith(("last_lock", "peak_", "final_max"))][:6]
+        # the figures of the whole structure first, then those of each part
+        first = ["last_lock", "peak_latch_moment", "peak_latch_load", "peak_hinge_moment", "final_max_displacement"]
+        rest = [n for n in varying if n.startswith(("lock_time", "peak_")) and n not in first]
+        key = ([n for n in first if n in varying] + rest)[:6]
     key = [k for k in key if k in varying]
     for p in params:
         if len(set(_numeric(rows, p))) < 2 or not key:

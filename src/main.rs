@@ -1,7 +1,7 @@
 //! `unfold`: command-line front end.
 //!
 //! ```text
-//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii] [--restart FILE]
+//! unfold run MODEL.toml [--out DIR] [--quiet | --verbose] [--threads N] [--vtk-ascii] [--restart FILE]
 //! unfold check MODEL.toml [--threads N]
 //! unfold plot RESULTS_DIR [joints|moments|energies|hinge_laws ...] [--joint ID ...] [--format png|svg|both]
 //!             [--out DIR] [--degrees] [--units si|model] [--model MODEL.toml]
@@ -37,6 +37,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -57,7 +58,7 @@ use unfold::io::run::{
     SignalEvent, StopRequest,
 };
 use unfold::io::vtk::Encoding;
-use unfold::model::input::ModelInput;
+use unfold::model::input::{ModelInput, OutputInput};
 use unfold::model::Model;
 
 // `println!` and `eprintln!` that ignore a failed write instead of
@@ -100,6 +101,11 @@ enum Command {
         /// Do not print a log line per increment.
         #[arg(long, short)]
         quiet: bool,
+        /// Print every increment's line even when the output is not a
+        /// terminal (by default a redirected run prints a progress line
+        /// every 10 s instead; log.txt has every line either way).
+        #[arg(long, short, conflicts_with = "quiet")]
+        verbose: bool,
         /// Worker threads for assembly and factorisation (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
@@ -269,6 +275,7 @@ fn main() -> ExitCode {
             model,
             out,
             quiet,
+            verbose,
             threads,
             vtk_ascii,
             restart,
@@ -312,7 +319,8 @@ fn main() -> ExitCode {
                 Encoding::Binary
             };
             // on a worker of the thread pool (unfold::assembly::on_worker_thread)
-            on_worker_thread(|| run(&model, &out, quiet, encoding, restart.as_deref()))
+            let echo = Echo { quiet, verbose };
+            on_worker_thread(|| run(&model, &out, echo, encoding, restart.as_deref()))
         }
     }
 }
@@ -737,26 +745,67 @@ enum Planned {
 /// bar, and the last line.
 struct Terminal {
     bar: ProgressBar,
-    quiet: bool,
+    echo: Echo,
     end_time: f64,
+    /// When the run started and when the last progress line was printed
+    /// (output not a terminal).
+    started: Instant,
+    last_progress: Instant,
+}
+
+/// Which lines a run prints (`--quiet`, `--verbose`).
+#[derive(Clone, Copy, Debug)]
+struct Echo {
+    quiet: bool,
+    verbose: bool,
+}
+
+/// Between two progress lines of a run whose output is not a terminal.
+const PROGRESS_INTERVAL: Duration = Duration::from_secs(10);
+
+/// Whether `text` is the line of one converged increment or step
+/// (`step 12  t = … iterations …`), which a redirected run leaves to
+/// log.txt unless `--verbose`.
+fn is_increment_line(text: &str) -> bool {
+    let mut words = text.split_whitespace();
+    matches!(words.next(), Some("step" | "increment"))
+        && words.next().is_some_and(|n| n.parse::<usize>().is_ok())
+        && text.contains(" iterations ")
 }
 
 impl Console for Terminal {
     fn line(&mut self, text: &str) {
-        if self.quiet {
+        if self.echo.quiet {
             return;
         }
-        // plainly when there is no bar (output not a terminal)
+        // plainly when there is no bar (output not a terminal), without
+        // the increments' lines unless asked
         if self.bar.is_hidden() {
-            println!("{text}");
+            if self.echo.verbose || !is_increment_line(text) {
+                println!("{text}");
+            }
         } else {
             self.bar.println(text);
         }
     }
 
     fn progress(&mut self, info: &IncrementInfo) {
-        // nothing formatted for a bar no one sees (output not a terminal)
+        // output not a terminal: a line every PROGRESS_INTERVAL
         if self.bar.is_hidden() {
+            if !self.echo.quiet
+                && !self.echo.verbose
+                && self.last_progress.elapsed() >= PROGRESS_INTERVAL
+            {
+                self.last_progress = Instant::now();
+                println!(
+                    "progress: t = {:.6} of {} ({:.0} %), increment {}, {:.0} s",
+                    info.time,
+                    format_time(self.end_time),
+                    100.0 * info.time / self.end_time,
+                    info.increment,
+                    self.started.elapsed().as_secs_f64()
+                );
+            }
             return;
         }
         self.bar
@@ -789,7 +838,7 @@ impl Console for Terminal {
 fn run(
     path: &Path,
     out: &Path,
-    quiet: bool,
+    echo: Echo,
     encoding: Encoding,
     restart: Option<&Path>,
 ) -> ExitCode {
@@ -934,8 +983,10 @@ fn run(
     );
     let terminal = Terminal {
         bar,
-        quiet,
+        echo,
         end_time: plan.last().map_or(1.0, |a| a.end_time()),
+        started: Instant::now(),
+        last_progress: Instant::now(),
     };
     let recorder = match &first_planned {
         Planned::Static(a) => Recorder::create_sequence(out, &label, a, plan, terminal),
@@ -946,6 +997,7 @@ fn run(
         Ok(r) => r
             .with_stop(&stop)
             .with_vtk_encoding(encoding)
+            .with_vtk_every(OutputInput::vtk_interval(input.output.as_ref()))
             .with_restart(restarts, first),
         Err(e) => {
             eprintln!("error: cannot write results: {e}");

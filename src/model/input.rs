@@ -184,6 +184,25 @@ pub struct OutputInput {
     /// output directory.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plots: Vec<String>,
+    /// Whether the VTK grids (`vtk/step_NNNNN.vtu`, `unfold.pvd`) are
+    /// written (default true); the CSV histories are written either way.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vtk: Option<bool>,
+    /// A VTK grid at every `vtk_every`-th output step (the first, then
+    /// every N-th; default 1, every output step).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vtk_every: Option<u64>,
+}
+
+impl OutputInput {
+    /// Every how many output steps a VTK grid is written; 0: none.
+    pub fn vtk_interval(output: Option<&Self>) -> usize {
+        match output {
+            Some(o) if o.vtk == Some(false) => 0,
+            Some(o) => o.vtk_every.map_or(1, |n| n.max(1) as usize),
+            None => 1,
+        }
+    }
 }
 
 /// A kinematic pair between node A and node B (or the ground).

@@ -1638,11 +1638,13 @@ fn a_rotational_spring_past_half_a_turn_stops_the_run() {
 fn kinematic_increments_show_the_constraint_violation() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/four_bar.toml");
     let dir = scratch("kinematic_lines");
+    // every increment's line, also when the output is not a terminal
     let (code, out, err) = unfold(&[
         "run",
         path.to_str().unwrap(),
         "--out",
         dir.join("out").to_str().unwrap(),
+        "--verbose",
     ]);
     assert_eq!(code, 0, "{err}");
     let lines: Vec<&str> = out

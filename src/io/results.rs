@@ -1109,6 +1109,10 @@ impl ResultWriter {
     /// included), none if `every` is 0 (`[output] vtk`, `vtk_every`).
     pub fn with_vtk_every(mut self, every: usize) -> Self {
         self.vtk_every = every;
+        if every == 0 {
+            // no grid will be written: no empty directory either
+            let _ = std::fs::remove_dir(self.dir.join("vtk"));
+        }
         self
     }
 
@@ -1355,7 +1359,7 @@ impl ResultWriter {
         let step = self.output_steps;
         self.format_step(step, info, model, state, residual);
         // the grid of this output step, if one is written
-        let grid = (self.vtk_every > 0 && step % self.vtk_every == 0).then(|| {
+        let grid = (self.vtk_every > 0 && step.is_multiple_of(self.vtk_every)).then(|| {
             let name = format!("step_{step:05}.vtu");
             (self.dir.join("vtk").join(&name), format!("vtk/{name}"))
         });

@@ -136,6 +136,13 @@ const CARRY_WAIT: usize = 64;
 /// velocity scale violate the joints (D10).
 const VELOCITY_TOLERANCE: f64 = 1e-6;
 
+/// Normwise backward error of the solves of the Newton corrections by
+/// GMRES (docs/theory.md §8, "Inexact corrections"), relative to Newton's
+/// residual tolerance: the linearised residual a correction leaves is
+/// then a hundredth of what Newton accepts; at most 10⁻¹⁰, at least the
+/// solver's default 10⁻¹⁴.
+const CORRECTION_BACKWARD_ERROR: f64 = 1e-2;
+
 /// Corrections larger than this times the model size, or than this in
 /// radians, mean the iteration matrix is singular or nearly so.
 const RUNAWAY_CORRECTION: f64 = 1e6;
@@ -2553,7 +2560,11 @@ impl Dynamics<'_> {
             .values_mut()
             .copy_from_slice(assembler.matrix.values());
         if factors.lu.is_none() {
-            factors.lu = Some(SymmetricFirst::analyze(matrix)?);
+            let mut lu = SymmetricFirst::analyze(matrix)?;
+            lu.set_backward_error(
+                (CORRECTION_BACKWARD_ERROR * self.settings.residual_tolerance).min(1e-10),
+            );
+            factors.lu = Some(lu);
         }
         let lu = factors.lu.as_mut().expect("analysed above");
         factors.count += 1;

@@ -38,6 +38,8 @@ pub enum ElementKind {
     Contact,
     /// Disc rolling without slipping on a plane.
     RollingDisc,
+    /// Flexible body reduced by Craig–Bampton on a floating frame.
+    Superelement,
 }
 
 /// A cell data array of the VTK files filled from an element's results:
@@ -65,7 +67,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 14] = [
+    pub const ALL: [ElementKind; 15] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -80,6 +82,7 @@ impl ElementKind {
         Self::Stop,
         Self::Contact,
         Self::RollingDisc,
+        Self::Superelement,
     ];
 
     /// Lower-case name used in messages and output file names.
@@ -99,6 +102,7 @@ impl ElementKind {
             Self::Stop => "stop",
             Self::Contact => "contact",
             Self::RollingDisc => "rolling disc",
+            Self::Superelement => "superelement",
         }
     }
 
@@ -119,6 +123,7 @@ impl ElementKind {
             Self::Stop => 12,
             Self::Contact => 14,
             Self::RollingDisc => 13,
+            Self::Superelement => 15,
         }
     }
 
@@ -137,6 +142,7 @@ impl ElementKind {
             Self::Stop => Some("stops.csv"),
             Self::Contact => Some("contacts.csv"),
             Self::RollingDisc => Some("rolling.csv"),
+            Self::Superelement => Some("superelements.csv"),
             Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
     }
@@ -150,6 +156,7 @@ impl ElementKind {
             Self::Stop => "stop",
             Self::Contact => "contact",
             Self::RollingDisc => "joint",
+            Self::Superelement => "superelement",
             _ => "element",
         }
     }

@@ -109,6 +109,22 @@ pub struct Superelement {
     offsets: Offsets,
 }
 
+/// The original mesh of a superelement at a state
+/// ([`Superelement::recovered_mesh`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RecoveredMesh {
+    /// Position of each mesh node, global frame.
+    pub position: Vec<Vec3>,
+    /// Orientation of each mesh node.
+    pub orientation: Vec<Rotation>,
+    /// Position of each mesh node in the floating frame (the reference
+    /// axes), `X + u`.
+    pub local_position: Vec<Vec3>,
+    /// Orientation of each mesh node in the floating frame,
+    /// `exp(θ~) R_ref`.
+    pub local_orientation: Vec<Rotation>,
+}
+
 /// Generic 3 × 3 algebra on [`M3`] (stored by columns).
 mod algebra {
     use super::*;
@@ -913,6 +929,33 @@ impl Superelement {
             }
         }
         u
+    }
+
+    /// The original mesh at `state` (docs/theory.md §17.7): the elastic
+    /// displacements `u = Φ_y y` recovered in the frame, and every mesh
+    /// node placed by the frame, `x = x₀ + A(X − X₀ + u)`,
+    /// `R = A exp(θ~) R_ref`. Returns the positions and orientations in
+    /// the model (global) and in the frame (`X + u`, `exp(θ~) R_ref`:
+    /// the state of the original elements, for their results).
+    pub fn recovered_mesh(&self, state: &State) -> RecoveredMesh {
+        let u = self.recovered(state);
+        let mesh = &self.body.body;
+        let (x0, a) = self.frame(state);
+        let origin = mesh.positions[self.body.boundary[self.frame]];
+        let rows = mesh.dof_rows();
+        let rot_a = so3::from_matrix(&a);
+        let mut out = RecoveredMesh::default();
+        for (i, r) in rows.iter().enumerate() {
+            let t = Vec3::from_fn(|c, _| r[c].map_or(0.0, |row| u[row]));
+            let theta = Vec3::from_fn(|c, _| r[3 + c].map_or(0.0, |row| u[row]));
+            let local_x = mesh.positions[i] + t;
+            let local_q = so3::exp(&theta) * mesh.orientations[i];
+            out.position.push(x0 + a * (local_x - origin));
+            out.orientation.push(rot_a * local_q);
+            out.local_position.push(local_x);
+            out.local_orientation.push(local_q);
+        }
+        out
     }
 }
 

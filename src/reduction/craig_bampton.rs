@@ -60,6 +60,12 @@ pub const ORTHOGONALITY_TOLERANCE: f64 = 1e-6;
 /// slenderness 1,000 between its ends); round-off leaves ~1e-15.
 pub const SINGULAR_BOUNDARY: f64 = 1e-12;
 
+/// `‖K r‖ / (‖|K|‖ ‖r‖)` of the rigid-body motions below which the body
+/// is free (its matrices hold no support): round-off leaves 1e-17 to
+/// 1e-15 (measured on beams and imported matrices written to 16 digits),
+/// 8-digit matrices ~1e-8.
+pub const FREE_BODY: f64 = 1e-6;
+
 /// How the fixed-interface modes are chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ModeSelection {
@@ -70,7 +76,8 @@ pub enum ModeSelection {
 }
 
 /// Which mass matrix the inertia invariants are computed from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum InertiaModel {
     /// The body's own mass matrix (consistent): docs/theory.md §17.5.
     #[default]
@@ -226,8 +233,9 @@ pub struct ReductionReport {
     pub mass_orthogonality: f64,
     /// `max |Φ_NᵀK_IIΦ_N − Ω²| / max ω²`.
     pub stiffness_orthogonality: f64,
-    /// `max |K̄_BN(i, k)| / √(K̄_BB(i, i) ω²_k)`: the constraint modes
-    /// against the fixed-interface ones.
+    /// `max |K̄_BN(i, k)| / √(K_BB(i, i) ω²_k)`: the constraint modes
+    /// against the fixed-interface ones, relative to the size of the terms
+    /// that cancel in `K̄_BN`.
     pub coupling_orthogonality: f64,
     /// `‖K r‖ / (‖|K|‖ ‖r‖)` over the six rigid-body motions `r` of the
     /// body: about 1e-16 for a free body; larger if the matrices hold
@@ -557,7 +565,9 @@ pub fn reduce(
         let coupling = (&k_ib + sparse_times(&k_ii, &psi)).transpose() * &phi_n;
         for i in 0..nb {
             for k in 0..nm {
-                let scale = (k_bar_bb[(i, i)].abs() * omega_squared[k]).sqrt();
+                // the size of the terms that cancel: the boundary dof's own
+                // stiffness (its reduced one vanishes for a rigid motion)
+                let scale = (k_bb[(i, i)].abs() * omega_squared[k]).sqrt();
                 if scale > 0.0 {
                     report.coupling_orthogonality = report
                         .coupling_orthogonality
@@ -655,20 +665,6 @@ pub fn reduce(
             reduced,
         })
         .collect();
-    let free = reduced_frequencies_with_zero(&reduced_stiffness, &reduced_mass)?;
-    report.free_zero_modes = free.0;
-    if settings.compare_free_free && !free.1.is_empty() {
-        let top = omega_squared.last().map_or(f64::INFINITY, |&w| hz(w));
-        let kept: Vec<f64> = free.1.iter().copied().filter(|&f| f <= top).collect();
-        let want = kept.len().max(1).min(free.1.len());
-        let full = full_free_frequencies(&body, free.0 + want)?;
-        report.free = full
-            .iter()
-            .zip(&free.1[..want])
-            .map(|(&full, &reduced)| FrequencyPair { full, reduced })
-            .collect();
-    }
-
     // the rigid-body motions leave the body unstrained
     let origin = body.positions[boundary[settings.frame]];
     let gamma = rigid_modes(&body, &origin);
@@ -690,6 +686,31 @@ pub fn reduce(
             }
         })
         .fold(0.0, f64::max);
+
+    // free-free: a free body's six rigid-body motions (the boundary dofs
+    // moving rigidly, the modes still) are taken out of the reduced
+    // pencil exactly, where round-off of K_BB + K_BI Ψ would leave them at
+    // ~1e-8 of ω² instead of zero
+    let rigid = (report.rigid_body_residual <= FREE_BODY).then(|| {
+        DMatrix::from_fn(
+            ncb,
+            6,
+            |i, j| if i < nb { gamma[(b_rows[i], j)] } else { 0.0 },
+        )
+    });
+    let free = free_frequencies(&reduced_stiffness, &reduced_mass, rigid.as_ref())?;
+    report.free_zero_modes = free.0;
+    if settings.compare_free_free && !free.1.is_empty() {
+        let top = omega_squared.last().map_or(f64::INFINITY, |&w| hz(w));
+        let kept: Vec<f64> = free.1.iter().copied().filter(|&f| f <= top).collect();
+        let want = kept.len().max(1).min(free.1.len());
+        let full = full_free_frequencies(&body, free.0 + want)?;
+        report.free = full
+            .iter()
+            .zip(&free.1[..want])
+            .map(|(&full, &reduced)| FrequencyPair { full, reduced })
+            .collect();
+    }
 
     // inertia invariants
     let mass_matrix = match settings.inertia {
@@ -792,6 +813,62 @@ fn dense_to_sparse(a: &DMatrix<f64>) -> SparseMatrix {
 /// Frequencies (Hz) of the dense pencil `(k, m)`, every mode.
 fn reduced_frequencies(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Result<Vec<f64>, ReductionError> {
     Ok(reduced_frequencies_with_zero(k, m)?.1)
+}
+
+/// The number of zero modes and the frequencies (Hz) of the others of the
+/// dense pencil `(k, m)` free-free: with the rigid-body motions `rigid`
+/// (columns) taken out, in the `m`-orthogonal complement of them, when
+/// given (six zero modes then).
+fn free_frequencies(
+    k: &DMatrix<f64>,
+    m: &DMatrix<f64>,
+    rigid: Option<&DMatrix<f64>>,
+) -> Result<(usize, Vec<f64>), ReductionError> {
+    let Some(r) = rigid else {
+        return reduced_frequencies_with_zero(k, m);
+    };
+    let n = k.nrows();
+    // an orthonormal basis Z of the complement of M r (Zᵀ M r = 0), by
+    // Gram–Schmidt with reorthogonalisation
+    let w = m * r;
+    let mut basis: Vec<DVector<f64>> = Vec::with_capacity(n);
+    let push = |basis: &mut Vec<DVector<f64>>, mut v: DVector<f64>| -> bool {
+        let size = v.norm();
+        for _ in 0..2 {
+            for b in basis.iter() {
+                let c = b.dot(&v);
+                v.axpy(-c, b, 1.0);
+            }
+        }
+        let left = v.norm();
+        if left > 1e-8 * size && left > 0.0 {
+            basis.push(v / left);
+            true
+        } else {
+            false
+        }
+    };
+    let mut rank = 0;
+    for j in 0..w.ncols() {
+        rank += usize::from(push(&mut basis, w.column(j).into_owned()));
+    }
+    for i in 0..n {
+        if basis.len() == n {
+            break;
+        }
+        push(
+            &mut basis,
+            DVector::from_fn(n, |r, _| if r == i { 1.0 } else { 0.0 }),
+        );
+    }
+    let z = DMatrix::from_columns(&basis[rank..]);
+    let kz = z.transpose() * k * &z;
+    let mz = z.transpose() * m * &z;
+    let (zero, f) = reduced_frequencies_with_zero(
+        &((&kz + kz.transpose()) * 0.5),
+        &((&mz + mz.transpose()) * 0.5),
+    )?;
+    Ok((zero + rank, f))
 }
 
 /// The number of zero modes and the frequencies (Hz) of the others of the

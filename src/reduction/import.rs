@@ -365,13 +365,15 @@ pub fn read_cells(path: &Path) -> Result<Vec<(usize, Vec<Id>)>, ImportError> {
             .collect();
         match w {
             Ok(w) if (3..=5).contains(&w.len()) => cells.push((line, w[1..].to_vec())),
-            _ => return Err(error(
-                path,
-                Some(line),
-                format!(
+            _ => {
+                return Err(error(
+                    path,
+                    Some(line),
+                    format!(
                     "a cell is `id n1 n2 [n3 [n4]]` (a line, triangle or quadrilateral), got `{l}`"
                 ),
-            )),
+                ))
+            }
         }
     }
     Ok(cells)

@@ -28,6 +28,7 @@ mod sections;
 mod settings;
 mod springs;
 mod stops;
+mod superelements;
 mod supports;
 
 use super::input::*;
@@ -336,6 +337,11 @@ struct Builder<'i> {
     beam_specs: Vec<BeamSpec>,
     fixed: Vec<[bool; 6]>,
     prescribed: Vec<Prescribed>,
+    /// Nodes taken out of the model inside a superelement, with its
+    /// entity.
+    absorbed_nodes: HashMap<Id, String>,
+    /// Rigid bodies and point masses reduced into a superelement.
+    absorbed_elements: HashSet<Id>,
 }
 
 impl Builder<'_> {
@@ -344,11 +350,11 @@ impl Builder<'_> {
     fn node(&mut self, entity: &str, id: Id) -> Option<usize> {
         let found = self.node_index.get(&id).copied();
         if found.is_none() && !self.invalid_nodes.contains(&id) {
-            self.ck.push(
-                ModelErrorKind::UnknownNode,
-                entity,
-                format!("node {id} does not exist"),
-            );
+            let message = match self.absorbed_nodes.get(&id) {
+                Some(holder) => format!("node {id} is inside {holder}, reduced away with its interior: make it one of its boundary nodes to attach to it"),
+                None => format!("node {id} does not exist"),
+            };
+            self.ck.push(ModelErrorKind::UnknownNode, entity, message);
         }
         found
     }
@@ -423,6 +429,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.stops.len(),
         input.contacts.len(),
         input.rolling_discs.len(),
+        input.superelements.len(),
         generated,
     ]
     .into_iter()
@@ -453,6 +460,8 @@ impl Model {
             beam_specs: Vec::new(),
             fixed: Vec::new(),
             prescribed: Vec::new(),
+            absorbed_nodes: HashMap::new(),
+            absorbed_elements: HashSet::new(),
         };
         let size = model_size(input);
         let mesh = size <= MAX_MODEL_SIZE;
@@ -469,6 +478,7 @@ impl Model {
         b.sections();
         b.beams();
         b.beam_lines(mesh);
+        b.superelements();
         b.build_beams();
         b.masses();
         b.springs();

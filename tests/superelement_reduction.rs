@@ -36,7 +36,12 @@ fn beam(n: usize) -> ModelInput {
 fn frame() -> ModelInput {
     let mut m = ModelInput::new("braced frame");
     m.analysis.kind = "modal".into();
-    for (id, x) in [(1, [0.0, 0.0, 0.0]), (2, [1.0, 0.0, 0.0]), (3, [1.0, 1.0, 0.0]), (4, [0.0, 1.0, 0.0])] {
+    for (id, x) in [
+        (1, [0.0, 0.0, 0.0]),
+        (2, [1.0, 0.0, 0.0]),
+        (3, [1.0, 1.0, 0.0]),
+        (4, [0.0, 1.0, 0.0]),
+    ] {
         m.add_node(id, x);
     }
     m.sections.push(tube());
@@ -53,7 +58,10 @@ fn body(input: &ModelInput) -> FlexibleBody {
 
 fn reduced(input: &ModelInput, boundary: &[u64], modes: ModeSelection) -> ReducedBody {
     let b = body(input);
-    let boundary = boundary.iter().map(|&id| b.node_index(id).unwrap()).collect();
+    let boundary = boundary
+        .iter()
+        .map(|&id| b.node_index(id).unwrap())
+        .collect();
     reduce(b, &ReductionSettings::new(boundary, modes)).unwrap()
 }
 
@@ -79,7 +87,11 @@ fn assert_reduction(r: &ReducedBody, tolerance: f64) {
     for p in &rep.clamped {
         assert!(p.relative_error().abs() < 1e-10, "{p:?}");
     }
-    let band = r.omega_squared.last().map_or(0.0, |w2| w2.sqrt() / std::f64::consts::TAU) / 1.5;
+    let band = r
+        .omega_squared
+        .last()
+        .map_or(0.0, |w2| w2.sqrt() / std::f64::consts::TAU)
+        / 1.5;
     let compared: Vec<_> = rep.free.iter().filter(|p| p.full <= band).collect();
     assert!(!compared.is_empty());
     for p in compared {
@@ -134,7 +146,10 @@ fn braced_frame_reduced_on_its_corners_keeps_its_frequencies() {
     let r = reduced(&frame(), &[1, 2, 3, 4], ModeSelection::CutOff(500.0));
     print("frame", &r);
     assert!(r.n_modes() > 0);
-    assert!(r.omega_squared.iter().all(|&w2| w2.sqrt() / std::f64::consts::TAU <= 500.0));
+    assert!(r
+        .omega_squared
+        .iter()
+        .all(|&w2| w2.sqrt() / std::f64::consts::TAU <= 500.0));
     assert_reduction(&r, 0.01);
 }
 
@@ -153,14 +168,19 @@ fn cantilever_modes_are_beam_theory() {
     for (k, f) in theory.iter().enumerate() {
         // each bending mode twice: in the two planes
         for p in &r.report.clamped[2 * k..2 * k + 2] {
-            assert!((p.reduced / f - 1.0).abs() < 5e-3, "mode {k}: {} against {f}", p.reduced);
+            assert!(
+                (p.reduced / f - 1.0).abs() < 5e-3,
+                "mode {k}: {} against {f}",
+                p.reduced
+            );
         }
     }
 }
 
 /// Writes `a` (`rows` of a body) as a symmetric Matrix Market file.
 fn write_mtx(path: &Path, a: &unfold::linalg::SparseMatrix) {
-    let lower: Vec<(usize, usize, f64)> = a.entries().filter(|e| e.0 >= e.1 && e.2 != 0.0).collect();
+    let lower: Vec<(usize, usize, f64)> =
+        a.entries().filter(|e| e.0 >= e.1 && e.2 != 0.0).collect();
     let mut text = format!(
         "%%MatrixMarket matrix coordinate real symmetric\n% written by the test\n{} {} {}\n",
         a.dim(),
@@ -179,7 +199,10 @@ fn write_dmig(path: &Path, b: &FlexibleBody) {
     let mut text = String::new();
     let dof = |r: usize| (b.node_ids[b.dofs[r].0], b.dofs[r].1 + 1);
     for (name, a) in [("KAAX", &b.stiffness), ("MAAX", &b.mass)] {
-        text.push_str(&format!("DMIG    {name:<8}       0       6       2       0                {:>8}\n", a.dim()));
+        text.push_str(&format!(
+            "DMIG    {name:<8}       0       6       2       0                {:>8}\n",
+            a.dim()
+        ));
         for c in 0..a.dim() {
             let entries: Vec<(usize, f64)> = a
                 .entries()
@@ -253,11 +276,18 @@ fn imported_matrices_reduce_as_the_model_they_came_from() {
     ] {
         let imported = import_body(&files, &none).unwrap();
         let boundary = [1, 2].map(|id| imported.node_index(id).unwrap()).to_vec();
-        let r = reduce(imported, &ReductionSettings::new(boundary, ModeSelection::Count(10))).unwrap();
+        let r = reduce(
+            imported,
+            &ReductionSettings::new(boundary, ModeSelection::Count(10)),
+        )
+        .unwrap();
         print(name, &r);
         assert_reduction(&r, 0.01);
         for (a, b) in r.report.free.iter().zip(&own.report.free) {
-            assert!((a.reduced / b.reduced - 1.0).abs() < tolerance, "{name}: {a:?} {b:?}");
+            assert!(
+                (a.reduced / b.reduced - 1.0).abs() < tolerance,
+                "{name}: {a:?} {b:?}"
+            );
         }
         for (a, b) in r.omega_squared.iter().zip(&own.omega_squared) {
             assert!((a / b - 1.0).abs() < tolerance, "{name}: {a} {b}");

@@ -123,6 +123,11 @@ pub struct RecoveredMesh {
     /// Orientation of each mesh node in the floating frame,
     /// `exp(θ~) R_ref`.
     pub local_orientation: Vec<Rotation>,
+    /// Velocity of each mesh node, global frame:
+    /// `ẋ₀ + A(ω × (X − X₀ + u) + u̇)`.
+    pub velocity: Vec<Vec3>,
+    /// Angular velocity of each mesh node, global frame: `A(ω + θ̇)`.
+    pub angular_velocity: Vec<Vec3>,
 }
 
 /// Generic 3 × 3 algebra on [`M3`] (stored by columns).
@@ -934,28 +939,126 @@ impl Superelement {
     /// The original mesh at `state` (docs/theory.md §17.7): the elastic
     /// displacements `u = Φ_y y` recovered in the frame, and every mesh
     /// node placed by the frame, `x = x₀ + A(X − X₀ + u)`,
-    /// `R = A exp(θ~) R_ref`. Returns the positions and orientations in
-    /// the model (global) and in the frame (`X + u`, `exp(θ~) R_ref`:
-    /// the state of the original elements, for their results).
+    /// `R = A exp(θ~) R_ref`, with its velocities. Returns the positions
+    /// and orientations in the model (global) and in the frame (`X + u`,
+    /// `exp(θ~) R_ref`: the state of the original elements, for their
+    /// results).
     pub fn recovered_mesh(&self, state: &State) -> RecoveredMesh {
-        let u = self.recovered(state);
-        let mesh = &self.body.body;
+        let k = self.kinematics(state, false);
+        let body = &self.body;
+        let n = body.basis.nrows();
+        let (mut u, mut u_dot) = (DVector::zeros(n), DVector::zeros(n));
+        for (j, &c) in body.y_columns.iter().enumerate() {
+            let column = body.basis.column(c);
+            if k.y[j] != 0.0 {
+                u.axpy(k.y[j], &column, 1.0);
+            }
+            if k.xi[6 + j] != 0.0 {
+                u_dot.axpy(k.xi[6 + j], &column, 1.0);
+            }
+        }
+        let mesh = &body.body;
         let (x0, a) = self.frame(state);
-        let origin = mesh.positions[self.body.boundary[self.frame]];
+        let (v0, w) = (k.a * v3(&k.xi, 0), v3(&k.xi, 3));
+        let origin = mesh.positions[body.boundary[self.frame]];
         let rows = mesh.dof_rows();
         let rot_a = so3::from_matrix(&a);
         let mut out = RecoveredMesh::default();
+        let at = |v: &DVector<f64>, r: &[Option<usize>; 6], first: usize| {
+            Vec3::from_fn(|c, _| r[first + c].map_or(0.0, |row| v[row]))
+        };
         for (i, r) in rows.iter().enumerate() {
-            let t = Vec3::from_fn(|c, _| r[c].map_or(0.0, |row| u[row]));
-            let theta = Vec3::from_fn(|c, _| r[3 + c].map_or(0.0, |row| u[row]));
+            let (t, theta) = (at(&u, r, 0), at(&u, r, 3));
             let local_x = mesh.positions[i] + t;
             let local_q = so3::exp(&theta) * mesh.orientations[i];
             out.position.push(x0 + a * (local_x - origin));
             out.orientation.push(rot_a * local_q);
             out.local_position.push(local_x);
             out.local_orientation.push(local_q);
+            out.velocity
+                .push(v0 + a * (w.cross(&(local_x - origin)) + at(&u_dot, r, 0)));
+            out.angular_velocity.push(a * (w + at(&u_dot, r, 3)));
         }
         out
+    }
+
+    /// The results of every original element of the body (the beams'
+    /// section forces; a shell's skin stresses) at the recovered mesh
+    /// `mesh`: each element's own [`Element::results`] on the state of the
+    /// mesh in the floating frame (objective elements give there what
+    /// they give in the model's frame). Empty for imported matrices,
+    /// which have no elements.
+    pub fn element_results(&self, mesh: &RecoveredMesh) -> Vec<Vec<f64>> {
+        let Some(model) = &self.body.body.elements else {
+            return Vec::new();
+        };
+        let state = State::at_rest(
+            0.0,
+            mesh.local_position.clone(),
+            mesh.local_orientation.clone(),
+        );
+        let ctx = EvalContext {
+            gravity: Vec3::zeros(),
+            ..model.context(0.0, super::Need::RESIDUAL)
+        };
+        model
+            .elements
+            .iter()
+            .map(|e| {
+                let mut out = vec![0.0; e.result_names().len()];
+                e.results(&ctx, &state, &mut out);
+                out
+            })
+            .collect()
+    }
+
+    /// A mode shape on the mesh: the translation and rotation (global) of
+    /// every mesh node for the small motion of the boundary nodes
+    /// `boundary` (translation and rotation of each, global) and of the
+    /// modal amplitudes `eta`, linearised about `state`:
+    /// `δx = δx₀ + δφ₀ × (x − x₀) + A Φ_t δy`, `δθ = δφ₀ + A Φ_θ δy`,
+    /// `δy = Υ_y δq`.
+    pub fn mode_shape(
+        &self,
+        state: &State,
+        boundary: &[(Vec3, Vec3)],
+        eta: &[f64],
+    ) -> Vec<(Vec3, Vec3)> {
+        let k = self.kinematics(state, true);
+        let (nb, nm) = (self.nodes.len(), self.n_modes());
+        let mut dq = DVector::zeros(6 * nb + nm);
+        for (b, (t, th)) in boundary.iter().enumerate() {
+            let material = so3::matrix(&state.q[self.nodes[b]]).transpose() * th;
+            for c in 0..3 {
+                dq[6 * b + c] = t[c];
+                dq[6 * b + 3 + c] = material[c];
+            }
+        }
+        for (j, e) in eta.iter().enumerate().take(nm) {
+            dq[6 * nb + j] = *e;
+        }
+        let ny = k.y.len();
+        let dy = k.upsilon.rows(6, ny) * &dq;
+        let body = &self.body;
+        let mut du = DVector::zeros(body.basis.nrows());
+        for (j, &c) in body.y_columns.iter().enumerate() {
+            du.axpy(dy[j], &body.basis.column(c), 1.0);
+        }
+        let mesh = self.recovered_mesh(state);
+        let (x0, a) = self.frame(state);
+        let (t0, phi0) = boundary[self.frame];
+        let rows = body.body.dof_rows();
+        rows.iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let t = Vec3::from_fn(|c, _| r[c].map_or(0.0, |row| du[row]));
+                let th = Vec3::from_fn(|c, _| r[3 + c].map_or(0.0, |row| du[row]));
+                (
+                    t0 + phi0.cross(&(mesh.position[i] - x0)) + a * t,
+                    phi0 + a * th,
+                )
+            })
+            .collect()
     }
 }
 

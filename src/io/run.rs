@@ -406,6 +406,10 @@ pub fn describe(model: &Model) -> String {
         0 => String::new(),
         n => format!(", {n} hinge laws"),
     };
+    let superelements = match count(ElementKind::Superelement) {
+        0 => String::new(),
+        n => format!(", {n} superelements"),
+    };
     format!(
         "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
         model.n_nodes(),
@@ -418,6 +422,7 @@ pub fn describe(model: &Model) -> String {
         count(ElementKind::Driver),
         count(ElementKind::NodalLoad),
     ) + &hinge_laws
+        + &superelements
 }
 
 /// `log.txt`: a line per increment, iteration, cut-back and note. A write
@@ -1496,6 +1501,7 @@ impl Recorder {
         self.summary.latches = self.peaks.latches();
         self.summary.stops = self.peaks.stops();
         self.summary.contacts = self.peaks.contacts();
+        self.summary.superelements = self.peaks.superelements();
         self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
         // the initial equilibria's iterations are counted in the total,

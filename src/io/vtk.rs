@@ -38,7 +38,7 @@ use std::path::{Path, PathBuf};
 use flate2::{Compress, Compression, FlushCompress, Status};
 
 use super::results::file_error;
-use crate::elements::{Attachment, CellField, CellShape, ElementKind, EvalContext};
+use crate::elements::{Attachment, CellField, CellShape, Element, ElementKind, EvalContext};
 use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -285,6 +285,14 @@ fn push3(out: &mut Vec<f64>, v: &Vec3) {
     out.extend_from_slice(&[v.x, v.y, v.z]);
 }
 
+/// The recovered mesh of a superelement in a grid: the element, its first
+/// point and the results of its original elements.
+struct Recovered {
+    element: usize,
+    first: usize,
+    results: Vec<Vec<f64>>,
+}
+
 /// Writes the grid of `state` to `path`.
 pub fn write_vtu(
     path: &Path,
@@ -315,13 +323,16 @@ pub fn write_step_vtu(
 }
 
 /// A mode shape on the nodes: translation and rotation (global frame) of
-/// each node.
+/// each node, and the generalised coordinates of the elements (a
+/// superelement's modal amplitudes; empty: zero).
 #[derive(Clone, Copy, Debug)]
 pub struct ModeField<'a> {
     /// Translation of each node.
     pub translation: &'a [Vec3],
     /// Rotation (small rotation vector) of each node.
     pub rotation: &'a [Vec3],
+    /// Coordinates of the elements, as in [`State::coordinates`].
+    pub coordinates: &'a [f64],
 }
 
 /// Writes the grid of `state` to `path` with a mode shape as the point
@@ -357,7 +368,7 @@ fn write_grid(
         attachments(model, &model.initial_state())
     };
 
-    // points: nodes then joint points
+    // points: nodes, joint points, then the recovered meshes
     let n_points = n_nodes + joints.len();
     let mut position = Vec::with_capacity(3 * n_points);
     let mut displacement = Vec::with_capacity(3 * n_points);
@@ -432,6 +443,75 @@ fn write_grid(
         node_id.push(-1);
         joint_id.push(model.elements[*k].id() as i64);
     }
+    // the original meshes of superelements, recovered (docs/results.md,
+    // "VTK files"): their points after the joint points
+    let recovered: Vec<Recovered> = model
+        .elements
+        .iter()
+        .enumerate()
+        .filter_map(|(k, e)| e.as_superelement().map(|s| (k, s)))
+        .map(|(k, s)| {
+            let first = node_id.len();
+            let mesh = s.recovered_mesh(state);
+            let body = &s.body().body;
+            for (i, x) in mesh.position.iter().enumerate() {
+                push3(&mut position, x);
+                push3(&mut displacement, &(x - body.positions[i]));
+                push3(
+                    &mut rotation,
+                    &so3::log(&(mesh.orientation[i] * body.orientations[i].inverse())),
+                );
+                let r = so3::matrix(&mesh.orientation[i]);
+                for (c, ax) in axes.iter_mut().enumerate() {
+                    push3(ax, &r.column(c).into_owned());
+                }
+                node_id.push(-1);
+                joint_id.push(-1);
+            }
+            if let Some(m) = &mode {
+                let boundary: Vec<(Vec3, Vec3)> = s
+                    .nodes()
+                    .iter()
+                    .map(|&n| (m.translation[n], m.rotation[n]))
+                    .collect();
+                let o = model.offsets(k).coordinates;
+                let eta: Vec<f64> = (0..s.n_coordinates())
+                    .map(|j| m.coordinates.get(o + j).copied().unwrap_or(0.0))
+                    .collect();
+                for (u, theta) in s.mode_shape(state, &boundary, &eta) {
+                    push3(&mut mode_u, &u);
+                    push3(&mut mode_theta, &theta);
+                }
+            }
+            if let Some(moving) = velocities {
+                for i in 0..mesh.position.len() {
+                    let (v, w) = if moving {
+                        (mesh.velocity[i], mesh.angular_velocity[i])
+                    } else {
+                        (Vec3::zeros(), Vec3::zeros())
+                    };
+                    push3(&mut velocity, &v);
+                    push3(&mut angular_velocity, &w);
+                }
+            }
+            let results = s.element_results(&mesh);
+            Recovered {
+                element: k,
+                first,
+                results,
+            }
+        })
+        .collect();
+    let mut mesh_node_id = vec![-1i64; node_id.len()];
+    for r in &recovered {
+        let s = model.elements[r.element]
+            .as_superelement()
+            .expect("a superelement");
+        for (i, id) in s.body().body.node_ids.iter().enumerate() {
+            mesh_node_id[r.first + i] = *id as i64;
+        }
+    }
+    let n_points = node_id.len();
 
     // cells: the shape of each element, its results in the cell arrays of
     // its kind (ElementKind::cell_fields), zeros in the others
@@ -445,6 +525,7 @@ fn write_grid(
     let mut types: Vec<u8> = Vec::new();
     let mut kinds: Vec<i32> = Vec::new();
     let mut ids: Vec<i64> = Vec::new();
+    let mut superelement_ids: Vec<i64> = Vec::new();
     let longest = model
         .elements
         .iter()
@@ -452,7 +533,11 @@ fn write_grid(
         .max()
         .unwrap_or(0);
     let mut results = vec![0.0; longest];
-    let mut cell = |points: &[usize], kind: i32, id: i64, values: Option<(ElementKind, &[f64])>| {
+    let mut cell = |points: &[usize],
+                    kind: i32,
+                    id: i64,
+                    superelement: i64,
+                    values: Option<(ElementKind, &[f64])>| {
         connectivity.extend(points.iter().map(|&p| p as i64));
         offsets.push(connectivity.len() as i64);
         types.push(
@@ -462,6 +547,7 @@ fn write_grid(
         );
         kinds.push(kind);
         ids.push(id);
+        superelement_ids.push(superelement);
         for ((k, f), column) in fields.iter().zip(&mut field_values) {
             match values {
                 Some((of, v)) if of == *k && f.first + f.components <= v.len() => {
@@ -472,20 +558,47 @@ fn write_grid(
         }
     };
     let mut next_joint_point = n_nodes;
+    let joint_points_end = n_nodes + joints.len();
     for (k, e) in model.elements.iter().enumerate() {
         let id = e.id() as i64;
         let nodes = e.nodes();
         // joints: links from the nodes to the joint points, a marker at B's
         let first = next_joint_point;
-        while next_joint_point < n_points && joints[next_joint_point - n_nodes].0 == k {
+        while next_joint_point < joint_points_end && joints[next_joint_point - n_nodes].0 == k {
             let a = &joints[next_joint_point - n_nodes].1;
             if let Some(node) = a.node {
-                cell(&[node, next_joint_point], KIND_LINK, id, None);
+                cell(&[node, next_joint_point], KIND_LINK, id, -1, None);
             }
             next_joint_point += 1;
         }
         if next_joint_point > first {
-            cell(&[next_joint_point - 1], e.kind().code(), id, None);
+            cell(&[next_joint_point - 1], e.kind().code(), id, -1, None);
+            continue;
+        }
+        // a superelement: the cells of its original mesh, each with its
+        // original element's kind, id and results
+        if let Some(r) = recovered.iter().find(|r| r.element == k) {
+            let s = e.as_superelement().expect("a superelement");
+            let body = &s.body().body;
+            let mut points = Vec::new();
+            for c in &body.cells {
+                points.clear();
+                points.extend(c.nodes.iter().map(|&i| r.first + i));
+                let original = c
+                    .element
+                    .zip(body.elements.as_ref())
+                    .map(|(el, m)| &m.elements[el]);
+                match original {
+                    Some(o) => {
+                        let values = r
+                            .results
+                            .get(c.element.unwrap_or(0))
+                            .map(|v| (o.kind(), &v[..]));
+                        cell(&points, o.kind().code(), o.id() as i64, id, values);
+                    }
+                    None => cell(&points, e.kind().code(), id, id, None),
+                }
+            }
             continue;
         }
         let shape = e.cell_shape();
@@ -502,7 +615,7 @@ fn write_grid(
             e.results(ctx, state, r);
             Some((kind, &*r))
         };
-        cell(points, kind.code(), id, values);
+        cell(points, kind.code(), id, -1, values);
     }
     let n_cells = types.len();
 
@@ -545,12 +658,18 @@ fn write_grid(
         doc.array("velocity", 3, &velocity);
         doc.array("angular_velocity", 3, &angular_velocity);
     }
+    if !recovered.is_empty() {
+        doc.array("mesh_node_id", 1, &mesh_node_id);
+    }
     doc.xml.push_str("      </PointData>\n");
 
     // cell data
     doc.xml.push_str("      <CellData Scalars=\"kind\">\n");
     doc.array("kind", 1, &kinds);
     doc.array("element_id", 1, &ids);
+    if !recovered.is_empty() {
+        doc.array("superelement_id", 1, &superelement_ids);
+    }
     for ((_, f), column) in fields.iter().zip(&field_values) {
         doc.array(f.name, f.components, column);
     }

@@ -95,12 +95,13 @@ impl Builder<'_> {
 
         // the boundary and the frame node
         if se.boundary.is_empty() {
+            // the body's elements stay in the model: no node is taken out
             self.ck.push(
                 ModelErrorKind::Missing,
                 entity,
                 "boundary: no boundary node; list at least one (the node its floating frame is attached to)",
             );
-            ok = false;
+            return None;
         }
         for (k, b) in se.boundary.iter().enumerate() {
             if se.boundary[..k].contains(b) {
@@ -307,11 +308,14 @@ impl Builder<'_> {
             compare_free_free: se.check_frequencies.unwrap_or(true),
         };
         match reduce(body, &settings) {
-            Ok(body) => Some(Pending {
-                id: se.id,
-                model_nodes,
-                body,
-            }),
+            Ok(body) => {
+                self.ck.note(entity, reduction_summary(&body));
+                Some(Pending {
+                    id: se.id,
+                    model_nodes,
+                    body,
+                })
+            }
             Err(e) => {
                 self.ck.push(ModelErrorKind::Invalid, entity, e.to_string());
                 None
@@ -643,6 +647,40 @@ impl Builder<'_> {
             s.nodes = s.nodes.map(|n| new_index[n]);
         }
     }
+}
+
+/// The reduction in one line, for the notes of `unfold check` and
+/// `unfold run`.
+fn reduction_summary(b: &ReducedBody) -> String {
+    let r = &b.report;
+    let hz = |w2: &f64| w2.sqrt() / std::f64::consts::TAU;
+    let modes = match (b.omega_squared.first(), b.omega_squared.last()) {
+        (Some(lo), Some(hi)) => format!(" ({:.4} to {:.4} Hz)", hz(lo), hz(hi)),
+        _ => String::new(),
+    };
+    let free = if r.free.is_empty() {
+        String::new()
+    } else {
+        let worst = r
+            .free
+            .iter()
+            .fold(0.0f64, |a, p| a.max(p.relative_error().abs()));
+        format!(
+            "; its {} free-free modes up to {:.4} Hz within {:.2} % of the full model's",
+            r.free.len(),
+            r.free.last().map_or(0.0, |p| p.full),
+            100.0 * worst
+        )
+    };
+    format!(
+        "{} dofs reduced to {} boundary nodes and {} fixed-interface modes{modes} in {:.3} s, {} inertia, mass {:.6e}{free}",
+        r.dofs,
+        b.n_boundary(),
+        b.n_modes(),
+        r.seconds,
+        b.inertia.name(),
+        r.mass
+    )
 }
 
 /// The diagonal of the box around `x` (1 if it is empty or a point).

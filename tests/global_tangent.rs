@@ -1,7 +1,8 @@
 //! The assembled tangent equals central finite differences of the
 //! assembled residual, on a model that mixes every element kind (beams on
 //! an arc, a rigid body with an offset centre of mass under gravity,
-//! translational, rotational and axial springs, dead and follower loads)
+//! translational, rotational and axial springs, dead and follower loads,
+//! a panel of shells with an unsymmetric laminate under pressure)
 //! with fixed dofs, in a deformed configuration with large rotations. This
 //! checks the scatter maps and dof numbering on top of the element tests.
 //!
@@ -20,6 +21,52 @@ use unfold::model::input::*;
 use unfold::model::Model;
 use unfold::so3::Vec3;
 use unfold::state::State;
+
+/// A 2 × 2 panel of shells (an unsymmetric two-ply laminate, so that
+/// every block of the shell's matrices is filled) beside the bend, under
+/// a pressure, held at its corner node 500.
+fn add_panel(m: &mut ModelInput, density: f64) {
+    m.ply_materials.push(PlyMaterialInput {
+        name: "sheet".into(),
+        e: Some(1e7),
+        nu: Some(0.3),
+        density: Some(density),
+        ..Default::default()
+    });
+    m.laminates.push(LaminateInput {
+        name: "two plies".into(),
+        plies: vec![
+            PlyInput {
+                material: "sheet".into(),
+                thickness: 0.5,
+                angle: None,
+            },
+            PlyInput {
+                material: "sheet".into(),
+                thickness: 0.2,
+                angle: Some(0.7),
+            },
+        ],
+        ..Default::default()
+    });
+    m.panels.push(PanelInput {
+        name: "panel".into(),
+        size: [10.0, 8.0],
+        elements: [2, 2],
+        laminate: "two plies".into(),
+        origin: Some([0.0, -20.0, 0.0]),
+        axis_a: Some([1.0, 0.2, 0.0]),
+        axis_b: Some([0.0, 0.3, 1.0]),
+        zones: Vec::new(),
+        stiffeners: Vec::new(),
+        pressure: Some(3.0),
+        pressure_curve: None,
+        first_node: Some(500),
+        first_element: Some(500),
+        node_ids: None,
+    });
+    m.fix(500, &["all"]);
+}
 
 #[test]
 fn assembled_tangent_matches_finite_differences() {
@@ -89,7 +136,12 @@ fn assembled_tangent_matches_finite_differences() {
         node: 5,
         fixed: vec!["y".into(), "rz".into()],
     });
+    add_panel(&mut m, 0.0);
     let model = Model::from_input(&m).unwrap();
+    assert!(model
+        .elements
+        .iter()
+        .any(|e| e.kind() == unfold::elements::ElementKind::Shell));
 
     // a deformed state with rotations of order one radian
     let mut state = model.initial_state();
@@ -136,7 +188,8 @@ fn assembled_tangent_matches_finite_differences() {
 /// (docs/theory.md §11.5), a rigid body with
 /// its centre of mass off its node, a point mass, the springs, and a link
 /// (a second beam) hinged to the tip by a revolute joint carrying a spring
-/// and a damper, driven by a driver on the same hinge.
+/// and a damper, driven by a driver on the same hinge, and a panel of
+/// shells with their consistent mass.
 fn dynamic_model() -> Model {
     let mut m = common::example("bend_45.toml");
     m.sections[0].mass_per_length = Some(0.3);
@@ -218,6 +271,7 @@ fn dynamic_model() -> Model {
         node: 5,
         fixed: vec!["y".into(), "rz".into()],
     });
+    add_panel(&mut m, 0.8);
     Model::from_input(&m).unwrap()
 }
 

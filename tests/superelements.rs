@@ -1,5 +1,5 @@
 //! Superelements in the mechanism (src/elements/superelement.rs,
-//! docs/theory.md §17): statics, dynamics and energies against the same
+//! docs/theory.md §18): statics, dynamics and energies against the same
 //! bodies in beam elements.
 
 mod common;
@@ -355,7 +355,7 @@ fn settled_flap(text: &str) -> f64 {
 /// uniform cantilever, `1 + 1.19 (Ω/ω₀)²` in the first mode (Southwell's
 /// coefficient; Bauchau & Craig, Structural Analysis, §16.4; Hodges &
 /// Pierce), within 2 % of that ratio (the load excites higher modes too,
-/// whose coefficients differ). Documented in docs/theory.md §17.8.
+/// whose coefficients differ). Documented in docs/theory.md §18.8.
 /// Measured: flap at rest 6.1490e-4 m; at 2 rad/s beams 6.1468e-4,
 /// superelement 6.1490e-4 (0.04 %); at 50 rad/s beams 5.4828e-4 (a
 /// stiffening of 1.1215 against Southwell's 1.1202), superelement

@@ -287,6 +287,20 @@ pub enum DynamicError {
         /// Violation relative to the tolerance.
         violation: f64,
     },
+    /// A converged step took an element where its law does not hold (a
+    /// shell turned past the rotations of its linear theory, a beam or a
+    /// rotational spring past half a turn of a relative rotation).
+    #[error("{element}, between t = {from} and t = {time}: {reason}")]
+    LawViolated {
+        /// The element, as in messages (`shell 12`, `beam 3`).
+        element: String,
+        /// Time at the start of the step.
+        from: f64,
+        /// Time reached.
+        time: f64,
+        /// What happened.
+        reason: String,
+    },
     /// The initial velocities move the joints apart.
     #[error("the initial velocities violate {constraint}: its rate is {rate:.3e} (tolerance {tolerance:.1e}); give the connected nodes velocities of one rigid motion, or velocities the joint allows")]
     InconsistentVelocity {
@@ -3082,6 +3096,17 @@ impl Stepper for Dynamics<'_> {
                 constraint,
                 violation,
             });
+        }
+        // laws that hold within bounds (docs/theory.md §3.1, §17.5)
+        for e in &self.model.elements {
+            if let Some(reason) = e.law_violated(&self.run.accepted, &self.run.state) {
+                return Err(DynamicError::LawViolated {
+                    element: format!("{} {}", e.kind().name(), e.id()),
+                    from: self.run.accepted.time,
+                    time: info.time,
+                    reason,
+                });
+            }
         }
         let (model, run) = (self.model, &mut *self.run);
         // the controller may snap t onto a landing time within round-off

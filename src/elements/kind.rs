@@ -38,6 +38,8 @@ pub enum ElementKind {
     Contact,
     /// Disc rolling without slipping on a plane.
     RollingDisc,
+    /// Flat four-node shell of a laminated section (linear).
+    Shell,
     /// Flexible body reduced by Craig–Bampton on a floating frame.
     Superelement,
 }
@@ -67,7 +69,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 15] = [
+    pub const ALL: [ElementKind; 16] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -82,6 +84,7 @@ impl ElementKind {
         Self::Stop,
         Self::Contact,
         Self::RollingDisc,
+        Self::Shell,
         Self::Superelement,
     ];
 
@@ -102,6 +105,7 @@ impl ElementKind {
             Self::Stop => "stop",
             Self::Contact => "contact",
             Self::RollingDisc => "rolling disc",
+            Self::Shell => "shell",
             Self::Superelement => "superelement",
         }
     }
@@ -123,7 +127,8 @@ impl ElementKind {
             Self::Stop => 12,
             Self::Contact => 14,
             Self::RollingDisc => 13,
-            Self::Superelement => 15,
+            Self::Shell => 15,
+            Self::Superelement => 16,
         }
     }
 
@@ -142,6 +147,7 @@ impl ElementKind {
             Self::Stop => Some("stops.csv"),
             Self::Contact => Some("contacts.csv"),
             Self::RollingDisc => Some("rolling.csv"),
+            Self::Shell => Some("shells.csv"),
             Self::Superelement => Some("superelements.csv"),
             Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
@@ -171,6 +177,12 @@ impl ElementKind {
             CellField::new("M2", 1, 4),
             CellField::new("M3", 1, 5),
         ];
+        const SHELL: [CellField; 4] = [
+            CellField::new("shell_N", 3, 0),
+            CellField::new("shell_M", 3, 3),
+            CellField::new("shell_Q", 2, 6),
+            CellField::new("shell_von_mises", 1, 8),
+        ];
         const SPRING: [CellField; 2] = [
             CellField::new("spring_F", 3, 0),
             CellField::new("spring_D", 3, 3),
@@ -178,6 +190,7 @@ impl ElementKind {
         match self {
             Self::Beam => &BEAM,
             Self::Spring => &SPRING,
+            Self::Shell => &SHELL,
             _ => &[],
         }
     }

@@ -1,8 +1,8 @@
 //! Elements: everything that contributes to the residual and its
 //! matrices.
 //!
-//! Beams, rigid bodies, point masses, springs, nodal loads and joints are
-//! all elements behind one small trait, [`Element`]; the assembler does not
+//! Beams, shells, rigid bodies, point masses, springs, nodal loads and
+//! joints are all elements behind one small trait, [`Element`]; the assembler does not
 //! know which is which. The same trait carries what analyses need:
 //! - generalised coordinates ([`Element::n_coordinates`]: a slider's curve
 //!   parameter, modal amplitudes) and Lagrange multipliers
@@ -30,8 +30,10 @@
 pub mod beam;
 pub mod inertia;
 mod kind;
+pub mod laminate;
 pub mod load;
 pub mod mass;
+pub mod shell;
 pub mod spring;
 pub mod superelement;
 
@@ -316,8 +318,14 @@ pub trait Element: Send + Sync {
     }
 
     /// The element as a superelement, for the recovery of its original
-    /// mesh in the outputs (docs/theory.md §17.7).
+    /// mesh in the outputs (docs/theory.md §18.7).
     fn as_superelement(&self) -> Option<&superelement::Superelement> {
+        None
+    }
+
+    /// The element as a shell, for its stress recovery
+    /// ([`shell::Shell::layer_stresses`]).
+    fn as_shell(&self) -> Option<&shell::Shell> {
         None
     }
 

@@ -1,6 +1,6 @@
 //! A flexible body reduced by Craig–Bampton, moving on a floating frame
 //! (reference paper §5, eq. 20–29; Cardona & Géradin 1991; docs/theory.md
-//! §17).
+//! §18).
 //!
 //! ## Unknowns
 //! Its nodes are the boundary nodes of the body, ordinary nodes of the
@@ -662,7 +662,7 @@ impl Superelement {
     }
 
     /// The body-level inertia forces of the floating frame (docs/theory.md
-    /// §17.5) and their derivatives in `y`, `ξ`, `ξ̇`.
+    /// §18.5) and their derivatives in `y`, `ξ`, `ξ̇`.
     fn inertia_forces(
         &self,
         y: &DVector<f64>,
@@ -936,7 +936,7 @@ impl Superelement {
         u
     }
 
-    /// The original mesh at `state` (docs/theory.md §17.7): the elastic
+    /// The original mesh at `state` (docs/theory.md §18.7): the elastic
     /// displacements `u = Φ_y y` recovered in the frame, and every mesh
     /// node placed by the frame, `x = x₀ + A(X − X₀ + u)`,
     /// `R = A exp(θ~) R_ref`, with its velocities. Returns the positions
@@ -992,11 +992,7 @@ impl Superelement {
         let Some(model) = &self.body.body.elements else {
             return Vec::new();
         };
-        let state = State::at_rest(
-            0.0,
-            mesh.local_position.clone(),
-            mesh.local_orientation.clone(),
-        );
+        let state = Self::local_state(mesh);
         let ctx = EvalContext {
             gravity: Vec3::zeros(),
             ..model.context(0.0, super::Need::RESIDUAL)
@@ -1010,6 +1006,44 @@ impl Superelement {
                 out
             })
             .collect()
+    }
+
+    /// The stresses of the skins, `[bottom, top]`, at the centre of every
+    /// shell of the body at the recovered mesh `mesh` (`None` for its
+    /// other elements; empty for imported matrices): each shell's own
+    /// layer stress recovery ([`super::shell::Shell::layer_stresses`],
+    /// [`super::shell::Shell::skin_stresses`]) on the displacements of the
+    /// mesh in the floating frame (docs/theory.md §18.7).
+    pub fn skin_stresses(
+        &self,
+        mesh: &RecoveredMesh,
+    ) -> Vec<Option<[super::shell::SkinStress; 2]>> {
+        let Some(model) = &self.body.body.elements else {
+            return Vec::new();
+        };
+        let state = Self::local_state(mesh);
+        let mut layers = Vec::new();
+        model
+            .elements
+            .iter()
+            .map(|e| {
+                e.as_shell().map(|shell| {
+                    let d = shell.displacements(&state);
+                    shell.layer_stresses_into(&d, super::shell::StressPoint::Centre, &mut layers);
+                    shell.skin_stresses(&layers)
+                })
+            })
+            .collect()
+    }
+
+    /// The state of the body's own model at the recovered mesh, in the
+    /// floating frame, at rest.
+    fn local_state(mesh: &RecoveredMesh) -> State {
+        State::at_rest(
+            0.0,
+            mesh.local_position.clone(),
+            mesh.local_orientation.clone(),
+        )
     }
 
     /// A mode shape on the mesh: the translation and rotation (global) of
@@ -1258,7 +1292,7 @@ impl Element for Superelement {
             let psi = so3::axial(&e).norm().atan2(0.5 * (e.trace() - 1.0));
             if psi > LARGEST_ELASTIC_ROTATION {
                 return Some(format!(
-                    "a boundary node turned by {psi:.3} rad relative to its floating frame: a superelement is a linear model of small elastic deformations (docs/theory.md §17); split the body, or model it with beams"
+                    "a boundary node turned by {psi:.3} rad relative to its floating frame: a superelement is a linear model of small elastic deformations (docs/theory.md §18); split the body, or model it with beams"
                 ));
             }
         }
@@ -1279,7 +1313,7 @@ impl Element for Superelement {
 }
 
 impl Superelement {
-    /// `p = 𝕄(y) ξ` (docs/theory.md §17.5).
+    /// `p = 𝕄(y) ξ` (docs/theory.md §18.5).
     fn momentum(&self, k: &Kinematics) -> DVector<f64> {
         let inv = &self.body.invariants;
         let y = &k.y;

@@ -121,6 +121,10 @@ pub struct ResultPeak {
     pub kind: &'static str,
     /// Its nodes (ids in the body).
     pub nodes: Vec<Id>,
+    /// For a skin stress of a shell: the layer of its laminate (from the
+    /// bottom, 0) where it is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layer: Option<usize>,
     /// When (`null` if never reached: a body at rest).
     pub time: Option<f64>,
     /// At which increment, numbered across the run as in `steps.csv`.
@@ -149,6 +153,17 @@ pub struct SuperelementRecord {
     /// the run (empty for imported matrices).
     pub peaks: Vec<ResultPeak>,
 }
+
+/// The skin stresses of a shell followed over a run, `[bottom, top]`:
+/// von Mises and the principal stresses where it is largest.
+const SKIN_QUANTITIES: [[&str; 3]; 2] = [
+    [
+        "bottom_skin_von_mises",
+        "bottom_skin_sigma1",
+        "bottom_skin_sigma2",
+    ],
+    ["top_skin_von_mises", "top_skin_sigma1", "top_skin_sigma2"],
+];
 
 /// Follows the loads of a model's latches, stops and contacts over a run,
 /// and the results of the original elements of its superelements.
@@ -300,9 +315,11 @@ impl PeakLoads {
             let Some(originals) = &se.body().body.elements else {
                 continue;
             };
-            let results = se.element_results(&se.recovered_mesh(state));
-            for (e, values) in originals.elements.iter().zip(&results) {
-                for (&quantity, &value) in e.result_names().iter().zip(values) {
+            let mesh = se.recovered_mesh(state);
+            let results = se.element_results(&mesh);
+            let skins = se.skin_stresses(&mesh);
+            let mut take =
+                |e: &dyn Element, quantity: &'static str, value: f64, layer: Option<usize>| {
                     let at = match record.peaks.iter().position(|p| p.quantity == quantity) {
                         Some(at) => at,
                         None => {
@@ -312,6 +329,7 @@ impl PeakLoads {
                                 element: e.id(),
                                 kind: e.kind().name(),
                                 nodes: e.nodes().iter().map(|&n| originals.node_ids[n]).collect(),
+                                layer,
                                 time: None,
                                 increment: None,
                             });
@@ -324,8 +342,24 @@ impl PeakLoads {
                         p.element = e.id();
                         p.kind = e.kind().name();
                         p.nodes = e.nodes().iter().map(|&n| originals.node_ids[n]).collect();
+                        p.layer = layer;
                         p.time = Some(time);
                         p.increment = Some(increment);
+                    }
+                };
+            for (e, values) in originals.elements.iter().zip(&results) {
+                for (&quantity, &value) in e.result_names().iter().zip(values) {
+                    take(e.as_ref(), quantity, value, None);
+                }
+            }
+            for (e, skin) in originals.elements.iter().zip(&skins) {
+                let Some(skin) = skin else {
+                    continue;
+                };
+                for (s, names) in skin.iter().zip(SKIN_QUANTITIES) {
+                    let values = [s.von_mises, s.principal[0], s.principal[1]];
+                    for (quantity, value) in names.into_iter().zip(values) {
+                        take(e.as_ref(), quantity, value, Some(s.layer));
                     }
                 }
             }

@@ -410,6 +410,10 @@ pub fn describe(model: &Model) -> String {
         0 => String::new(),
         n => format!(", {n} superelements"),
     };
+    let shells = match count(ElementKind::Shell) {
+        0 => String::new(),
+        n => format!(", {n} shells"),
+    };
     format!(
         "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
         model.n_nodes(),
@@ -423,6 +427,7 @@ pub fn describe(model: &Model) -> String {
         count(ElementKind::NodalLoad),
     ) + &hinge_laws
         + &superelements
+        + &shells
 }
 
 /// `log.txt`: a line per increment, iteration, cut-back and note. A write

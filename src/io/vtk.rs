@@ -38,6 +38,7 @@ use std::path::{Path, PathBuf};
 use flate2::{Compress, Compression, FlushCompress, Status};
 
 use super::results::file_error;
+use crate::elements::shell::SkinStress;
 use crate::elements::{Attachment, CellField, CellShape, Element, ElementKind, EvalContext};
 use crate::model::Model;
 use crate::so3::{self, Vec3};
@@ -291,6 +292,22 @@ struct Recovered {
     element: usize,
     first: usize,
     results: Vec<Vec<f64>>,
+    /// The skin stresses of its shells (`None` for its other elements).
+    skins: Vec<Option<[SkinStress; 2]>>,
+}
+
+/// A cell's skin stresses in the grid: von Mises of the bottom and top
+/// skins, then the principal stresses of each.
+fn skin_row(skins: &[SkinStress; 2]) -> [f64; 6] {
+    let [b, t] = skins;
+    [
+        b.von_mises,
+        t.von_mises,
+        b.principal[0],
+        b.principal[1],
+        t.principal[0],
+        t.principal[1],
+    ]
 }
 
 /// Writes the grid of `state` to `path`.
@@ -495,10 +512,12 @@ fn write_grid(
                 }
             }
             let results = s.element_results(&mesh);
+            let skins = s.skin_stresses(&mesh);
             Recovered {
                 element: k,
                 first,
                 results,
+                skins,
             }
         })
         .collect();
@@ -526,6 +545,12 @@ fn write_grid(
     let mut kinds: Vec<i32> = Vec::new();
     let mut ids: Vec<i64> = Vec::new();
     let mut superelement_ids: Vec<i64> = Vec::new();
+    // the skin stresses of the shells of recovered meshes (docs/results.md,
+    // "VTK files"), six a cell
+    let with_skins = recovered
+        .iter()
+        .any(|r| r.skins.iter().any(Option::is_some));
+    let mut skin_values: Vec<f64> = Vec::new();
     let longest = model
         .elements
         .iter()
@@ -537,7 +562,8 @@ fn write_grid(
                     kind: i32,
                     id: i64,
                     superelement: i64,
-                    values: Option<(ElementKind, &[f64])>| {
+                    values: Option<(ElementKind, &[f64])>,
+                    skin: Option<[f64; 6]>| {
         connectivity.extend(points.iter().map(|&p| p as i64));
         offsets.push(connectivity.len() as i64);
         types.push(
@@ -548,6 +574,9 @@ fn write_grid(
         kinds.push(kind);
         ids.push(id);
         superelement_ids.push(superelement);
+        if with_skins {
+            skin_values.extend(skin.unwrap_or([0.0; 6]));
+        }
         for ((k, f), column) in fields.iter().zip(&mut field_values) {
             match values {
                 Some((of, v)) if of == *k && f.first + f.components <= v.len() => {
@@ -567,12 +596,12 @@ fn write_grid(
         while next_joint_point < joint_points_end && joints[next_joint_point - n_nodes].0 == k {
             let a = &joints[next_joint_point - n_nodes].1;
             if let Some(node) = a.node {
-                cell(&[node, next_joint_point], KIND_LINK, id, -1, None);
+                cell(&[node, next_joint_point], KIND_LINK, id, -1, None, None);
             }
             next_joint_point += 1;
         }
         if next_joint_point > first {
-            cell(&[next_joint_point - 1], e.kind().code(), id, -1, None);
+            cell(&[next_joint_point - 1], e.kind().code(), id, -1, None, None);
             continue;
         }
         // a superelement: the cells of its original mesh, each with its
@@ -590,13 +619,12 @@ fn write_grid(
                     .map(|(el, m)| &m.elements[el]);
                 match original {
                     Some(o) => {
-                        let values = r
-                            .results
-                            .get(c.element.unwrap_or(0))
-                            .map(|v| (o.kind(), &v[..]));
-                        cell(&points, o.kind().code(), o.id() as i64, id, values);
+                        let at = c.element.unwrap_or(0);
+                        let values = r.results.get(at).map(|v| (o.kind(), &v[..]));
+                        let skin = r.skins.get(at).copied().flatten().map(|s| skin_row(&s));
+                        cell(&points, o.kind().code(), o.id() as i64, id, values, skin);
                     }
-                    None => cell(&points, e.kind().code(), id, id, None),
+                    None => cell(&points, e.kind().code(), id, id, None, None),
                 }
             }
             continue;
@@ -615,7 +643,7 @@ fn write_grid(
             e.results(ctx, state, r);
             Some((kind, &*r))
         };
-        cell(points, kind.code(), id, -1, values);
+        cell(points, kind.code(), id, -1, values, None);
     }
     let n_cells = types.len();
 
@@ -669,6 +697,17 @@ fn write_grid(
     doc.array("element_id", 1, &ids);
     if !recovered.is_empty() {
         doc.array("superelement_id", 1, &superelement_ids);
+    }
+    if with_skins {
+        let column = |first: usize, n: usize| -> Vec<f64> {
+            skin_values
+                .chunks_exact(6)
+                .flat_map(|row| row[first..first + n].iter().copied())
+                .collect()
+        };
+        doc.array("skin_von_mises", 2, &column(0, 2));
+        doc.array("bottom_skin_principal", 2, &column(2, 2));
+        doc.array("top_skin_principal", 2, &column(4, 2));
     }
     for ((_, f), column) in fields.iter().zip(&field_values) {
         doc.array(f.name, f.components, column);

@@ -8,6 +8,7 @@
 
 use std::fmt;
 
+use super::input::{PanelPoint, PanelSide};
 use super::{Id, Model};
 use crate::elements::beam::SectionForces;
 use crate::elements::{Element, ElementKind};
@@ -74,6 +75,11 @@ element_handle!(
     /// A beam element.
     BeamHandle,
     ElementKind::Beam
+);
+element_handle!(
+    /// A shell element.
+    ShellHandle,
+    ElementKind::Shell
 );
 element_handle!(
     /// A rigid body.
@@ -163,6 +169,77 @@ impl BeamLineHandle {
     }
 }
 
+/// The nodes and elements of a panel (docs/model-format.md,
+/// `[[panels]]`): a grid of `(nx + 1) × (ny + 1)` nodes, `(i, j)` at
+/// `i a/nx` along side `a` and `j b/ny` along side `b`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PanelHandle {
+    /// Elements along each side, `[nx, ny]`.
+    pub elements: [usize; 2],
+    /// Id of the grid node `(0, 0)` (unless named otherwise).
+    pub(super) first_node: Id,
+    /// Ids given to the named points, in the order of [`PanelPoint::ALL`].
+    pub(super) named: [Option<Id>; 8],
+    /// The shells, `(i, j)` at `j nx + i`.
+    pub shells: Vec<ShellHandle>,
+    /// The beams of each stiffener (in the order given), from the start
+    /// of its side.
+    pub stiffeners: Vec<Vec<BeamHandle>>,
+}
+
+impl PanelHandle {
+    /// The node at grid position `(i, j)`.
+    ///
+    /// # Panics
+    /// Outside the grid.
+    #[track_caller]
+    pub fn node(&self, i: usize, j: usize) -> NodeHandle {
+        let [nx, ny] = self.elements;
+        assert!(
+            i <= nx && j <= ny,
+            "({i}, {j}) is outside the {nx} × {ny} panel"
+        );
+        let named = PanelPoint::at(nx, ny, i, j).and_then(|p| {
+            let k = PanelPoint::ALL.iter().position(|q| *q == p)?;
+            self.named[k]
+        });
+        NodeHandle(named.unwrap_or(self.first_node + (j * (nx + 1) + i) as Id))
+    }
+
+    /// A named node: a corner or the middle of a side.
+    pub fn point(&self, point: PanelPoint) -> NodeHandle {
+        let (i, j) = point.grid(self.elements[0], self.elements[1]);
+        self.node(i, j)
+    }
+
+    /// The nodes along `side`, from its start (`south` and `north` from
+    /// west to east, `east` and `west` from south to north).
+    pub fn side(&self, side: PanelSide) -> Vec<NodeHandle> {
+        let [nx, ny] = self.elements;
+        match side {
+            PanelSide::South => (0..=nx).map(|i| self.node(i, 0)).collect(),
+            PanelSide::North => (0..=nx).map(|i| self.node(i, ny)).collect(),
+            PanelSide::West => (0..=ny).map(|j| self.node(0, j)).collect(),
+            PanelSide::East => (0..=ny).map(|j| self.node(nx, j)).collect(),
+        }
+    }
+
+    /// Every node, row by row from the south side.
+    pub fn nodes(&self) -> Vec<NodeHandle> {
+        let [nx, ny] = self.elements;
+        (0..=ny)
+            .flat_map(|j| (0..=nx).map(move |i| (i, j)))
+            .map(|(i, j)| self.node(i, j))
+            .collect()
+    }
+
+    /// The shell at `(i, j)` (its corner nearest the origin at node
+    /// `(i, j)`).
+    pub fn shell(&self, i: usize, j: usize) -> ShellHandle {
+        self.shells[j * self.elements[0] + i]
+    }
+}
+
 /// The results of one element at one state, named as in its result file
 /// (docs/results.md).
 #[derive(Clone, Debug, PartialEq)]
@@ -245,6 +322,15 @@ impl Model {
             &mut values,
         );
         ElementResults { names, values }
+    }
+
+    /// The shell element of `handle`, for its stress recovery
+    /// ([`crate::elements::shell::Shell::layer_stresses`]).
+    #[track_caller]
+    pub fn shell(&self, handle: ShellHandle) -> &crate::elements::shell::Shell {
+        self.element(handle)
+            .as_shell()
+            .expect("a shell handle refers to a shell element")
     }
 
     /// The section forces of a beam at `state`: `(N, V₂, V₃)` and

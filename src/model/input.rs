@@ -44,13 +44,17 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 25] = [
+pub const TOP_LEVEL_KEYS: [&str; 29] = [
     "title",
     "analysis",
     "nodes",
     "sections",
     "beams",
     "beam_lines",
+    "ply_materials",
+    "laminates",
+    "shells",
+    "panels",
     "rigid_bodies",
     "point_masses",
     "springs",
@@ -95,6 +99,19 @@ pub struct ModelInput {
     /// Straight or circular lines meshed into beam elements.
     #[serde(default)]
     pub beam_lines: Vec<BeamLineInput>,
+    /// Orthotropic (or isotropic) ply materials, referenced by name.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub ply_materials: Vec<PlyMaterialInput>,
+    /// Shell sections: ply stacks and sandwiches, referenced by name.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub laminates: Vec<LaminateInput>,
+    /// Four-node shell elements.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shells: Vec<ShellInput>,
+    /// Rectangular panels meshed into shell elements, with property zones
+    /// and edge stiffeners.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub panels: Vec<PanelInput>,
     /// Rigid bodies attached to a node.
     #[serde(default)]
     pub rigid_bodies: Vec<RigidBodyInput>,
@@ -166,7 +183,7 @@ pub struct ModelInput {
 
 /// A flexible body reduced by Craig–Bampton and moved as a superelement
 /// on a floating frame (docs/model-format.md, "Superelements";
-/// docs/theory.md §17). Its body comes from one source: `elements` of
+/// docs/theory.md §18). Its body comes from one source: `elements` of
 /// this model, a `model` file of the body, Matrix Market `stiffness`,
 /// `mass` and `dofs` files, or a Nastran `dmig` punch file.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
@@ -1066,6 +1083,392 @@ pub struct BeamLineInput {
     /// Curve applying the initial strain gradually (as for beams).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_strain_curve: Option<String>,
+}
+
+/// `[[ply_materials]]`: an orthotropic ply material (`E1`, `E2`, `nu12`,
+/// `G12`, `G13`, `G23`) or an isotropic one (`E`, `nu`), and its density.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PlyMaterialInput {
+    /// Name by which laminates refer to it.
+    pub name: String,
+    /// Young's modulus along the fibres.
+    #[serde(rename = "E1", default, skip_serializing_if = "Option::is_none")]
+    pub e1: Option<f64>,
+    /// Young's modulus across the fibres, in the plane.
+    #[serde(rename = "E2", default, skip_serializing_if = "Option::is_none")]
+    pub e2: Option<f64>,
+    /// Major Poisson's ratio `ν₁₂`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nu12: Option<f64>,
+    /// In-plane shear modulus.
+    #[serde(rename = "G12", default, skip_serializing_if = "Option::is_none")]
+    pub g12: Option<f64>,
+    /// Transverse shear modulus in the fibre–normal plane.
+    #[serde(rename = "G13", default, skip_serializing_if = "Option::is_none")]
+    pub g13: Option<f64>,
+    /// Transverse shear modulus in the transverse–normal plane.
+    #[serde(rename = "G23", default, skip_serializing_if = "Option::is_none")]
+    pub g23: Option<f64>,
+    /// Isotropic material: Young's modulus (instead of `E1` … `G23`).
+    #[serde(rename = "E", default, skip_serializing_if = "Option::is_none")]
+    pub e: Option<f64>,
+    /// Isotropic material: Poisson's ratio.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nu: Option<f64>,
+    /// Density (mass per volume), default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+}
+
+/// A ply of a laminate: its material, thickness and fibre angle.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PlyInput {
+    /// Name of its `[[ply_materials]]` entry.
+    pub material: String,
+    /// Thickness.
+    pub thickness: f64,
+    /// Angle from the shell's material axis to the fibres, about the
+    /// normal, in the laminate's `unit` (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
+}
+
+/// The core of a sandwich laminate.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CoreInput {
+    /// Thickness.
+    pub thickness: f64,
+    /// Transverse shear modulus in the plane of the core's direction 1
+    /// (a honeycomb's ribbon direction `L`).
+    #[serde(rename = "G13")]
+    pub g13: f64,
+    /// Transverse shear modulus in the plane of the core's direction 2
+    /// (`W`).
+    #[serde(rename = "G23")]
+    pub g23: f64,
+    /// Density, default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+    /// In-plane Young's modulus (isotropic), default 0 (a honeycomb).
+    #[serde(rename = "E", default, skip_serializing_if = "Option::is_none")]
+    pub e: Option<f64>,
+    /// In-plane Poisson's ratio, default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nu: Option<f64>,
+    /// Angle of direction 1 from the shell's material axis, in the
+    /// laminate's `unit` (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
+}
+
+/// `[[laminates]]`: a stack of plies (`plies`), or a sandwich (`core` with
+/// `faces`, or with `bottom_face` and `top_face`).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LaminateInput {
+    /// Name by which shells and panels refer to it.
+    pub name: String,
+    /// A stack: its plies from the bottom (`z = −h/2`) up.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plies: Vec<PlyInput>,
+    /// A sandwich: its core.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub core: Option<CoreInput>,
+    /// A sandwich: the laminate (a stack) of both face sheets, its plies
+    /// listed from the core outward.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub faces: Option<String>,
+    /// A sandwich: the laminate of the bottom face sheet (from the core
+    /// outward, i.e. downward), instead of `faces`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bottom_face: Option<String>,
+    /// A sandwich: the laminate of the top face sheet (from the core
+    /// outward, i.e. upward), instead of `faces`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub top_face: Option<String>,
+    /// Unit of the ply and core angles (radians by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+}
+
+/// `[[shells]]`: a four-node shell element.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ShellInput {
+    /// Unique element id.
+    pub id: Id,
+    /// The four nodes, in order around the element (its normal follows
+    /// them by the right-hand rule).
+    pub nodes: [Id; 4],
+    /// Name of its laminate.
+    pub laminate: String,
+    /// Direction whose projection on the element is its material axis
+    /// `x` (ply angles are measured from it); default global x, or
+    /// global y for an element whose normal is along x.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material_axis: Option<[f64; 3]>,
+    /// Load per unit area along the element's normal (a pressure on its
+    /// bottom face), reached when its curve equals 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure: Option<f64>,
+    /// Curve of the pressure, default as for loads.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure_curve: Option<String>,
+}
+
+/// A side of a panel: `south` (from its origin along `a`), `east`,
+/// `north`, `west` (from its origin along `b`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PanelSide {
+    /// `η = 0`, along `a`.
+    South,
+    /// `ξ = a`, along `b`.
+    East,
+    /// `η = b`, along `a`.
+    North,
+    /// `ξ = 0`, along `b`.
+    West,
+}
+
+impl PanelSide {
+    /// Every side, counterclockwise from `south`.
+    pub const ALL: [PanelSide; 4] = [Self::South, Self::East, Self::North, Self::West];
+
+    /// Name used in files and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::South => "south",
+            Self::East => "east",
+            Self::North => "north",
+            Self::West => "west",
+        }
+    }
+}
+
+/// A named node of a panel: a corner or the middle of a side.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PanelPoint {
+    /// The corner at the origin, `(0, 0)`.
+    SouthWest,
+    /// The middle of the south side, `(a/2, 0)`.
+    South,
+    /// The corner `(a, 0)`.
+    SouthEast,
+    /// The middle of the east side, `(a, b/2)`.
+    East,
+    /// The corner `(a, b)`.
+    NorthEast,
+    /// The middle of the north side, `(a/2, b)`.
+    North,
+    /// The corner `(0, b)`.
+    NorthWest,
+    /// The middle of the west side, `(0, b/2)`.
+    West,
+}
+
+impl PanelPoint {
+    /// Every named point, counterclockwise from the origin.
+    pub const ALL: [PanelPoint; 8] = [
+        Self::SouthWest,
+        Self::South,
+        Self::SouthEast,
+        Self::East,
+        Self::NorthEast,
+        Self::North,
+        Self::NorthWest,
+        Self::West,
+    ];
+
+    /// Name used in files (`node_ids`) and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::SouthWest => "south_west",
+            Self::South => "south",
+            Self::SouthEast => "south_east",
+            Self::East => "east",
+            Self::NorthEast => "north_east",
+            Self::North => "north",
+            Self::NorthWest => "north_west",
+            Self::West => "west",
+        }
+    }
+
+    /// Its place in halves of the sides, `(0|1|2, 0|1|2)`.
+    fn halves(self) -> (usize, usize) {
+        match self {
+            Self::SouthWest => (0, 0),
+            Self::South => (1, 0),
+            Self::SouthEast => (2, 0),
+            Self::East => (2, 1),
+            Self::NorthEast => (2, 2),
+            Self::North => (1, 2),
+            Self::NorthWest => (0, 2),
+            Self::West => (0, 1),
+        }
+    }
+
+    /// Its grid position `(i, j)` on a panel of `nx × ny` elements (both
+    /// even).
+    pub fn grid(self, nx: usize, ny: usize) -> (usize, usize) {
+        let (a, b) = self.halves();
+        (a * nx / 2, b * ny / 2)
+    }
+
+    /// The named point at grid position `(i, j)` of an `nx × ny` panel,
+    /// if any.
+    pub fn at(nx: usize, ny: usize, i: usize, j: usize) -> Option<PanelPoint> {
+        Self::ALL.into_iter().find(|p| p.grid(nx, ny) == (i, j))
+    }
+}
+
+impl PanelNodeIds {
+    /// The id given to `point`, if any.
+    pub fn get(&self, point: PanelPoint) -> Option<Id> {
+        match point {
+            PanelPoint::SouthWest => self.south_west,
+            PanelPoint::South => self.south,
+            PanelPoint::SouthEast => self.south_east,
+            PanelPoint::East => self.east,
+            PanelPoint::NorthEast => self.north_east,
+            PanelPoint::North => self.north,
+            PanelPoint::NorthWest => self.north_west,
+            PanelPoint::West => self.west,
+        }
+    }
+
+    /// Gives `point` the id `id`.
+    pub fn set(&mut self, point: PanelPoint, id: Id) {
+        let slot = match point {
+            PanelPoint::SouthWest => &mut self.south_west,
+            PanelPoint::South => &mut self.south,
+            PanelPoint::SouthEast => &mut self.south_east,
+            PanelPoint::East => &mut self.east,
+            PanelPoint::NorthEast => &mut self.north_east,
+            PanelPoint::North => &mut self.north,
+            PanelPoint::NorthWest => &mut self.north_west,
+            PanelPoint::West => &mut self.west,
+        };
+        *slot = Some(id);
+    }
+}
+
+/// A rectangular zone of a panel with its own laminate: the elements
+/// whose centres lie in `[from, to]` (panel coordinates along `a` and
+/// `b`, from the origin).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PanelZoneInput {
+    /// Lower corner `(ξ, η)`.
+    pub from: [f64; 2],
+    /// Upper corner `(ξ, η)`.
+    pub to: [f64; 2],
+    /// Name of its laminate.
+    pub laminate: String,
+}
+
+/// A stiffener along a side of a panel: beam elements on the side's
+/// nodes, their axis offset along the panel's normal.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StiffenerInput {
+    /// The side.
+    pub side: PanelSide,
+    /// Name of its `[[sections]]` entry (stiffness about its own
+    /// centroid; local axis 2 along the panel's normal).
+    pub section: String,
+    /// Distance from the panel's mid-surface to the stiffener's axis,
+    /// along the normal (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset: Option<f64>,
+}
+
+/// Ids given to the named nodes of a panel (its corners and the middles
+/// of its sides) instead of their grid ids.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PanelNodeIds {
+    /// Corner at the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub south_west: Option<Id>,
+    /// Middle of the south side.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub south: Option<Id>,
+    /// Corner at `(a, 0)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub south_east: Option<Id>,
+    /// Middle of the east side.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub east: Option<Id>,
+    /// Corner at `(a, b)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub north_east: Option<Id>,
+    /// Middle of the north side.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub north: Option<Id>,
+    /// Corner at `(0, b)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub north_west: Option<Id>,
+    /// Middle of the west side.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub west: Option<Id>,
+}
+
+/// `[[panels]]`: a flat rectangular panel of `size = [a, b]` meshed into
+/// `elements = [nx, ny]` shell elements (both even, so that the middle of
+/// each side is a node).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PanelInput {
+    /// Name in messages.
+    pub name: String,
+    /// Side lengths `[a, b]` along the panel's axes.
+    pub size: [f64; 2],
+    /// Elements along each side `[nx, ny]`, both even.
+    pub elements: [usize; 2],
+    /// Name of the laminate of the panel (outside its zones).
+    pub laminate: String,
+    /// The corner `south_west`, default the origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<[f64; 3]>,
+    /// Direction of side `a` (and the panel's material axis), default
+    /// global x.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis_a: Option<[f64; 3]>,
+    /// A direction in the panel's plane, not along `axis_a`: side `b` is
+    /// its part normal to `axis_a`; default global y.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis_b: Option<[f64; 3]>,
+    /// Zones with their own laminate; a later zone overrides an earlier
+    /// one where they overlap.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub zones: Vec<PanelZoneInput>,
+    /// Stiffeners along sides.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stiffeners: Vec<StiffenerInput>,
+    /// Load per unit area along the panel's normal `a × b`, reached when
+    /// its curve equals 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure: Option<f64>,
+    /// Curve of the pressure, default as for loads.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure_curve: Option<String>,
+    /// Id of the node at grid position `(0, 0)`: node `(i, j)` has id
+    /// `first_node + j (nx + 1) + i`. Default: one more than the largest
+    /// node id so far.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_node: Option<Id>,
+    /// Id of the first shell element: element `(i, j)` has id
+    /// `first_element + j nx + i`, the stiffeners' beams follow. Default:
+    /// one more than the largest element id so far.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_element: Option<Id>,
+    /// Ids of the corners and side middles instead of their grid ids.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub node_ids: Option<PanelNodeIds>,
 }
 
 /// A rigid body carried by a node.

@@ -34,7 +34,8 @@ pub use builder::ModelBuilder;
 pub use handles::{
     BeamHandle, BeamLineHandle, ContactHandle, DriverHandle, ElementRef, ElementResults,
     HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle,
-    PointMassHandle, RigidBodyHandle, RollingDiscHandle, SpringHandle, StopHandle,
+    PanelHandle, PointMassHandle, RigidBodyHandle, RollingDiscHandle, ShellHandle, SpringHandle,
+    StopHandle,
 };
 
 /// Names of the six components of a node, in local unknown order.
@@ -434,6 +435,8 @@ pub enum ModelErrorKind {
     UnknownSection,
     /// A reference to a curve that does not exist.
     UnknownCurve,
+    /// A reference to a laminate or a ply material that does not exist.
+    UnknownLaminate,
     /// A required value is missing.
     Missing,
     /// A value is not acceptable (wrong name, not finite, inconsistent).

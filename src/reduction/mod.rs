@@ -1,5 +1,5 @@
 //! Substructuring of flexible bodies (reference paper §5, eq. 20–29;
-//! docs/theory.md §17): a linear finite-element model of a body is
+//! docs/theory.md §18): a linear finite-element model of a body is
 //! reduced by the Craig–Bampton method to its boundary nodes and a few
 //! fixed-interface modes, and moves in the mechanism as a superelement on
 //! a floating frame ([`crate::elements::superelement`]).

@@ -113,7 +113,7 @@ impl Builder<'_> {
     /// sequence whose first analysis is static and a later one dynamic:
     /// the default ramp `f = t` goes on growing through the motion
     /// (docs/model-format.md, "Loads in time").
-    fn ramp_through_dynamics(&mut self, entity: &str) {
+    pub(super) fn ramp_through_dynamics(&mut self, entity: &str) {
         let Some((analysis, start, end)) = self.plan.dynamic_after_static.clone() else {
             return;
         };

@@ -26,12 +26,12 @@ use crate::reduction::{
 use crate::so3::{self, Mat3, Rotation, Vec3};
 
 /// Whether elements of this kind can be reduced into a superelement: the
-/// linear elements of a body's structure and its masses. A new structural
-/// element (a shell) joins the list here.
+/// linear elements of a body's structure (beams, shells) and its masses.
+/// A new structural element joins the list here.
 pub fn reducible(kind: ElementKind) -> bool {
     matches!(
         kind,
-        ElementKind::Beam | ElementKind::RigidBody | ElementKind::PointMass
+        ElementKind::Beam | ElementKind::Shell | ElementKind::RigidBody | ElementKind::PointMass
     )
 }
 
@@ -351,7 +351,7 @@ impl Builder<'_> {
                 masses.push((id, pm.node, pm.mass, None, None));
             } else {
                 let what = match self.element_ids.get(&id) {
-                    Some(holder) => format!("elements: {holder} cannot be reduced (beams, rigid bodies and point masses can)"),
+                    Some(holder) => format!("elements: {holder} cannot be reduced from this model (beams, rigid bodies and point masses can; shells and panels from a body file, `model`)"),
                     None => format!("elements: no beam, rigid body or point mass has id {id}"),
                 };
                 self.ck.push(ModelErrorKind::Invalid, entity, what);
@@ -559,7 +559,7 @@ impl Builder<'_> {
                 ModelErrorKind::Invalid,
                 entity,
                 format!(
-                    "model: {}: {} {} cannot be part of a reduced body (beams, rigid bodies and point masses can)",
+                    "model: {}: {} {} cannot be part of a reduced body (beams, shells, rigid bodies and point masses can)",
                     path.display(),
                     e.kind().name(),
                     e.id()

@@ -38,20 +38,25 @@
 
 mod loading;
 mod mechanism;
+mod shells;
 mod structure;
 
 pub use loading::{
     Analysis, Component, CurveHandle, Dofs, Gravity, Load, LoadCurve, PrescribedMotion,
 };
 pub use mechanism::{Contact, Driver, HingeLaw, Joint, JointSpring, Latch, RollingDisc, Stop};
+pub use shells::{Core, Laminate, LaminateHandle, Panel, PlyMaterial, PlyMaterialHandle, Shell};
 pub use structure::{Beam, BeamLine, Node, PointMass, RigidBody, Section, SectionHandle, Spring};
 
 pub use super::handles::{
     BeamHandle, BeamLineHandle, ContactHandle, DriverHandle, ElementRef, ElementResults,
     HingeLawHandle, JointHandle, JointSpringHandle, LatchHandle, LoadHandle, NodeHandle,
-    PointMassHandle, RigidBodyHandle, RollingDiscHandle, SpringHandle, StopHandle,
+    PanelHandle, PointMassHandle, RigidBodyHandle, RollingDiscHandle, ShellHandle, SpringHandle,
+    StopHandle,
 };
-pub use super::input::{AngleUnit, Approach, StartBranch, TapeSpringInput as TapeSpring};
+pub use super::input::{
+    AngleUnit, Approach, PanelPoint, PanelSide, StartBranch, TapeSpringInput as TapeSpring,
+};
 pub use super::{Id, Model, ModelErrors};
 pub use crate::joints::{Coordinate, JointType};
 

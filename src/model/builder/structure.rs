@@ -155,7 +155,7 @@ impl Entity for Section {
 
 impl ModelBuilder {
     /// The name of a section in the model file.
-    fn section_name(&self, s: SectionHandle) -> String {
+    pub(super) fn section_name(&self, s: SectionHandle) -> String {
         self.input.sections[s.0].name.clone()
     }
 }

@@ -992,7 +992,7 @@ impl Superelement {
         let Some(model) = &self.body.body.elements else {
             return Vec::new();
         };
-        let state = Self::local_state(mesh);
+        let state = self.local_state(mesh);
         let ctx = EvalContext {
             gravity: Vec3::zeros(),
             ..model.context(0.0, super::Need::RESIDUAL)
@@ -1021,7 +1021,7 @@ impl Superelement {
         let Some(model) = &self.body.body.elements else {
             return Vec::new();
         };
-        let state = Self::local_state(mesh);
+        let state = self.local_state(mesh);
         let mut layers = Vec::new();
         model
             .elements
@@ -1036,13 +1036,17 @@ impl Superelement {
             .collect()
     }
 
-    /// The state of the body's own model at the recovered mesh, in the
-    /// floating frame, at rest.
-    fn local_state(mesh: &RecoveredMesh) -> State {
+    /// The state of the body's own model at the recovered mesh: in the
+    /// floating frame, taken back to the coordinates the original
+    /// elements were built in (`X_own = Qᵀ (X − p)` for a body placed by
+    /// `(p, Q)`), at rest.
+    fn local_state(&self, mesh: &RecoveredMesh) -> State {
+        let (p, q) = &self.body.body.placement;
+        let back = q.inverse();
         State::at_rest(
             0.0,
-            mesh.local_position.clone(),
-            mesh.local_orientation.clone(),
+            mesh.local_position.iter().map(|x| back * (x - p)).collect(),
+            mesh.local_orientation.iter().map(|r| back * r).collect(),
         )
     }
 

@@ -304,6 +304,14 @@ impl PeakLoads {
                 p.peak.take(load, time, increment);
             }
         }
+    }
+
+    /// Takes the results of the original elements of the superelements
+    /// (a beam's section forces, a shell's skin stresses) at the output
+    /// step `increment` (numbered as in [`PeakLoads::sample`]): the mesh
+    /// recovered at output steps only, where the results are written.
+    pub fn sample_recovered(&mut self, model: &Model, state: &State, increment: usize) {
+        let time = state.time;
         for (element, record) in &mut self.superelements {
             let Some(se) = model
                 .elements

@@ -1671,6 +1671,9 @@ impl Observer for Recorder {
             info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
         let info = &self.renumbered(info);
         self.peaks.sample(model, state, info.increment);
+        if info.output {
+            self.peaks.sample_recovered(model, state, info.increment);
+        }
         // a kinematic analysis has no loads: its residual is all constraint
         // violation, measured against the tolerance of each constraint
         let (what, values) = if self.current.kind == "kinematic" {

@@ -50,6 +50,11 @@ pub struct FlexibleBody {
     /// own elements: their results at a recovered state are the stresses
     /// of the body ([`super::ReducedBody::element_results`]).
     pub elements: Option<Model>,
+    /// Where the body was placed in the model ([`FlexibleBody::placed`]):
+    /// `(p, Q)` with `X = p + Q X_own`. The original elements stay in
+    /// their own coordinates `X_own`: a recovered state is taken back
+    /// there for their results.
+    pub placement: (Vec3, Rotation),
 }
 
 impl std::fmt::Debug for FlexibleBody {
@@ -157,6 +162,7 @@ impl FlexibleBody {
             mass,
             cells,
             elements: Some(model),
+            placement: (Vec3::zeros(), Rotation::identity()),
         }
     }
 
@@ -228,6 +234,9 @@ impl FlexibleBody {
         for r in &mut self.orientations {
             *r = rotation * *r;
         }
+        // composed with an earlier placement: X = p + Q (p₀ + Q₀ X_own)
+        let (p0, q0) = self.placement;
+        self.placement = (position + q * p0, rotation * q0);
         Ok(self)
     }
 }

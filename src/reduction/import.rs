@@ -812,6 +812,7 @@ pub fn import_body(
         mass,
         cells,
         elements: None,
+        placement: (Vec3::zeros(), Rotation::identity()),
     })
 }
 

@@ -537,7 +537,13 @@ impl Builder<'_> {
             );
             return None;
         }
-        // a body is reduced free: no static analysis of it
+        // a body is reduced free and unloaded (the model it joins gives
+        // its supports, loads and gravity): no static analysis of it
+        input.supports.clear();
+        input.prescribed.clear();
+        input.loads.clear();
+        input.gravity = None;
+        input.initial_motion.clear();
         input.analysis = AnalysisInput {
             kind: "modal".into(),
             ..AnalysisInput::default()

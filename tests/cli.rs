@@ -1685,3 +1685,54 @@ fn the_run_warns_about_limit_points_passed() {
         "{warnings:?}"
     );
 }
+
+/// A kinetostatic analysis is named so, not `static`, in what a run
+/// writes: the console, `log.txt` and the analyses of `summary.json`.
+/// It is solved as a static one, so its restart files continue it (and
+/// those written as `static` before it had its own name still do).
+#[test]
+fn kinetostatic_runs_are_named_kinetostatic() {
+    let dir = scratch("kinetostatic");
+    let text = pendulum(
+        "1.0",
+        None,
+        "[analysis]\ntype = \"kinetostatic\"\nend_time = 1.0\n",
+    );
+    let (code, out, err) = run_model(&dir, "pendulum.toml", &text);
+    assert_eq!(code, 0, "{err}");
+    let log = std::fs::read_to_string(dir.join("out/log.txt")).unwrap();
+    let first = log.lines().next().unwrap();
+    assert!(first.contains("kinetostatic analysis to t = 1"), "{first}");
+    assert!(out.contains("kinetostatic analysis to t = 1"), "{out}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["analyses"][0]["type"], "kinetostatic", "{summary}");
+    // its restart file, as written and as an older one naming it static
+    let restart = dir.join("out/restart.json");
+    let written = std::fs::read_to_string(&restart).unwrap();
+    assert!(written.contains("\"analysis_type\":\"kinetostatic\""));
+    let older = dir.join("older.json");
+    std::fs::write(
+        &older,
+        written.replace(
+            "\"analysis_type\":\"kinetostatic\"",
+            "\"analysis_type\":\"static\"",
+        ),
+    )
+    .unwrap();
+    let model = dir.join("pendulum.toml");
+    std::fs::write(&model, text.replace("end_time = 1.0", "end_time = 2.0")).unwrap();
+    for (name, file) in [("again", &restart), ("older", &older)] {
+        let o = dir.join(name);
+        let (code, _, err) = unfold(&[
+            "run",
+            model.to_str().unwrap(),
+            "--restart",
+            file.to_str().unwrap(),
+            "--out",
+            o.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{name}: {err}");
+    }
+}

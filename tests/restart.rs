@@ -522,3 +522,140 @@ fn restart_files_of_version_1_are_read_and_later_versions_refused() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Tens of thousands of restart times (a restart file each, every one
+/// holding the whole state) are refused at input with the limit and what
+/// to do; a list of times outside the run is reported once, with how
+/// many more, not once per time.
+#[test]
+fn too_many_restart_times_are_refused() {
+    let dir = scratch("too_many_times");
+    let mut input = driven_bend(&[2.0], 600.0);
+    input.output = Some(OutputInput {
+        restart_times: (1..=20_000).map(|k| k as f64 * 1e-4).collect(),
+        ..OutputInput::default()
+    });
+    let (code, err, _) = run(&dir, "many", &input, &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("restart_times has 20000 times: a run writes at most 1000 restart files"),
+        "{err}"
+    );
+    input.output = Some(OutputInput {
+        restart_times: (1..=500).map(|k| 2.0 + k as f64).collect(),
+        ..OutputInput::default()
+    });
+    let (code, err, _) = run(&dir, "outside", &input, &[]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(err.matches("restart_times must lie").count(), 1, "{err}");
+    assert!(err.contains("got 3 (and 499 more)"), "{err}");
+}
+
+/// A restart file edited or damaged so that it holds what no run writes
+/// is refused (exit 2, naming the file and the value), not integrated
+/// from or silently replaced: a time before the start of the analysis, a
+/// step of the controller's memory that is negative or longer than the
+/// analysis, a last step of zero, an error estimate below zero, an event
+/// side that is not ±1. The file as written is accepted.
+#[test]
+fn a_restart_file_with_values_no_run_writes_is_refused() {
+    let dir = scratch("edited");
+    let model = dir.join("panel.toml");
+    let text = common::hinged_panel::latched_panel(
+        "panel on a rigid latch",
+        "[analysis]\ntype = \"dynamic\"\nend_time = 0.6\ntime_step = 0.01",
+        90.0,
+        "[output]\nrestart_times = [0.3]",
+    );
+    std::fs::write(&model, text).unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        let out = dir.join(out);
+        let mut args = vec![
+            "run",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        let (code, _, err) = unfold(&args);
+        (code, err)
+    };
+    let (code, err) = run("whole", &[]);
+    assert_eq!(code, 0, "{err}");
+    let file = dir.join("whole/restart-0.3.json");
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    assert!(
+        written["motion"]["control"]["size"].is_number(),
+        "{}",
+        written["motion"]
+    );
+    let edits: [(&str, &[&str], serde_json::Value, &str); 7] = [
+        (
+            "before",
+            &["state", "time"],
+            (-1.0).into(),
+            "its time t = -1 is before the start of analysis 1",
+        ),
+        (
+            "negative",
+            &["motion", "control", "size"],
+            (-1.0).into(),
+            "motion.control.size = -1 is not a step of the analysis",
+        ),
+        (
+            "huge",
+            &["motion", "control", "size"],
+            1e300.into(),
+            "motion.control.size = 1e300 is not a step of the analysis",
+        ),
+        (
+            "zero",
+            &["motion", "last_step"],
+            0.0.into(),
+            "motion.last_step = 0 is not a step of the analysis",
+        ),
+        (
+            "error",
+            &["motion", "control", "last_error"],
+            (-1.0).into(),
+            "last_error = -1 must be zero or positive",
+        ),
+        (
+            "sides",
+            &["motion", "control", "event_sides"],
+            serde_json::json!([2.0]),
+            "event_sides holds 2, not 1 or -1",
+        ),
+        (
+            "mass",
+            &["motion", "mass_scale"],
+            serde_json::json!([0.0, 1.0]),
+            "motion.mass_scale = [0, 1] must be positive",
+        ),
+    ];
+    for (name, path, value, fragment) in edits {
+        let mut v = written.clone();
+        let mut at = &mut v;
+        for key in path {
+            at = &mut at[*key];
+        }
+        *at = value.clone();
+        if path == ["state", "time"] {
+            // the file's time is the state's
+            v["time"] = value;
+        }
+        let edited = dir.join(format!("{name}.json"));
+        std::fs::write(&edited, v.to_string()).unwrap();
+        let (code, err) = run(name, &["--restart", edited.to_str().unwrap()]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(
+            err.contains(&format!("{name}.json")) && err.contains(fragment),
+            "{name}: {err}"
+        );
+    }
+    let (code, err) = run("as-written", &["--restart", file.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

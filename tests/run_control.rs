@@ -143,7 +143,8 @@ fn assert_consistent(out: &Path) -> (usize, f64) {
             assert_eq!(steps_in(&path), steps, "{name} has other steps");
         }
     }
-    let pvd = std::fs::read_to_string(out.join("unfold.pvd")).unwrap();
+    // no collection before the first grid
+    let pvd = std::fs::read_to_string(out.join("unfold.pvd")).unwrap_or_default();
     let listed: BTreeSet<String> = pvd
         .split("file=\"")
         .skip(1)
@@ -155,6 +156,9 @@ fn assert_consistent(out: &Path) -> (usize, f64) {
         .collect();
     assert_eq!(listed, grids, "grids and collection differ");
     assert_eq!(grids.len(), n);
+    if n == 0 {
+        return (0, f64::NAN);
+    }
     let last_row = std::fs::read_to_string(out.join("steps.csv")).unwrap();
     let last_time = last_row.lines().last().unwrap().split(',').nth(2).unwrap();
     (n, last_time.parse().unwrap())
@@ -476,4 +480,168 @@ fn the_note_after_a_write_failure_gives_the_last_step_written() {
         "note {t}, last step written {last}: {err}"
     );
     assert!(!out.join(".unfold.lock").exists());
+}
+
+/// Runs `unfold run model --out out` with `out` on a disk of `size` bytes
+/// (a tmpfs mounted in a mount namespace of its own, `unshare -Urm`), and
+/// copies what the run left there to `copy` (the disk goes with the
+/// namespace). Exit code and stderr; `None` where this machine cannot
+/// make such a disk (said on stderr; in CI, `UNFOLD_CI` set, a failure).
+#[cfg(target_os = "linux")]
+fn run_on_a_small_disk(
+    size: usize,
+    model: &Path,
+    out: &Path,
+    copy: &Path,
+) -> Option<(i32, String)> {
+    std::fs::create_dir_all(out).unwrap();
+    std::fs::create_dir_all(copy).unwrap();
+    let script = r#"mount -t tmpfs -o size="$1" tmpfs "$2" || exit 99
+"$4" run "$5" --out "$2"; code=$?; cp -a "$2/." "$3"; exit $code"#;
+    let result = Command::new("unshare")
+        .args(["-Urm", "sh", "-c", script, "sh", &size.to_string()])
+        .args([out, copy, Path::new(env!("CARGO_BIN_EXE_unfold")), model])
+        .output();
+    let unavailable = match &result {
+        Err(e) => Some(e.to_string()),
+        Ok(r)
+            if r.status.code() == Some(99)
+                || (r.status.code() == Some(1)
+                    && r.stdout.is_empty()
+                    && String::from_utf8_lossy(&r.stderr).contains("unshare")) =>
+        {
+            Some(String::from_utf8_lossy(&r.stderr).into_owned())
+        }
+        Ok(_) => None,
+    };
+    if let Some(why) = unavailable {
+        assert!(
+            std::env::var_os("UNFOLD_CI").is_none(),
+            "CI: no small disk can be made here (unshare -Urm and a tmpfs): {why}"
+        );
+        eprintln!(
+            "SKIPPED: no small disk can be made on this machine (unshare -Urm and a tmpfs): {why}"
+        );
+        return None;
+    }
+    let r = result.unwrap();
+    Some((
+        r.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&r.stderr).into_owned(),
+    ))
+}
+
+/// A disk that fills up during the run (a real one: a tmpfs of a few
+/// hundred kB), at several points of the run (a step's grid or rows, the
+/// restart file at the end): the run stops with exit code 1, every result
+/// file holds the same steps, no temporary file or lock file is left, and
+/// `summary.json` says the run failed and names the file, written into
+/// the space the lock reserved when the disk has none left.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_leaves_no_temporary_file_and_a_failed_summary() {
+    let dir = scratch("tmpfs");
+    let model = dir.join("model.toml");
+    // 401 nodes, about 80 kB of nodes.csv and 40 kB of beams.csv a step,
+    // and a restart file of about 130 kB: 20 steps fill any of these disks
+    std::fs::write(&model, rollup(400, 0.05)).unwrap();
+    let mut failures = BTreeSet::new();
+    let mut restart_failed = false;
+    for size in [250_000, 400_000, 700_000, 1_000_000, 1_500_000, 2_500_000] {
+        let (out, copy) = (
+            dir.join(format!("out{size}")),
+            dir.join(format!("copy{size}")),
+        );
+        let Some((code, err)) = run_on_a_small_disk(size, &model, &out, &copy) else {
+            return;
+        };
+        assert_eq!(code, 1, "{size} B: {err}");
+        assert!(err.contains("No space left on device"), "{size} B: {err}");
+        assert!(
+            !copy.join(".unfold.lock").exists(),
+            "{size} B: lock file left"
+        );
+        let s = summary(&copy);
+        assert_eq!(s["status"], "failed", "{size} B: {s}");
+        let message = s["message"].as_str().unwrap();
+        assert!(
+            message.contains("No space left on device"),
+            "{size} B: {message}"
+        );
+        // the file that could not be written, by kind
+        let file = message
+            .split(": No space")
+            .next()
+            .unwrap()
+            .rsplit('/')
+            .next()
+            .unwrap();
+        failures.insert(file.split('_').next().unwrap().to_string());
+        restart_failed |= message.contains("restart.json: No space left on device");
+        if copy.join("steps.csv").exists() {
+            let (steps, _) = assert_consistent(&copy);
+            println!("{size} B: {steps} steps, then {file}");
+            assert_eq!(
+                s["output_steps"].as_u64().unwrap() as usize,
+                steps,
+                "{size} B"
+            );
+        }
+        for entry in std::fs::read_dir(&copy).unwrap() {
+            let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+            assert!(!name.ends_with(".tmp"), "{size} B: {name} left");
+        }
+    }
+    println!("files that filled the disk: {failures:?}");
+    // the sizes reach more than one file, and the restart file written at
+    // the end (whose temporary file was left behind)
+    assert!(failures.len() >= 2, "{failures:?}");
+    assert!(restart_failed, "no run failed on restart.json");
+}
+
+/// A run killed with SIGKILL leaves its lock file (nothing of it runs to
+/// remove the file); the next run into that directory finds that no
+/// process holds it, says so, naming the killed process, and goes on.
+#[test]
+fn a_killed_runs_lock_file_is_taken_over_with_a_note() {
+    let dir = scratch("sigkill");
+    let model = dir.join("long.toml");
+    std::fs::write(&model, rollup(200, 2e-4)).unwrap();
+    let out = dir.join("out");
+    let run = Run::start(&model, &out);
+    let killed = run.child.id();
+    wait_for_steps(&out, 2);
+    run.signal(libc::SIGKILL);
+    let (code, _) = run.finish();
+    assert_eq!(code, -1, "killed by a signal");
+    let lock = std::fs::read_to_string(out.join(".unfold.lock")).expect("lock file left");
+    assert_eq!(lock.trim(), killed.to_string());
+    assert_eq!(summary(&out)["status"], "running");
+
+    let short = dir.join("short.toml");
+    std::fs::write(&short, rollup(10, 0.5)).unwrap();
+    let next = Command::new(env!("CARGO_BIN_EXE_unfold"))
+        .args([
+            "run",
+            short.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&next.stderr);
+    let stdout = String::from_utf8_lossy(&next.stdout);
+    assert_eq!(next.status.code(), Some(0), "{err}");
+    let said = format!("{stdout}{err}");
+    assert!(
+        said.contains(&format!(
+            "an earlier run (process {killed}) did not end there"
+        )),
+        "{said}"
+    );
+    let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
+    assert!(log.contains(&format!("process {killed}")), "{log}");
+    assert_eq!(summary(&out)["status"], "completed");
+    assert!(!out.join(".unfold.lock").exists());
+    assert_consistent(&out);
 }

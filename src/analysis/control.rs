@@ -304,6 +304,36 @@ impl StepMemory {
     pub fn size(&self) -> f64 {
         self.size
     }
+
+    /// What is not a value a run writes, if anything: an error estimate
+    /// that is negative or not finite, event values that are not finite,
+    /// sides other than ±1, or not as many values as sides.
+    pub fn invalid(&self) -> Option<String> {
+        if let Some(e) = self.last_error {
+            if !(e.is_finite() && e >= 0.0) {
+                return Some(format!(
+                    "last_error = {e} must be zero or positive and finite"
+                ));
+            }
+        }
+        if self.event_values.len() != self.event_sides.len() {
+            return Some(format!(
+                "{} event_values against {} event_sides",
+                self.event_values.len(),
+                self.event_sides.len()
+            ));
+        }
+        if let Some(v) = self.event_values.iter().find(|v| !v.is_finite()) {
+            return Some(format!("event_values holds {v}, not a finite number"));
+        }
+        if let Some(v) = self.event_sides.iter().find(|&&v| v != 1.0 && v != -1.0) {
+            return Some(format!(
+                "event_sides holds {}, not 1 or -1",
+                crate::io::number::plain(*v)
+            ));
+        }
+        None
+    }
 }
 
 /// The step controller (see the module documentation).

@@ -64,6 +64,7 @@ use super::settings::{DynamicSettings, NewtonMethod};
 use super::{ConvergenceNorms, IncrementInfo, IterationInfo, Observer, WarningInfo};
 use crate::dofs::{DofKind, DofMap, NO_EQUATION};
 use crate::elements::{ConstraintKind, ConstraintScaling, EvalContext, Need};
+use crate::io::number::plain;
 use crate::linalg::{
     smallest_relative_pivot, SolveError, SolverCounts, SparseMatrix, SymmetricFirst,
 };
@@ -446,6 +447,49 @@ pub struct Continuation {
     /// the consistent accelerations (D9).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mass_scale: Option<[f64; 2]>,
+}
+
+impl Continuation {
+    /// What makes this continuation of an analysis from `start` to `end`
+    /// not one its run could have written, if anything (a restart file
+    /// edited or damaged): a step size that is not positive and finite or
+    /// longer than the analysis, a controller memory or a mass scale that
+    /// is not finite and positive.
+    pub fn invalid(&self, start: f64, end: f64) -> Option<String> {
+        let span = (end - start).abs();
+        let step = |what: &str, h: f64| {
+            (!(h.is_finite() && h > 0.0 && h <= span * (1.0 + 1e-9))).then(|| {
+                format!(
+                    "motion.{what} = {} is not a step of the analysis (positive, at most its span {})",
+                    plain(h),
+                    plain(span)
+                )
+            })
+        };
+        if let Some(h) = self.last_step {
+            if let Some(e) = step("last_step", h) {
+                return Some(e);
+            }
+        }
+        if let Some(c) = &self.control {
+            if let Some(e) = step("control.size", c.size()) {
+                return Some(e);
+            }
+            if let Some(e) = c.invalid() {
+                return Some(format!("motion.control: {e}"));
+            }
+        }
+        if let Some(m) = self.mass_scale {
+            if !m.iter().all(|v| v.is_finite() && *v > 0.0) {
+                return Some(format!(
+                    "motion.mass_scale = [{}, {}] must be positive and finite",
+                    plain(m[0]),
+                    plain(m[1])
+                ));
+            }
+        }
+        None
+    }
 }
 
 /// An implicit dynamic analysis of a model (see the module documentation).

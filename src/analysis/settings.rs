@@ -29,10 +29,11 @@ impl AnalysisSettings {
     }
 
     /// The analysis type as the model file names it (`static`,
-    /// `kinematic`).
+    /// `kinetostatic`, `kinematic`, `dynamic`, `modal`).
     pub fn name(&self) -> &'static str {
         match self {
             Self::Static(s) if s.kinematic => "kinematic",
+            Self::Static(s) if s.kinetostatic => "kinetostatic",
             Self::Static(_) => "static",
             Self::Dynamic(_) => "dynamic",
             Self::Modal(_) => "modal",
@@ -105,6 +106,10 @@ pub struct StaticSettings {
     /// Kinematic analysis: the joints and drivers must determine every
     /// unknown (docs/joints.md §6).
     pub kinematic: bool,
+    /// Named a kinetostatic analysis in the model file (the same solution
+    /// as a static one: quasi-static, displacement controlled); only its
+    /// name in the log and the result files differs.
+    pub kinetostatic: bool,
     /// Arc-length path control instead of load increments.
     pub arc_length: bool,
     /// Arc-length control: largest number of increments.

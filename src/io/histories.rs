@@ -676,7 +676,7 @@ impl Histories {
         let quasi_static = self
             .analysis_types
             .iter()
-            .any(|t| t == "static" || t == "kinematic");
+            .any(|t| t == "static" || t == "kinetostatic" || t == "kinematic");
         match (dynamic, quasi_static) {
             (true, false) => Axis::new("time t", units.time()),
             (true, true) => Axis::new("t: load parameter (static), time (dynamic)", units.time()),

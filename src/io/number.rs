@@ -28,6 +28,18 @@ const POW10: [f64; 23] = [
 #[derive(Clone, Copy, Debug)]
 pub struct Sci<const P: usize>(pub f64);
 
+/// A number for messages, as a person would write it in a model file:
+/// plainly (`0.6`, `-1`, `2500`) from 1e-4 to 1e15, in exponent form
+/// (`1e300`, `2.5e-7`) outside.
+pub fn plain(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// `x` in the shortest scientific notation that reads back to the same
 /// double (at most 17 significant digits), as `format!("{x:e}")`: the
 /// same text but where two shortest decimals are equally near `x`, which

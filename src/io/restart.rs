@@ -270,13 +270,18 @@ impl Restart {
         let err = |e: io::Error| io::Error::new(e.kind(), format!("{}: {e}", path.display()));
         let text = serde_json::to_vec(&file).map_err(|e| err(e.into()))?;
         let tmp = path.with_extension("json.tmp");
-        {
-            let mut f = std::fs::File::create(&tmp).map_err(err)?;
-            f.write_all(&text).map_err(err)?;
-            f.write_all(b"\n").map_err(err)?;
-            f.sync_all().map_err(err)?;
-        }
-        std::fs::rename(&tmp, path).map_err(err)
+        let written = std::fs::File::create(&tmp)
+            .and_then(|mut f| {
+                f.write_all(&text)?;
+                f.write_all(b"\n")?;
+                f.sync_all()
+            })
+            .and_then(|()| std::fs::rename(&tmp, path));
+        written.map_err(|e| {
+            // a full disk leaves no half-written file behind
+            let _ = std::fs::remove_file(&tmp);
+            err(e)
+        })
     }
 
     /// Reads a restart file.
@@ -414,13 +419,44 @@ impl Restart {
                 plan.len()
             )));
         };
-        if running.name() != self.analysis_type {
+        // a kinetostatic analysis is a static one under another name (and
+        // was written as "static" before it had its own)
+        fn base(t: &str) -> &str {
+            if t == "kinetostatic" {
+                "static"
+            } else {
+                t
+            }
+        }
+        let same_type = |a: &str, b: &str| base(a) == base(b);
+        if !same_type(running.name(), &self.analysis_type) {
             return Err(analysis_error(format!(
                 "that analysis of the model is {}",
                 running.name()
             )));
         }
         let end = running.end_time();
+        // the analysis runs from the end of the one before (0 for the
+        // first): a state before that, or one whose time is not a number,
+        // is not one of its states
+        let start = match self.analysis {
+            0 => 0.0,
+            k => plan[k - 1].end_time(),
+        };
+        if !s.time.is_finite() || s.time < start - END_TOLERANCE * start.abs().max(1.0) {
+            return Err(RestartError::Parse {
+                path,
+                message: format!(
+                    "its time t = {} is before the start of analysis {} ({}, from t = {start})",
+                    s.time,
+                    self.analysis + 1,
+                    running.name()
+                ),
+            });
+        }
+        if let Some(message) = self.motion.as_ref().and_then(|m| m.invalid(start, end)) {
+            return Err(RestartError::Parse { path, message });
+        }
         let analysis = if s.time < end - END_TOLERANCE * end.abs().max(1.0) {
             self.analysis
         } else {

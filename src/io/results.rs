@@ -577,36 +577,70 @@ impl Summary {
 /// A lock held on an output directory for the life of a run: an advisory
 /// lock on `.unfold.lock`, released by the system when the process ends,
 /// however it ends, so that the file left by a killed process does not
-/// block the next run. The file itself is removed when the lock is
-/// dropped (while still locked: a run that opened it meanwhile finds, once
-/// it holds the lock, that the file is no longer the one at the path, and
-/// starts again).
+/// block the next run (which says so: [`DirectoryLock::stale_owner`]). The
+/// file itself is removed when the lock is dropped (while still locked: a
+/// run that opened it meanwhile finds, once it holds the lock, that the
+/// file is no longer the one at the path, and starts again).
+///
+/// The lock file also holds [`SUMMARY_RESERVE`] bytes taken on the disk
+/// when the run starts, given back by [`DirectoryLock::release_reserve`]
+/// so that a run that filled the disk can still write the `summary.json`
+/// saying that it failed.
 #[derive(Debug)]
 pub struct DirectoryLock {
     file: File,
     path: PathBuf,
+    /// The process named in a lock file found unlocked (a run that did
+    /// not end: killed, or its machine stopped).
+    stale_owner: Option<String>,
+    /// Length of the lock file without its reserve (the owner's id).
+    owner_length: u64,
 }
 
 /// Attempts at locking a directory whose lock file is being replaced.
 const LOCK_ATTEMPTS: usize = 10;
 
+/// Bytes of disk taken by the lock file for the summary of a run that
+/// fills the disk: more than a summary without its increment log (about
+/// 2 kB, plus some 300 bytes per latch, stop and warning).
+pub const SUMMARY_RESERVE: usize = 64 * 1024;
+
 impl DirectoryLock {
     /// Locks `dir`, or fails with [`io::ErrorKind::ResourceBusy`] if
-    /// another run holds it.
+    /// another run holds it. A disk too full for the reserve of
+    /// [`SUMMARY_RESERVE`] bytes fails too, before anything is written.
     pub fn acquire(dir: &Path) -> io::Result<Self> {
         let path = dir.join(LOCK_FILE);
         for _ in 0..LOCK_ATTEMPTS {
-            let file = Self::try_acquire(dir, &path)?;
+            let mut file = Self::try_acquire(dir, &path)?;
             // the file locked must still be the one at the path (not one
             // removed by the run that held it)
             if same_file(&file, &path) {
-                let mut lock = Self { file, path };
-                // the owner, for the message of a run refused (best effort)
-                let _ = lock
-                    .file
-                    .set_len(0)
-                    .and_then(|()| write!(lock.file, "{}", std::process::id()));
-                return Ok(lock);
+                // a process id left in a file nobody held: its run did not
+                // end (a run that ends removes the file)
+                let mut left = String::new();
+                let _ = io::Read::read_to_string(&mut file, &mut left);
+                let left = left.trim();
+                let stale_owner = (!left.is_empty()).then(|| left.to_string());
+                let owner = std::process::id().to_string();
+                let reserve = vec![b' '; SUMMARY_RESERVE];
+                file.set_len(0)
+                    .and_then(|()| file.seek(SeekFrom::Start(0)))
+                    .and_then(|_| file.write_all(owner.as_bytes()))
+                    .and_then(|()| file.write_all(b"\n"))
+                    .and_then(|()| file.write_all(&reserve))
+                    .and_then(|()| file.flush())
+                    .map_err(|e| {
+                        // nothing of this run is left
+                        let _ = std::fs::remove_file(&path);
+                        file_error(&path, e)
+                    })?;
+                return Ok(Self {
+                    file,
+                    path,
+                    stale_owner,
+                    owner_length: owner.len() as u64 + 1,
+                });
             }
         }
         Err(io::Error::new(
@@ -616,6 +650,21 @@ impl DirectoryLock {
                 dir.display()
             ),
         ))
+    }
+
+    /// The process (its id) of a run whose lock file was found in the
+    /// directory but held by nobody: that run did not end (it was killed,
+    /// or its machine stopped) and its results there are replaced.
+    pub fn stale_owner(&self) -> Option<&str> {
+        self.stale_owner.as_deref()
+    }
+
+    /// Gives back the disk space reserved for the summary (see the type's
+    /// documentation); the lock is kept.
+    pub fn release_reserve(&mut self) -> io::Result<()> {
+        self.file
+            .set_len(self.owner_length)
+            .map_err(|e| file_error(&self.path, e))
     }
 
     /// Opens and locks the lock file `path` of `dir`.
@@ -786,7 +835,7 @@ const RATE_MOTION: f64 = 1e-4;
 /// Writes result files as the analysis converges.
 pub struct ResultWriter {
     dir: PathBuf,
-    _lock: DirectoryLock,
+    lock: DirectoryLock,
     encoding: vtk::Encoding,
     nodes: CsvFile,
     /// Node indices in increasing id.
@@ -866,15 +915,48 @@ pub fn write_rejected(
     keep: Option<&Path>,
 ) -> io::Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| file_error(dir, e))?;
-    let _lock = DirectoryLock::acquire(dir)?;
+    let mut lock = DirectoryLock::acquire(dir)?;
     remove_leftovers(dir, |_| false)?;
     super::restart::remove_earlier(dir, keep)?;
     // an empty grid folder of an earlier run goes too
     let _ = std::fs::remove_dir(dir.join("vtk"));
     summary.status = RunStatus::Failed;
     summary.message = Some(message.to_string());
-    let text = serde_json::to_string_pretty(&summary).map_err(io::Error::other)?;
-    vtk::write_atomically(&dir.join("summary.json"), (text + "\n").as_bytes())
+    write_summary_file(dir, &summary, &mut lock)
+}
+
+/// Writes `summary` to `dir/summary.json` (through a temporary file, so
+/// that it is never seen half written). If that fails (a full disk), the
+/// lock's reserve is given back and the summary written again, and then
+/// without its increment log (saying so in its message) if it is still
+/// too long.
+fn write_summary_file(dir: &Path, summary: &Summary, lock: &mut DirectoryLock) -> io::Result<()> {
+    let path = dir.join("summary.json");
+    let write = |summary: &Summary| {
+        let text = serde_json::to_string_pretty(summary).map_err(io::Error::other)?;
+        vtk::write_atomically(&path, (text + "\n").as_bytes())
+    };
+    let Err(first) = write(summary) else {
+        return Ok(());
+    };
+    if lock.release_reserve().is_ok() {
+        if write(summary).is_ok() {
+            return Ok(());
+        }
+        let note = "the increment log is left out: the disk was too full for it";
+        let compact = Summary {
+            increment_log: Vec::new(),
+            message: Some(match &summary.message {
+                Some(m) => format!("{m} ({note})"),
+                None => note.to_string(),
+            }),
+            ..summary.clone()
+        };
+        if write(&compact).is_ok() {
+            return Ok(());
+        }
+    }
+    Err(first)
 }
 
 impl ResultWriter {
@@ -960,7 +1042,7 @@ impl ResultWriter {
             .unwrap_or(0);
         Ok(Self {
             dir: dir.to_path_buf(),
-            _lock: lock,
+            lock,
             encoding: vtk::Encoding::default(),
             nodes: CsvFile::create(
                 dir.join("nodes.csv"),
@@ -1034,10 +1116,16 @@ impl ResultWriter {
     }
 
     /// Writes `summary.json` (through a temporary file, so that it is
-    /// never seen half written).
-    pub fn write_summary(&self, summary: &Summary) -> io::Result<()> {
-        let text = serde_json::to_string_pretty(summary).map_err(io::Error::other)?;
-        vtk::write_atomically(&self.dir.join("summary.json"), (text + "\n").as_bytes())
+    /// never seen half written; on a full disk, into the space the lock
+    /// reserved for it).
+    pub fn write_summary(&mut self, summary: &Summary) -> io::Result<()> {
+        write_summary_file(&self.dir, summary, &mut self.lock)
+    }
+
+    /// The process of an earlier run whose lock file was left in the
+    /// directory (see [`DirectoryLock::stale_owner`]).
+    pub fn stale_lock(&self) -> Option<&str> {
+        self.lock.stale_owner()
     }
 
     /// Appends `row` to `events.csv` (a run with dynamics; its step, the

@@ -658,9 +658,9 @@ struct LatchWatch {
     contact: SpringContact,
     /// The largest force of its spring in the analysis.
     largest: f64,
-    /// Its whole contacts: steps, start and end times, largest force, and
-    /// the increment that ended it.
-    contacts: Vec<(usize, f64, f64, f64, usize)>,
+    /// Its whole contacts: the longest step within, start and end times,
+    /// largest force, and the increment that ended it.
+    contacts: Vec<(f64, f64, f64, f64, usize)>,
     /// Said already that a static analysis loaded it beyond its unlatch
     /// load.
     overloaded: bool,
@@ -696,7 +696,7 @@ impl LatchWatch {
                     passed: false,
                     contact: SpringContact {
                         sign: spring_force(l, state).signum(),
-                        steps: 0,
+                        longest: 0.0,
                         from: state.time,
                         whole: false,
                         peak: 0.0,
@@ -724,23 +724,26 @@ impl LatchWatch {
     /// Follows the contact of its spring to the converged step at `time`
     /// where its force is `f`: a contact is the steps between two changes
     /// of the force's sign, half a period of the latch's oscillation about
-    /// an edge of its dead band (docs/joints.md §6.2).
-    fn follow_contact(&mut self, f: f64, time: f64, increment: usize) {
+    /// an edge of its dead band (docs/joints.md §6.2); `step` is the size
+    /// of the step that ended at `time`.
+    fn follow_contact(&mut self, f: f64, time: f64, step: f64, increment: usize) {
         let sign = if f == 0.0 { 0.0 } else { f.signum() };
         self.largest = self.largest.max(f.abs());
         let c = &mut self.contact;
         if sign == c.sign {
-            c.steps += 1;
+            c.longest = c.longest.max(step);
             c.peak = c.peak.max(f.abs());
             return;
         }
         if c.sign != 0.0 && c.whole {
+            // the step that ended the contact crossed part of it too
+            let longest = c.longest.max(step);
             self.contacts
-                .push((c.steps, c.from, time, c.peak, increment));
+                .push((longest, c.from, time, c.peak, increment));
         }
         *c = SpringContact {
             sign,
-            steps: 1,
+            longest: step,
             from: time,
             whole: true,
             peak: f.abs(),
@@ -780,8 +783,8 @@ fn spring_force(l: &Latch, state: &State) -> f64 {
 struct SpringContact {
     /// The sign of the spring's force (0: none).
     sign: f64,
-    /// Converged steps of that sign so far, from `from`.
-    steps: usize,
+    /// The longest converged step of that sign so far, from `from`.
+    longest: f64,
     from: f64,
     /// Begun within the analysis (not already under way at its start).
     whole: bool,
@@ -845,7 +848,13 @@ impl Running {
         let s = analysis.settings();
         Self {
             index,
-            kind: if s.kinematic { "kinematic" } else { "static" },
+            kind: if s.kinematic {
+                "kinematic"
+            } else if s.kinetostatic {
+                "kinetostatic"
+            } else {
+                "static"
+            },
             start_time: 0.0,
             end_time: s.end_time,
             initial_iterations: 0,
@@ -1019,6 +1028,13 @@ impl Recorder {
             "{model_file}: {}; {unknowns} unknowns; {analyses}",
             describe(model),
         ));
+        if let Some(owner) = recorder.writer.stale_lock().map(str::to_owned) {
+            recorder.note_line(&format!(
+                "{}: an earlier run (process {owner}) did not end there: it was killed or its machine stopped, leaving its lock file {}; no process holds the directory now, so this run takes it over and replaces that run's results",
+                dir.display(),
+                super::results::LOCK_FILE
+            ));
+        }
         // warnings are shown by the caller; the log keeps them with the run
         for w in &model.warnings {
             recorder.log.line(&format!("warning: {w}"));
@@ -1144,7 +1160,7 @@ impl Recorder {
                 continue;
             };
             if !statics {
-                w.follow_contact(spring_force(l, state), info.time, info.increment);
+                w.follow_contact(spring_force(l, state), info.time, info.step, info.increment);
             }
             if let Some(limit) = l.spring().and_then(|s| s.unlatch_load) {
                 let load = l.spring_state(state).2;
@@ -1294,11 +1310,12 @@ impl Recorder {
     }
 
     /// At the end of a dynamic analysis: a warning for each spring latch
-    /// whose shortest contact lasted fewer than
-    /// [`RESOLVED_CONTACT_STEPS`] steps: the steps do not resolve its
-    /// spring, and its peak load and its rattles are unreliable (with
-    /// fixed steps longer than a contact, a peak load half the true one
-    /// and half the rattles have been seen, with the energy balanced).
+    /// with a contact shorter than [`RESOLVED_CONTACT_STEPS`] of the
+    /// longest step taken within it: the steps do not resolve its spring,
+    /// and its peak load and its rattles are unreliable (with fixed steps
+    /// longer than a contact, a peak load half the true one and half the
+    /// rattles have been seen, with the energy balanced). Steps cut short
+    /// to land on the edges of the dead band do not count as resolving it.
     fn unresolved_contacts(&mut self) {
         let warnings: Vec<WarningInfo> = self
             .latches
@@ -1307,21 +1324,22 @@ impl Recorder {
                 // contacts whose force stays below CONTACT_FORCE of the
                 // largest (the round-off of a step landed on an edge) are
                 // not counted
-                let (steps, from, to, _, increment) = w
+                let (longest, from, to, _, increment) = w
                     .contacts
                     .iter()
                     .filter(|c| c.3 >= CONTACT_FORCE * w.largest)
-                    .min_by_key(|c| c.0)
+                    .min_by(|a, b| ((a.2 - a.1) / a.0).total_cmp(&((b.2 - b.1) / b.0)))
                     .copied()?;
-                (steps < RESOLVED_CONTACT_STEPS).then(|| WarningInfo {
+                let steps = (to - from) / longest;
+                (steps < RESOLVED_CONTACT_STEPS as f64).then(|| WarningInfo {
                     increment,
                     from,
                     time: to,
                     message: format!(
-                        "latch {}: a contact of its spring lasted only {steps} step{} ({} s): the steps do not resolve the latch's spring, so its peak load and the number of its rattles are unreliable; use adaptive steps, or steps at least {} times shorter than a contact",
+                        "latch {}: a contact of its spring lasted {} s, {steps:.1} of the steps taken within it ({} s): the steps do not resolve the latch's spring, so its peak load and the number of its rattles are unreliable; use adaptive steps, or steps at least {} times shorter than a contact",
                         w.id,
-                        if steps == 1 { "" } else { "s" },
                         format_time(to - from),
+                        format_time(longest),
                         4 * RESOLVED_CONTACT_STEPS
                     ),
                 })
@@ -1503,6 +1521,22 @@ impl Recorder {
                 output_errors.push(e);
             }
         }
+        if let Err(e) = self.log.flush() {
+            output_errors.push(e);
+        }
+        // a result file that could not be written fails the run, and its
+        // summary says which (a full disk: docs/results.md)
+        let (status, message) = match output_errors.first() {
+            None => (status, message),
+            Some(e) => {
+                let what = format!("cannot write results: {e}");
+                match (status, message) {
+                    (RunStatus::Completed, _) => (RunStatus::Failed, Some(what)),
+                    (status, Some(m)) => (status, Some(format!("{m}; {what}"))),
+                    (status, None) => (status, Some(what)),
+                }
+            }
+        };
         self.summary.latches = self.peaks.latches();
         self.summary.stops = self.peaks.stops();
         self.summary.contacts = self.peaks.contacts();

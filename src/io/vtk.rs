@@ -762,7 +762,11 @@ impl PvdFile {
         if self.file.is_none() {
             let head = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
             let mut f = std::fs::File::create(&self.path).map_err(named)?;
-            f.write_all(head.as_bytes()).map_err(named)?;
+            if let Err(e) = f.write_all(head.as_bytes()) {
+                // no collection rather than a broken one
+                let _ = std::fs::remove_file(&self.path);
+                return Err(named(e));
+            }
             self.tail_at = head.len() as u64;
             self.file = Some(f);
         }

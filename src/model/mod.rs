@@ -261,9 +261,9 @@ impl Model {
     /// `p` equal to the largest diagonal stiffness of the elements' tangents
     /// in the reference state, for translations and rotations separately;
     /// a kind without stiffness takes the other's times or over `L²`
-    /// ([`Model::length_scale`]), and a model without stiffness (rigid
-    /// bodies and joints only) `1` and `L²`, so that the scaling follows
-    /// the units of the model; `scale` and `penalty`, when given, replace
+    /// ([`Model::length_scale`]), so that the scaling follows the units of
+    /// the model, and a model without stiffness (rigid bodies and joints
+    /// only) takes 1 for both; `scale` and `penalty`, when given, replace
     /// `k` and `p` of both kinds.
     pub fn default_scaling(&self, scale: Option<f64>, penalty: Option<f64>) -> ConstraintScaling {
         let state = self.initial_state();
@@ -302,14 +302,16 @@ impl Model {
         // a kind without stiffness takes the other's through the model's
         // length `L` (k_moment = k_force L²), so that k has the units of
         // its kind whichever units the model is in; a model without any
-        // stiffness takes k_force = 1, k_moment = L²
+        // stiffness takes 1 for both (k_moment = L² there made the rank
+        // analysis of the ERA cell's rigid links, a mechanism of one free
+        // motion, find none: tests/era.rs)
         let found = |v: f64| v > 0.0 && v.is_finite();
         let l2 = self.length_scale * self.length_scale;
         let (kf, km) = match (found(kf), found(km)) {
             (true, true) => (kf, km),
             (true, false) => (kf, kf * l2),
             (false, true) => (km / l2, km),
-            (false, false) => (1.0, l2),
+            (false, false) => (1.0, 1.0),
         };
         let pick = |v: f64, user: Option<f64>| user.unwrap_or(v);
         ConstraintScaling {

@@ -7,6 +7,7 @@
 //! to it. Sizes are checked before anything is allocated (the limits of
 //! docs/model-format.md, "Limits").
 
+use crate::io::number::plain as num;
 use std::collections::{HashMap, HashSet};
 
 mod beams;
@@ -198,18 +199,6 @@ impl Checker {
             );
             false
         }
-    }
-}
-
-/// A number for messages: as written for ordinary magnitudes, in
-/// exponent form for very large and very small ones (`1e-308`, not 308
-/// zeros).
-fn num(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
     }
 }
 

@@ -311,6 +311,7 @@ fn settings(ck: &mut Checker, entity: &str, a: &AnalysisInput, start: f64) -> St
         output_every: a.output_every.unwrap_or(1),
         output_times: a.output_times.clone().unwrap_or_default(),
         kinematic: a.kind == "kinematic",
+        kinetostatic: a.kind == "kinetostatic",
         arc_length: a.control.as_deref() == Some("arc_length"),
         max_increments: a.max_increments.unwrap_or(1000),
     };

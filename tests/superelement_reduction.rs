@@ -1,5 +1,5 @@
 //! Craig–Bampton reduction of beam models and of imported matrices
-//! (src/reduction; docs/theory.md §18.1–17.3): the reduced body's
+//! (src/reduction; docs/theory.md §18.1–18.3): the reduced body's
 //! frequencies, clamped at its boundary and free-free, against the full
 //! model's and against beam theory.
 

@@ -1,5 +1,5 @@
 //! Craig–Bampton reduction of a flexible body (Craig & Bampton 1968;
-//! reference paper eq. 21–24; docs/theory.md §18.1–17.3).
+//! reference paper eq. 21–24; docs/theory.md §18.1–18.3).
 //!
 //! The dofs are split into those of the boundary nodes `B` (six per node,
 //! in the order the boundary lists them) and the interior `I`. The basis

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+#[allow(dead_code)]
 #[path = "vtk_reader/mod.rs"]
 mod vtk_reader;
 

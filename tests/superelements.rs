@@ -229,7 +229,7 @@ rho_infinity = 0.9"#;
         worst_tip = worst_tip.max((r.x[tip_b] - tip).norm());
         let br = bending(&r.q[root_b], &r.x[root_b], &r.x[tip_b]);
         let bs = bending(&s.q[root], &s.x[root], &tip);
-        if (s.time * 5000.0).round() as usize % 200 == 0 {
+        if ((s.time * 5000.0).round() as usize).is_multiple_of(200) {
             println!(
                 "t {:.2}: bending beams {br:.4e}, superelement {bs:.4e}",
                 s.time

@@ -578,7 +578,7 @@ pub fn reduce(
             .mass_orthogonality
             .max(report.stiffness_orthogonality)
             .max(report.coupling_orthogonality);
-        if !(worst <= ORTHOGONALITY_TOLERANCE) {
+        if worst.is_nan() || worst > ORTHOGONALITY_TOLERANCE {
             return Err(ReductionError::Orthogonality(format!(
                 "Φ_NᵀMΦ_N − I: {:.3e}, Φ_NᵀKΦ_N − Ω²: {:.3e}, constraint against fixed-interface modes: {:.3e} (tolerance {ORTHOGONALITY_TOLERANCE:e})",
                 report.mass_orthogonality, report.stiffness_orthogonality, report.coupling_orthogonality
@@ -609,7 +609,7 @@ pub fn reduce(
         } else {
             d.iter().fold(f64::INFINITY, |a, &b| a.min(b))
         };
-        if !(smallest > SINGULAR_BOUNDARY) {
+        if smallest.is_nan() || smallest <= SINGULAR_BOUNDARY {
             return Err(ReductionError::SingularBoundary {
                 frame: body.node_ids[boundary[settings.frame]],
                 value: smallest,

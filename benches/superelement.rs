@@ -28,7 +28,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// A 1.2 m × 0.8 m sandwich panel of `n × n` shells with its side
-/// midpoints named 1001–1004.
+/// midpoints named 900001–900004.
 fn panel(n: usize) -> Model {
     let text = format!(
         r#"title = "panel"
@@ -58,7 +58,7 @@ elements = [{n}, {n}]
 laminate = "panel"
 first_node = 1
 first_element = 1
-node_ids = {{ west = 1001, east = 1002, south = 1003, north = 1004 }}
+node_ids = {{ west = 900001, east = 900002, south = 900003, north = 900004 }}
 "#
     );
     let input = parse_model(&text, Path::new("panel.toml")).unwrap();
@@ -74,7 +74,9 @@ fn reduction(n: usize) {
         let body = FlexibleBody::from_model(panel(n));
         let t1 = Instant::now();
         dofs = body.n_dofs();
-        let boundary = [1001, 1002, 1003, 1004].map(|id| body.node_index(id).unwrap()).to_vec();
+        let boundary = [900001, 900002, 900003, 900004]
+            .map(|id| body.node_index(id).unwrap())
+            .to_vec();
         let mut settings = ReductionSettings::new(boundary, ModeSelection::Count(4));
         settings.compare_free_free = false;
         let r = reduce(body, &settings).unwrap();
@@ -100,7 +102,9 @@ fn dynamic_settings(path: &Path) -> (Arc<Model>, DynamicSettings) {
 }
 
 fn array(name: &str) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").join(name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(name);
     let (mut build, mut run) = (Vec::new(), Vec::new());
     let mut steps = (0, 0);
     for _ in 0..3 {
@@ -178,15 +182,23 @@ force = [0.0, 0.0, -10.0]
     let mut times = Vec::new();
     for _ in 0..3 {
         let t0 = Instant::now();
-        let out = DynamicAnalysis::new(model.clone(), settings.clone()).run(model.initial_state(), &mut NoObserver);
+        let out = DynamicAnalysis::new(model.clone(), settings.clone())
+            .run(model.initial_state(), &mut NoObserver);
         times.push(t0.elapsed().as_secs_f64() / out.steps as f64);
     }
     median(times)
 }
 
 fn main() {
-    let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
-    let sizes = if args.is_empty() { vec![26, 50, 100] } else { args };
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.parse().ok())
+        .collect();
+    let sizes = if args.is_empty() {
+        vec![26, 50, 100]
+    } else {
+        args
+    };
     for n in sizes {
         reduction(n);
     }

@@ -809,6 +809,7 @@ mod tests {
                 mass: 1.5,
                 inertia: Some(InertiaInput::Diagonal([0.1, 0.2, 0.3])),
                 center_of_mass: Some([0.02, -0.01, 0.03]),
+                shape: None,
             });
             Model::from_input(&m).expect("valid model")
         };

@@ -1,11 +1,15 @@
 //! `unfold`: command-line front end.
 //!
 //! ```text
-//! unfold run MODEL.toml [--out DIR] [--quiet] [--threads N] [--vtk-ascii] [--restart FILE]
+//! unfold run MODEL.toml [--out DIR] [--quiet | --verbose] [--threads N] [--vtk-ascii] [--restart FILE]
 //! unfold check MODEL.toml [--threads N]
 //! unfold plot RESULTS_DIR [joints|moments|energies|hinge_laws ...] [--joint ID ...] [--format png|svg|both]
 //!             [--out DIR] [--degrees] [--units si|model] [--model MODEL.toml]
+//! unfold view RESULTS_DIR [--out FILE] [--open | --no-open] [--histories FILES] [--max-frames N]
 //! ```
+//! `unfold view` writes one self-contained HTML page that animates the run
+//! in 3-D in a web browser (docs/viewer.md), and opens it when asked or
+//! when run in a terminal on a display.
 //! `unfold plot` draws the time histories of a run from its result files
 //! (docs/plots.md): joint coordinates with the lock instants, moments
 //! along the joint coordinates, energies and the energy balance error.
@@ -33,6 +37,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -53,7 +58,7 @@ use unfold::io::run::{
     SignalEvent, StopRequest,
 };
 use unfold::io::vtk::Encoding;
-use unfold::model::input::ModelInput;
+use unfold::model::input::{ModelInput, OutputInput};
 use unfold::model::Model;
 
 // `println!` and `eprintln!` that ignore a failed write instead of
@@ -96,6 +101,11 @@ enum Command {
         /// Do not print a log line per increment.
         #[arg(long, short)]
         quiet: bool,
+        /// Print every increment's line even when the output is not a
+        /// terminal (by default a redirected run prints a progress line
+        /// every 10 s instead; log.txt has every line either way).
+        #[arg(long, short, conflicts_with = "quiet")]
+        verbose: bool,
         /// Worker threads for assembly and factorisation (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
@@ -145,6 +155,32 @@ enum Command {
         /// one named in summary.json).
         #[arg(long, value_name = "FILE")]
         model: Option<PathBuf>,
+    },
+    /// Write one HTML page that animates the run in 3-D in a web browser,
+    /// with a time line, its events and a time-history plot
+    /// (docs/viewer.md); it works offline.
+    View {
+        /// Results directory of a run (`unfold run MODEL --out DIR`).
+        results: PathBuf,
+        /// The page to write (default: RESULTS/view.html).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+        /// Open the page in a web browser (by default it is opened when the
+        /// command runs in a terminal on a display).
+        #[arg(long, conflicts_with = "no_open")]
+        open: bool,
+        /// Do not open the page.
+        #[arg(long)]
+        no_open: bool,
+        /// The history files to embed for the plot, comma-separated
+        /// (`joints,energies`; `all` for every CSV file; default: every one
+        /// but nodes, nodes_velocities and beams).
+        #[arg(long, value_delimiter = ',', value_name = "FILES")]
+        histories: Vec<String>,
+        /// At most this many frames (evenly spaced output steps, and the
+        /// steps of the events).
+        #[arg(long, default_value_t = unfold::io::view::MAX_FRAMES, value_name = "N")]
+        max_frames: usize,
     },
 }
 
@@ -214,10 +250,32 @@ fn main() -> ExitCode {
             let out = out.unwrap_or_else(|| results.join("plots"));
             plot(&results, model.as_deref(), &request, &out, format)
         }
+        Command::View {
+            results,
+            out,
+            open,
+            no_open,
+            histories,
+            max_frames,
+        } => {
+            let options = unfold::io::view::ViewOptions {
+                histories,
+                max_frames,
+            };
+            let open = if open {
+                Some(true)
+            } else if no_open {
+                Some(false)
+            } else {
+                None
+            };
+            view(&results, out, open, &options)
+        }
         Command::Run {
             model,
             out,
             quiet,
+            verbose,
             threads,
             vtk_ascii,
             restart,
@@ -261,7 +319,8 @@ fn main() -> ExitCode {
                 Encoding::Binary
             };
             // on a worker of the thread pool (unfold::assembly::on_worker_thread)
-            on_worker_thread(|| run(&model, &out, quiet, encoding, restart.as_deref()))
+            let echo = Echo { quiet, verbose };
+            on_worker_thread(|| run(&model, &out, echo, encoding, restart.as_deref()))
         }
     }
 }
@@ -351,6 +410,109 @@ fn plot(
             ExitCode::from(code)
         }
     }
+}
+
+/// `unfold view`: writes the page of the results in `dir` to `out`
+/// (default `dir/view.html`) and opens it if `open` says so (by default
+/// when run in a terminal on a display); exit code 2 for results that
+/// cannot be read, 1 if the page cannot be written.
+fn view(
+    dir: &Path,
+    out: Option<PathBuf>,
+    open: Option<bool>,
+    options: &unfold::io::view::ViewOptions,
+) -> ExitCode {
+    if options.max_frames < 2 {
+        eprintln!(
+            "error: --max-frames {}: give at least 2 (the first and the last step)",
+            options.max_frames
+        );
+        return ExitCode::from(EXIT_INPUT);
+    }
+    let out = out.unwrap_or_else(|| dir.join("view.html"));
+    if out.is_dir() {
+        eprintln!(
+            "error: --out {}: is a directory; give the file of the page (e.g. {})",
+            out.display(),
+            out.join("view.html").display()
+        );
+        return ExitCode::from(EXIT_INPUT);
+    }
+    let start = std::time::Instant::now();
+    let report = match unfold::io::view::write_view(dir, &out, options) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(if e.is_input() {
+                EXIT_INPUT
+            } else {
+                EXIT_FAILED
+            });
+        }
+    };
+    for note in &report.notes {
+        eprintln!("note: {note}");
+    }
+    println!(
+        "{}: {} frames of {} output steps, {} points, {} cells, {} colour fields, {} history series, {} events; {:.2} MB, written in {:.2} s",
+        out.display(),
+        report.frames,
+        report.steps,
+        report.points,
+        report.cells,
+        report.fields.len(),
+        report.series,
+        report.events,
+        report.bytes as f64 / 1e6,
+        start.elapsed().as_secs_f64()
+    );
+    let open = open.unwrap_or_else(|| {
+        use std::io::IsTerminal as _;
+        std::io::stdout().is_terminal() && has_display()
+    });
+    if open {
+        match open_in_browser(&out) {
+            Ok(how) => eprintln!("opened with {how}"),
+            Err(e) => eprintln!("note: {e}; open {} in a web browser", out.display()),
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// Whether pages can be shown: a graphical session (X11 or Wayland on
+/// Linux and the like; always on macOS and Windows).
+fn has_display() -> bool {
+    if cfg!(any(target_os = "macos", target_os = "windows")) {
+        return true;
+    }
+    ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|d| !d.is_empty()))
+}
+
+/// Opens `page` in the web browser (`$BROWSER`, else `xdg-open`, `open` on
+/// macOS, `start` on Windows), without waiting for it; the command used.
+fn open_in_browser(page: &Path) -> Result<String, String> {
+    let mut command = if let Some(b) = std::env::var_os("BROWSER").filter(|b| !b.is_empty()) {
+        std::process::Command::new(b)
+    } else if cfg!(target_os = "macos") {
+        std::process::Command::new("open")
+    } else if cfg!(target_os = "windows") {
+        let mut c = std::process::Command::new("cmd");
+        c.args(["/C", "start", ""]);
+        c
+    } else {
+        std::process::Command::new("xdg-open")
+    };
+    let how = format!("{:?}", command.get_program());
+    command
+        .arg(page)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .map(|_| how.clone())
+        .map_err(|e| format!("no web browser could be started ({how}: {e})"))
 }
 
 fn describe(model: &Model) -> String {
@@ -583,26 +745,67 @@ enum Planned {
 /// bar, and the last line.
 struct Terminal {
     bar: ProgressBar,
-    quiet: bool,
+    echo: Echo,
     end_time: f64,
+    /// When the run started and when the last progress line was printed
+    /// (output not a terminal).
+    started: Instant,
+    last_progress: Instant,
+}
+
+/// Which lines a run prints (`--quiet`, `--verbose`).
+#[derive(Clone, Copy, Debug)]
+struct Echo {
+    quiet: bool,
+    verbose: bool,
+}
+
+/// Between two progress lines of a run whose output is not a terminal.
+const PROGRESS_INTERVAL: Duration = Duration::from_secs(10);
+
+/// Whether `text` is the line of one converged increment or step
+/// (`step 12  t = … iterations …`), which a redirected run leaves to
+/// log.txt unless `--verbose`.
+fn is_increment_line(text: &str) -> bool {
+    let mut words = text.split_whitespace();
+    matches!(words.next(), Some("step" | "increment"))
+        && words.next().is_some_and(|n| n.parse::<usize>().is_ok())
+        && text.contains(" iterations ")
 }
 
 impl Console for Terminal {
     fn line(&mut self, text: &str) {
-        if self.quiet {
+        if self.echo.quiet {
             return;
         }
-        // plainly when there is no bar (output not a terminal)
+        // plainly when there is no bar (output not a terminal), without
+        // the increments' lines unless asked
         if self.bar.is_hidden() {
-            println!("{text}");
+            if self.echo.verbose || !is_increment_line(text) {
+                println!("{text}");
+            }
         } else {
             self.bar.println(text);
         }
     }
 
     fn progress(&mut self, info: &IncrementInfo) {
-        // nothing formatted for a bar no one sees (output not a terminal)
+        // output not a terminal: a line every PROGRESS_INTERVAL
         if self.bar.is_hidden() {
+            if !self.echo.quiet
+                && !self.echo.verbose
+                && self.last_progress.elapsed() >= PROGRESS_INTERVAL
+            {
+                self.last_progress = Instant::now();
+                println!(
+                    "progress: t = {:.6} of {} ({:.0} %), increment {}, {:.0} s",
+                    info.time,
+                    format_time(self.end_time),
+                    100.0 * info.time / self.end_time,
+                    info.increment,
+                    self.started.elapsed().as_secs_f64()
+                );
+            }
             return;
         }
         self.bar
@@ -635,7 +838,7 @@ impl Console for Terminal {
 fn run(
     path: &Path,
     out: &Path,
-    quiet: bool,
+    echo: Echo,
     encoding: Encoding,
     restart: Option<&Path>,
 ) -> ExitCode {
@@ -780,8 +983,10 @@ fn run(
     );
     let terminal = Terminal {
         bar,
-        quiet,
+        echo,
         end_time: plan.last().map_or(1.0, |a| a.end_time()),
+        started: Instant::now(),
+        last_progress: Instant::now(),
     };
     let recorder = match &first_planned {
         Planned::Static(a) => Recorder::create_sequence(out, &label, a, plan, terminal),
@@ -792,6 +997,7 @@ fn run(
         Ok(r) => r
             .with_stop(&stop)
             .with_vtk_encoding(encoding)
+            .with_vtk_every(OutputInput::vtk_interval(input.output.as_ref()))
             .with_restart(restarts, first),
         Err(e) => {
             eprintln!("error: cannot write results: {e}");

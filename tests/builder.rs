@@ -187,3 +187,27 @@ fn a_sequence_of_analyses_round_trips() {
     assert_eq!(second.output_times, vec![1.5, 2.0]);
     assert_eq!(settings, m.analyses().unwrap());
 }
+
+/// The dynamic step controls of the builder (`min_step`, `max_step`,
+/// `error_tolerance`, `newton`) reach the settings as the fields of
+/// `[analysis]` do, and are written to the model file.
+#[test]
+fn dynamic_step_controls_reach_the_settings() {
+    let a = Analysis::dynamic()
+        .end_time(2.0)
+        .time_step(0.01)
+        .min_step(1e-6)
+        .max_step(0.02)
+        .error_tolerance(1e-5)
+        .newton("modified");
+    let settings = a.clone().analysis_settings().unwrap();
+    let d = settings.as_dynamic().unwrap();
+    assert_eq!(
+        (d.min_step, d.max_step, d.error_tolerance),
+        (1e-6, 0.02, 1e-5)
+    );
+    assert_eq!(d.newton, unfold::analysis::NewtonMethod::Modified);
+    let input = a.into_input();
+    assert_eq!(input.max_step, Some(0.02));
+    assert_eq!(input.newton.as_deref(), Some("modified"));
+}

@@ -33,6 +33,9 @@ use unfold::model::Model;
 /// Longest a mutant may run.
 const RUN_LIMIT: Duration = Duration::from_secs(30);
 
+/// How soon a run interrupted at [`RUN_LIMIT`] must stop.
+const INTERRUPT_LIMIT: Duration = Duration::from_secs(10);
+
 /// The seed models, parsed: the example model files, and
 /// `tests/data/every_table.toml`, which uses every table of the format.
 fn examples() -> Vec<(String, Table)> {
@@ -405,8 +408,10 @@ fn non_finite_in_results(dir: &Path) -> Option<(PathBuf, String)> {
 
 /// A sample of mutants through `unfold run`: exit code 0, 1 or 2 with a
 /// message when not 0, no panic, finite result files, and an end within
-/// [`RUN_LIMIT`] (the examples run in a fraction of a second; a mutant
-/// that has not ended by then hangs).
+/// [`RUN_LIMIT`] (the examples run in a fraction of a second), or, for a
+/// mutant still running then, a clean stop on SIGINT within
+/// [`INTERRUPT_LIMIT`] (exit code 130, summary `interrupted`, finite
+/// results): a run that does not answer hangs.
 #[test]
 fn mutated_models_run_without_panic_or_non_finite_results() {
     let examples = examples();
@@ -436,14 +441,34 @@ fn mutated_models_run_without_panic_or_non_finite_results() {
                 .spawn()
                 .unwrap();
             let start = Instant::now();
+            let mut interrupted = false;
             while child.try_wait().unwrap().is_none() {
-                if start.elapsed() > RUN_LIMIT {
+                if start.elapsed() > RUN_LIMIT + INTERRUPT_LIMIT {
                     let _ = child.kill();
-                    prop_assert!(false, "no end in {RUN_LIMIT:?} for\n{text}");
+                    prop_assert!(false, "no end in {RUN_LIMIT:?}, nor {INTERRUPT_LIMIT:?} after SIGINT, for\n{text}");
+                }
+                if start.elapsed() > RUN_LIMIT && !interrupted {
+                    // a long run (a mutant may ask for a million steps, as
+                    // a gravity of 1e9 does of a double pendulum): it must
+                    // stop cleanly when interrupted
+                    // SAFETY: kill(2) on the child's process id
+                    unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) };
+                    interrupted = true;
                 }
                 std::thread::sleep(Duration::from_millis(5));
             }
             let code = child.wait().unwrap().code();
+            if interrupted {
+                // 128 + SIGINT, its summary saying so
+                prop_assert_eq!(code, Some(130), "for\n{}", text);
+                let summary = std::fs::read_to_string(out.join("summary.json")).unwrap_or_default();
+                prop_assert!(summary.contains("\"interrupted\""), "{summary}");
+                if let Some((f, token)) = non_finite_in_results(&out) {
+                    prop_assert!(false, "{token} in {} for\n{text}", f.display());
+                }
+                let _ = std::fs::remove_dir_all(&out);
+                return Ok(());
+            }
             let stderr = std::fs::read_to_string(&log).unwrap_or_default();
             prop_assert!(
                 matches!(code, Some(0..=2)),

@@ -78,6 +78,7 @@ fn assembled_tangent_matches_finite_differences() {
         mass: 2.0,
         inertia: Some(InertiaInput::Diagonal([0.1, 0.2, 0.3])),
         center_of_mass: Some([1.0, -2.0, 0.5]),
+        shape: None,
     });
     m.gravity = Some(GravityInput {
         acceleration: [0.0, -9.81, -3.0],
@@ -202,6 +203,7 @@ fn dynamic_model() -> Model {
         mass: 2.0,
         inertia: Some(InertiaInput::Diagonal([0.1, 0.2, 0.3])),
         center_of_mass: Some([1.0, -2.0, 0.5]),
+        shape: None,
     });
     m.point_masses.push(PointMassInput {
         id: 101,

@@ -1201,6 +1201,7 @@ fn cantilever_with_body(link: Option<JointType>, force: [f64; 3], moment: [f64; 
                 mass: 2.0,
                 inertia: None,
                 center_of_mass: None,
+                shape: None,
             });
             m.joints.push(JointInput {
                 id: 101,

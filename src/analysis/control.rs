@@ -24,7 +24,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::newton::NewtonFailure;
-use super::{CutbackInfo, EventInfo, IncrementInfo, Observer};
+use super::{CutbackInfo, EventInfo, IncrementInfo, Observer, RejectionInfo, WarningInfo};
 use crate::model::Model;
 use crate::state::State;
 
@@ -138,6 +138,12 @@ pub trait Stepper {
 
     /// `t` reached by the last attempt.
     fn attempted_time(&self) -> f64;
+
+    /// Where the local error estimate of the last attempt was largest
+    /// (`node 12`), for messages.
+    fn error_location(&self) -> Option<String> {
+        None
+    }
 
     /// Goes back to the last accepted state after a rejected attempt.
     fn reject(&mut self);
@@ -371,13 +377,74 @@ pub struct StepController {
     /// The last attempt was rejected or cut back: the next accepted step
     /// does not let the size grow.
     rejected: bool,
+    /// Accepted steps in a row after which the error estimate planned a
+    /// step below [`COLLAPSE_RATIO`] of the first (`None` once warned).
+    collapsed_steps: Option<usize>,
 }
+
+/// The steps have collapsed when, for [`COLLAPSE_STEPS`] accepted steps in
+/// a row, the error estimate plans a step so short that the rest of the
+/// analysis would take more than this many steps at that pace, or below
+/// [`COLLAPSE_RATIO`] of the first step: a warning then says where the
+/// error is largest.
+pub const COLLAPSE_REMAINING_STEPS: f64 = 1e5;
+
+/// See [`COLLAPSE_REMAINING_STEPS`].
+pub const COLLAPSE_RATIO: f64 = 1e-4;
+
+/// See [`COLLAPSE_REMAINING_STEPS`].
+pub const COLLAPSE_STEPS: usize = 50;
 
 impl StepController {
     /// The shortest step that lands on an event, [`LANDING_FLOOR`] of the
     /// largest step.
     fn landing_floor(&self) -> f64 {
         LANDING_FLOOR * self.bounds.max
+    }
+
+    /// Counts the accepted steps (of `size`, from `t`) after which the
+    /// error estimate plans a collapsed step ([`COLLAPSE_REMAINING_STEPS`])
+    /// and warns once, after [`COLLAPSE_STEPS`] in a row, naming where the
+    /// error is largest: the steps follow a motion there far faster than
+    /// the model's time step asks.
+    fn watch_collapse<S: Stepper + ?Sized>(
+        &mut self,
+        size: f64,
+        t: f64,
+        increment: usize,
+        stepper: &S,
+        observer: &mut dyn Observer,
+    ) {
+        let Some(count) = self.collapsed_steps.as_mut() else {
+            return;
+        };
+        let remaining = (self.end_time - t - size).max(0.0) / self.size;
+        if remaining <= COLLAPSE_REMAINING_STEPS
+            && self.size >= COLLAPSE_RATIO * self.bounds.initial
+        {
+            *count = 0;
+            return;
+        }
+        *count += 1;
+        if *count < COLLAPSE_STEPS {
+            return;
+        }
+        self.collapsed_steps = None;
+        let at = stepper.error_location().map_or(String::new(), |a| {
+            format!(" The local error estimate is largest at {a}.")
+        });
+        observer.warning(&WarningInfo {
+            increment,
+            from: t,
+            time: t + size,
+            message: format!(
+                "the steps collapsed: for {COLLAPSE_STEPS} steps the error estimate has asked for steps of about {:.3e} (the first was {:.3e}), which would take {:.1e} more steps to the end of the analysis; it stops if they fall below min_step = {:.3e}.{at} The steps follow a motion there far faster than the rest: a stiff and light part (a short beam, a small mass on a stiff spring or latch) vibrating, an impact, or a load or contact switched on at once. Damp it (rayleigh_beta of its section, damping of a spring latch, rho_infinity below 1 to damp the highest modes), make it less stiff or heavier if the model allows, or raise error_tolerance",
+                self.size,
+                self.bounds.initial,
+                remaining,
+                self.bounds.min
+            ),
+        });
     }
 
     /// A controller for steps within `bounds`, from increment 1 to
@@ -402,6 +469,7 @@ impl StepController {
             error_controlled: false,
             last_error: None,
             rejected: false,
+            collapsed_steps: Some(0),
         }
     }
 
@@ -702,6 +770,7 @@ impl StepController {
                     self.counts.wasted_iterations += iterations;
                     self.counts.error_rejections += 1;
                     self.rejected = true;
+                    let at = stepper.error_location().unwrap_or_default();
                     stepper.reject();
                     let next = size * self.error_factor(e, None, stepper.error_order()).min(1.0);
                     if next < self.bounds.min {
@@ -709,9 +778,17 @@ impl StepController {
                             increment,
                             time: t,
                             step: size,
-                            reason: NewtonFailure::ErrorEstimate { error: e },
+                            reason: NewtonFailure::ErrorEstimate { error: e, at },
                         });
                     }
+                    observer.rejected(&RejectionInfo {
+                        increment,
+                        time: t,
+                        step: size,
+                        next_step: next,
+                        error: e,
+                        at,
+                    });
                     self.size = next;
                     continue;
                 }
@@ -740,6 +817,7 @@ impl StepController {
                     } else {
                         grown.min(size)
                     };
+                    self.watch_collapse(size, t, increment, &*stepper, observer);
                 }
             }
             self.rejected = false;

@@ -136,6 +136,13 @@ const CARRY_WAIT: usize = 64;
 /// velocity scale violate the joints (D10).
 const VELOCITY_TOLERANCE: f64 = 1e-6;
 
+/// Normwise backward error of the solves of the Newton corrections by
+/// GMRES (docs/theory.md §8, "Inexact corrections"), relative to Newton's
+/// residual tolerance: the linearised residual a correction leaves is
+/// then a hundredth of what Newton accepts; at most 10⁻¹⁰, at least the
+/// solver's default 10⁻¹⁴.
+const CORRECTION_BACKWARD_ERROR: f64 = 1e-2;
+
 /// Corrections larger than this times the model size, or than this in
 /// radians, mean the iteration matrix is singular or nearly so.
 const RUNAWAY_CORRECTION: f64 = 1e6;
@@ -592,6 +599,19 @@ struct Work {
     node_sums: Vec<[f64; 5]>,
     kept: Vec<f64>,
     kept_flux: Vec<f64>,
+    /// Where the last error estimate was largest: a node's index, or an
+    /// element coordinate's equation.
+    error_peak: Option<ErrorPeak>,
+}
+
+/// Where a step's local error estimate was largest.
+#[derive(Clone, Copy, Debug, Default)]
+enum ErrorPeak {
+    /// At a node (its index).
+    Node(usize),
+    /// At an element coordinate (its equation).
+    #[default]
+    Coordinate,
 }
 
 impl Work {
@@ -2540,7 +2560,11 @@ impl Dynamics<'_> {
             .values_mut()
             .copy_from_slice(assembler.matrix.values());
         if factors.lu.is_none() {
-            factors.lu = Some(SymmetricFirst::analyze(matrix)?);
+            let mut lu = SymmetricFirst::analyze(matrix)?;
+            lu.set_backward_error(
+                (CORRECTION_BACKWARD_ERROR * self.settings.residual_tolerance).min(1e-10),
+            );
+            factors.lu = Some(lu);
         }
         let lu = factors.lu.as_mut().expect("analysed above");
         factors.count += 1;
@@ -3000,15 +3024,20 @@ impl Dynamics<'_> {
             }
         }
         let mut measure = 0.0f64;
+        let mut peak = None;
         for (eq, &v) in e.iter().enumerate() {
             let d = dofs.dof(eq);
             if let Some((node, k)) = dofs.node_component(d) {
                 sums[node][3 + k / 3] += v * v;
             } else if let DofKind::Coordinate { length } = dofs.kind(d) {
-                measure = measure.max(v.abs() * length / x_ref);
+                let ratio = v.abs() * length / x_ref;
+                if ratio > measure {
+                    measure = ratio;
+                    peak = Some(ErrorPeak::Coordinate);
+                }
             }
         }
-        for &[error, mx, mth, ex, eth] in sums.iter() {
+        for (node, &[error, mx, mth, ex, eth]) in sums.iter().enumerate() {
             let reference = x_ref * x_ref * mx / 3.0 + th_ref * th_ref * mth / 3.0;
             let ratio = if reference > 0.0 {
                 (error.max(0.0) / reference).sqrt()
@@ -3016,8 +3045,12 @@ impl Dynamics<'_> {
                 // no mass: the Euclidean norms, as lengths and angles
                 (ex.sqrt() / x_ref).max(eth.sqrt() / th_ref)
             };
-            measure = measure.max(ratio);
+            if ratio > measure {
+                measure = ratio;
+                peak = Some(ErrorPeak::Node(node));
+            }
         }
+        work.error_peak = peak;
         measure / self.settings.error_tolerance
     }
 }
@@ -3113,6 +3146,15 @@ impl Stepper for Dynamics<'_> {
 
     fn attempted_time(&self) -> f64 {
         self.run.state.time
+    }
+
+    fn error_location(&self) -> Option<String> {
+        Some(match self.run.work.error_peak? {
+            ErrorPeak::Node(i) => format!("node {}", self.model.node_ids[i]),
+            ErrorPeak::Coordinate => {
+                "an element coordinate (a slider's curve parameter or a superelement's mode)".into()
+            }
+        })
     }
 
     fn reject(&mut self) {

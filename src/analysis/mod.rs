@@ -89,6 +89,24 @@ pub struct CutbackInfo {
     pub reason: NewtonFailure,
 }
 
+/// A converged step rejected by its local error estimate, retried shorter
+/// ([`Observer::rejected`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RejectionInfo {
+    /// Increment number being attempted.
+    pub increment: usize,
+    /// Time at the start of the step.
+    pub time: f64,
+    /// The step rejected.
+    pub step: f64,
+    /// The step tried next.
+    pub next_step: f64,
+    /// Its error estimate relative to the tolerance (above 1).
+    pub error: f64,
+    /// Where the estimate was largest (`node 12`; empty if unknown).
+    pub at: String,
+}
+
 /// A step that landed on an event ([`EventFunction`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EventInfo {
@@ -139,6 +157,10 @@ pub trait Observer {
 
     /// When an increment is cut back.
     fn cutback(&mut self, _info: &CutbackInfo) {}
+
+    /// After a converged step rejected by its error estimate, before the
+    /// shorter one is tried.
+    fn rejected(&mut self, _info: &RejectionInfo) {}
 
     /// After the increment that landed on an event (reported to
     /// [`Observer::increment`] first).

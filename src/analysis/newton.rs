@@ -247,10 +247,12 @@ pub enum NewtonFailure {
     },
     /// The step converged, but its estimated local error is above the
     /// tolerance (the step controller shrinks it).
-    #[error("local error estimate {error:.3e} times its tolerance")]
+    #[error("local error estimate {error:.3e} times its tolerance{}", if at.is_empty() { String::new() } else { format!(", largest at {at}: the steps follow a motion there far faster than the rest (a stiff and light part vibrating, an impact, a load switched on at once); damp it (rayleigh_beta of its section, rho_infinity below 1), or raise error_tolerance") })]
     ErrorEstimate {
         /// Error relative to the tolerance.
         error: f64,
+        /// Where the estimate was largest (`node 12`; empty if unknown).
+        at: String,
     },
 }
 

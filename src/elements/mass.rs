@@ -14,6 +14,7 @@
 //! (I4) matrices form the inertia matrix.
 
 use super::inertia::RigidBodyInertia;
+use super::shape::BodyShape;
 use super::{
     add_block, add_scaled, add_vec, node_motion, CellShape, Element, ElementKind, ElementOutput,
     EvalContext,
@@ -35,11 +36,14 @@ pub struct RigidBody {
     offset: Vec3,
     /// The inertia kernel.
     kernel: RigidBodyInertia,
+    /// The drawn shape (rigid bodies only).
+    shape: Option<BodyShape>,
 }
 
 impl RigidBody {
     /// A rigid body with mass, inertia about its centre of mass and
-    /// centre-of-mass offset (both in the node's material frame).
+    /// centre-of-mass offset (both in the node's material frame), drawn as
+    /// the box of its inertia ([`BodyShape::from_inertia`]).
     pub fn new(id: Id, node: usize, mass: f64, inertia: Mat3, offset: Vec3) -> Self {
         Self {
             id,
@@ -49,13 +53,23 @@ impl RigidBody {
             inertia,
             offset,
             kernel: RigidBodyInertia::new(mass, inertia, offset),
+            shape: Some(BodyShape::from_inertia(mass, &inertia, offset)),
         }
+    }
+
+    /// The body drawn as `shape` instead of the box of its inertia.
+    pub fn with_shape(mut self, shape: BodyShape) -> Self {
+        if self.kind == ElementKind::RigidBody {
+            self.shape = Some(shape);
+        }
+        self
     }
 
     /// A point mass at the node.
     pub fn point_mass(id: Id, node: usize, mass: f64) -> Self {
         Self {
             kind: ElementKind::PointMass,
+            shape: None,
             ..Self::new(id, node, mass, Mat3::zeros(), Vec3::zeros())
         }
     }
@@ -143,6 +157,10 @@ impl Element for RigidBody {
 
     fn cell_shape(&self) -> CellShape {
         CellShape::Vertex
+    }
+
+    fn body_shape(&self) -> Option<&BodyShape> {
+        self.shape.as_ref()
     }
 
     fn mass(&self) -> f64 {

@@ -33,6 +33,7 @@ mod kind;
 pub mod laminate;
 pub mod load;
 pub mod mass;
+pub mod shape;
 pub mod shell;
 pub mod spring;
 pub mod superelement;
@@ -415,6 +416,13 @@ pub trait Element: Send + Sync {
     /// How the element is drawn in VTK files.
     fn cell_shape(&self) -> CellShape {
         CellShape::None
+    }
+
+    /// The solid drawn for the element, carried by its first node (a
+    /// rigid body's box, plate or cylinder), in place of its
+    /// [`Element::cell_shape`]; none by default.
+    fn body_shape(&self) -> Option<&shape::BodyShape> {
+        None
     }
 
     /// Mass carried by the element (for model summaries and checks).

@@ -213,16 +213,16 @@ pub enum HistoryError {
 /// A CSV result file: header and rows as text, numbers parsed on demand
 /// so that an error names the line.
 #[derive(Clone, Debug)]
-struct Table {
-    path: PathBuf,
-    header: Vec<String>,
+pub(crate) struct Table {
+    pub(crate) path: PathBuf,
+    pub(crate) header: Vec<String>,
     /// Line number (from 1) and fields of each row.
-    rows: Vec<(usize, Vec<String>)>,
+    pub(crate) rows: Vec<(usize, Vec<String>)>,
 }
 
 impl Table {
     /// Reads `path`; `None` if the file does not exist.
-    fn read(path: &Path) -> Result<Option<Self>, HistoryError> {
+    pub(crate) fn read(path: &Path) -> Result<Option<Self>, HistoryError> {
         let text = match std::fs::read_to_string(path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
@@ -271,12 +271,12 @@ impl Table {
     }
 
     /// Index of column `name`, if the file has it.
-    fn find(&self, name: &str) -> Option<usize> {
+    pub(crate) fn find(&self, name: &str) -> Option<usize> {
         self.header.iter().position(|h| h == name)
     }
 
     /// Index of column `name`, which the file must have.
-    fn column(&self, name: &str) -> Result<usize, HistoryError> {
+    pub(crate) fn column(&self, name: &str) -> Result<usize, HistoryError> {
         self.find(name).ok_or_else(|| HistoryError::Malformed {
             path: self.path.clone(),
             line: 1,
@@ -285,7 +285,7 @@ impl Table {
     }
 
     /// The number in row `r`, column `c`: NaN where the field is empty.
-    fn number(&self, r: usize, c: usize) -> Result<f64, HistoryError> {
+    pub(crate) fn number(&self, r: usize, c: usize) -> Result<f64, HistoryError> {
         let (line, fields) = &self.rows[r];
         let field = &fields[c];
         if field.is_empty() {
@@ -299,7 +299,7 @@ impl Table {
     }
 
     /// The id in row `r`, column `c`.
-    fn id(&self, r: usize, c: usize) -> Result<Id, HistoryError> {
+    pub(crate) fn id(&self, r: usize, c: usize) -> Result<Id, HistoryError> {
         let (line, fields) = &self.rows[r];
         fields[c].parse().map_err(|_| HistoryError::Malformed {
             path: self.path.clone(),

@@ -20,7 +20,9 @@
 //!   groups at round-off told apart;
 //! - [`plot`]: line charts of result histories, as SVG and PNG files;
 //! - [`histories`]: the charts of a run for a report (joint coordinates,
-//!   hinge moments, energies), drawn from its result files.
+//!   hinge moments, energies), drawn from its result files;
+//! - [`view`]: the page that animates a run in a web browser
+//!   (`unfold view`), made from its result files.
 
 pub mod histories;
 pub mod model_file;
@@ -32,4 +34,5 @@ pub mod residual;
 pub mod restart;
 pub mod results;
 pub mod run;
+pub mod view;
 pub mod vtk;

@@ -75,14 +75,14 @@ pub fn parse_model(text: &str, path: &Path) -> Result<ModelInput, ModelFileError
         path: path.to_path_buf(),
         messages,
     };
-    let render = |e: &toml::de::Error| e.to_string().trim_end().to_string();
+    let render = |e: &toml::de::Error| render_error(e, false);
     // a sound file is read once
     let first = match toml::from_str(text) {
         Ok(input) => return Ok(input),
         Err(e) => e,
     };
     let Ok(original) = DeTable::parse(text) else {
-        return Err(failed(vec![render(&first)]));
+        return Err(failed(vec![render_error(&first, true)]));
     };
     let mut root = original.clone();
     // (position in the text, message)
@@ -134,6 +134,64 @@ pub fn parse_model(text: &str, path: &Path) -> Result<ModelInput, ModelFileError
     // in the order of the file (tables are deserialised in key order)
     messages.sort_by_key(|m| m.0);
     Err(failed(messages.into_iter().map(|m| m.1).collect()))
+}
+
+/// An error of the TOML reader in the words of a model file: "TOML syntax
+/// error at line …" when the text is not TOML, "line …, column …" when a
+/// value or key does not fit the model's schema, with the reader's
+/// message said in model-file words (see [`humanize`]).
+fn render_error(e: &toml::de::Error, syntax: bool) -> String {
+    let mut text = e.to_string().trim_end().to_string();
+    let head = if syntax { "TOML syntax error at " } else { "" };
+    if let Some(rest) = text.strip_prefix("TOML parse error at ") {
+        text = format!("{head}{rest}");
+    }
+    if !syntax {
+        let message = e.message().trim_end();
+        if let Some(at) = text.rfind(message) {
+            text.replace_range(at..at + message.len(), &humanize(message));
+        }
+    }
+    text
+}
+
+/// A schema error of the deserialiser in the words of a model file: the
+/// Rust types serde names (`f64`, `u64`, `usize`, `a sequence`) as the
+/// kinds of TOML value, a string that holds a number noticed (quotes make
+/// it a string), a missing key said as such.
+fn humanize(message: &str) -> String {
+    if let Some(rest) = message.strip_prefix("missing field `") {
+        let key = rest.split('`').next().unwrap_or(rest);
+        return format!("the required key `{key}` is missing from this table");
+    }
+    let mut m = message.to_string();
+    for (rust, words) in [
+        ("expected f64", "expected a number"),
+        ("expected f32", "expected a number"),
+        ("expected u64", "expected a whole number, 0 or more"),
+        ("expected u32", "expected a whole number, 0 or more"),
+        ("expected usize", "expected a whole number, 0 or more"),
+        ("expected i64", "expected a whole number"),
+        ("expected i32", "expected a whole number"),
+        ("expected a sequence", "expected a list `[…]`"),
+        ("expected a map", "expected a table"),
+        ("floating point `", "number `"),
+        ("invalid type: sequence", "invalid type: list"),
+        ("invalid type: map", "invalid type: table"),
+    ] {
+        m = m.replace(rust, words);
+    }
+    // `mass = "0.5"`: a number written as a string
+    if let Some(rest) = m.strip_prefix("invalid type: string \"") {
+        if let Some((text, expected)) = rest.split_once("\", ") {
+            if expected.contains("number") && text.trim().parse::<f64>().is_ok() {
+                m.push_str(&format!(
+                    " (\"{text}\" is a string: write numbers without quotes, {text})"
+                ));
+            }
+        }
+    }
+    m
 }
 
 /// Whether two spans of the text share a character (or are both the

@@ -19,7 +19,7 @@
 use serde::Serialize;
 
 use crate::analysis::{LatchEventKind, LockInfo};
-use crate::elements::{Element, Need};
+use crate::elements::{Element, ElementKind, Need};
 use crate::joints::latch::SpringLatch;
 use crate::model::{Id, Model};
 use crate::state::State;
@@ -38,10 +38,26 @@ pub struct LatchPeak {
     /// The time of the first converged increment at which it was locked
     /// (`null`: never locked).
     pub locked_at: Option<f64>,
+    /// The impulse of its first lock along the coordinate (N·m·s for an
+    /// angle in SI), as `impulse` in `events.csv` (`null`: never locked;
+    /// 0 for a spring latch, which locks without impact).
+    pub lock_impulse: Option<f64>,
+    /// The energy its first lock dissipated (`null`: never locked).
+    pub lock_energy_lost: Option<f64>,
     /// Its load of largest magnitude, with its sign (positive pushing the
     /// coordinate up, as `load` in `latches.csv`).
     #[serde(flatten)]
     pub peak: Peak,
+    /// Whether `peak_load` may be read as a design load: false for a rigid
+    /// latch whose lock was an impact (a non-zero impulse) onto deformable
+    /// members (beams, shells) and whose peak came at or after that lock:
+    /// the loads after such a lock follow a velocity jump imposed in one
+    /// step on members with distributed mass, and depend on the step and
+    /// on the damping of the highest modes, not on the structure alone.
+    pub design_load: bool,
+    /// Why `design_load` is false (absent when it is true).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// The largest load of a stop or contact over the run (`summary.json`,
@@ -104,6 +120,8 @@ struct Followed {
     load: usize,
     flag: usize,
     spring: Option<(SpringLatch, f64)>,
+    /// The increment (numbered across the run) of a latch's first lock.
+    lock_increment: Option<usize>,
 }
 
 /// The largest value of a result of the original elements of a
@@ -172,6 +190,8 @@ pub struct PeakLoads {
     latches: Vec<(Followed, LatchPeak)>,
     stops: Vec<(Followed, StopPeak)>,
     superelements: Vec<(usize, SuperelementRecord)>,
+    /// The model has deformable members (beams, shells).
+    deformable: bool,
 }
 
 impl PeakLoads {
@@ -185,6 +205,9 @@ impl PeakLoads {
         };
         let mut peaks = Self::default();
         for (element, e) in model.elements.iter().enumerate() {
+            if matches!(e.kind(), ElementKind::Beam | ElementKind::Shell) {
+                peaks.deformable = true;
+            }
             let e = e.as_ref();
             if let Some(l) = e.as_latch() {
                 let followed = Followed {
@@ -192,6 +215,7 @@ impl PeakLoads {
                     load: place(e, "load"),
                     flag: place(e, "locked"),
                     spring: l.spring().map(|s| (*s, l.value())),
+                    lock_increment: None,
                 };
                 peaks.latches.push((
                     followed,
@@ -205,7 +229,11 @@ impl PeakLoads {
                         },
                         quantity: quantity(l.is_angle()),
                         locked_at: None,
+                        lock_impulse: None,
+                        lock_energy_lost: None,
                         peak: Peak::default(),
+                        design_load: true,
+                        note: None,
                     },
                 ));
             } else if let Some(s) = e.as_stop() {
@@ -216,6 +244,7 @@ impl PeakLoads {
                         load: place(e, "force"),
                         flag: place(e, "closed"),
                         spring: None,
+                        lock_increment: None,
                     }
                 } else {
                     Followed {
@@ -223,6 +252,7 @@ impl PeakLoads {
                         load: place(e, "load"),
                         flag: place(e, "contact"),
                         spring: None,
+                        lock_increment: None,
                     }
                 };
                 peaks.stops.push((
@@ -377,6 +407,61 @@ impl PeakLoads {
     /// The superelements' records, in increasing id.
     pub fn superelements(&self) -> Vec<SuperelementRecord> {
         self.superelements.iter().map(|(_, r)| r.clone()).collect()
+    }
+
+    /// A latch event `event` (numbered across the run as `increment`):
+    /// the impulse and energy lost of the latch's first lock are kept, and
+    /// a spring latch's release load is taken ([`Self::unlatched`]).
+    pub fn event(&mut self, event: &LockInfo, increment: usize) {
+        if event.kind == LatchEventKind::Lock {
+            for (f, p) in &mut self.latches {
+                if p.latch == event.latch && p.lock_impulse.is_none() {
+                    p.lock_impulse = Some(event.impulse);
+                    p.lock_energy_lost = Some(event.energy_lost);
+                    f.lock_increment = Some(increment);
+                }
+            }
+        }
+        self.unlatched(event, increment);
+    }
+
+    /// Marks the peaks of the rigid latches whose first lock was an impact
+    /// (a non-zero impulse) and whose peak load came at or after it, in a
+    /// model with deformable members (beams, shells): not design loads
+    /// ([`LatchPeak::design_load`]). Returns a warning for each.
+    pub fn mark_impact_peaks(&mut self) -> Vec<String> {
+        let mut warnings = Vec::new();
+        if !self.deformable {
+            return warnings;
+        }
+        for (f, p) in &mut self.latches {
+            let (Some(lock), Some(at), Some(impulse)) =
+                (f.lock_increment, p.peak.peak_increment, p.lock_impulse)
+            else {
+                continue;
+            };
+            if p.mode != "rigid" || impulse == 0.0 || at < lock {
+                continue;
+            }
+            let (unit, impulse_unit) = if p.quantity == "moment" {
+                ("N·m", "N·m·s")
+            } else {
+                ("N", "N·s")
+            };
+            let note = format!(
+                "the peak follows the rigid lock, an impact onto deformable members (impulse {impulse:.4e} {impulse_unit}, energy lost {:.4e} J, in SI units): the loads after it answer a velocity jump imposed in one step and depend on the step and on the damping of the highest modes; it is not a design load: give the latch a stiffness (mode = \"spring\") for the load the hinge carries",
+                p.lock_energy_lost.unwrap_or(0.0)
+            );
+            warnings.push(format!(
+                "latch {}: peak load {:.4e} {unit} at t = {}: {note}",
+                p.latch,
+                p.peak.peak_load,
+                p.peak.peak_time.unwrap_or(0.0)
+            ));
+            p.design_load = false;
+            p.note = Some(note);
+        }
+        warnings
     }
 
     /// A spring latch released at `event` (numbered across the run as

@@ -206,9 +206,9 @@ pub struct Resume {
 }
 
 /// The fingerprint of a model input: the 64-bit FNV-1a hash of its JSON
-/// form without the analyses and the outputs, with the type, constraint
-/// scale and penalty of the first analysis (module documentation), as
-/// `fnv1a64:` and 16 hex digits. Two inputs that build the same model with
+/// form without the analyses, the outputs and the bodies' drawn shapes,
+/// with the type, constraint scale and penalty of the first analysis
+/// (module documentation), as `fnv1a64:` and 16 hex digits. Two inputs that build the same model with
 /// the same scaling have the same fingerprint.
 pub fn fingerprint(input: &ModelInput) -> String {
     let first = &*input.analysis;
@@ -220,6 +220,10 @@ pub fn fingerprint(input: &ModelInput) -> String {
     let mut model = input.clone();
     model.analysis = Default::default();
     model.output = None;
+    // a body's shape is drawn, not simulated: a new shape continues a run
+    for body in &mut model.rigid_bodies {
+        body.shape = None;
+    }
     let text = serde_json::to_string(&(&model, shaping)).expect("a model input serialises");
     let mut hash = FnvHasher::default();
     hash.write(text.as_bytes());

@@ -52,8 +52,9 @@ use crate::state::State;
 
 /// Result files in the output directory that unfold writes besides the
 /// tables of the element kinds ([`ElementKind::results_file`]) and the
-/// grids `vtk/step_NNNNN.vtu`.
-const RUN_FILES: [&str; 9] = [
+/// grids `vtk/step_NNNNN.vtu`; `view.html` is the page `unfold view`
+/// makes of them (docs/viewer.md).
+const RUN_FILES: [&str; 10] = [
     "log.txt",
     "steps.csv",
     "nodes.csv",
@@ -63,6 +64,7 @@ const RUN_FILES: [&str; 9] = [
     "reactions.csv",
     "unfold.pvd",
     "summary.json",
+    "view.html",
 ];
 
 /// Result files in the output directory that unfold writes (besides the
@@ -781,6 +783,11 @@ struct ElementTable {
     rates: usize,
 }
 
+/// Result columns written as integers: the states and sides of latches
+/// (`locked`, `contact`), stops (`contact`), contacts (`closed`) and hinge
+/// laws (`branch`).
+const INTEGER_RESULTS: [&str; 4] = ["locked", "contact", "closed", "branch"];
+
 /// Names of the columns of the rates of the joint coordinates.
 const COORDINATE_RATES: [&str; 3] = ["c1_rate", "c2_rate", "c3_rate"];
 
@@ -837,6 +844,8 @@ pub struct ResultWriter {
     dir: PathBuf,
     lock: DirectoryLock,
     encoding: vtk::Encoding,
+    /// A grid at every this many output steps; 0: none.
+    vtk_every: usize,
     nodes: CsvFile,
     /// Node indices in increasing id.
     node_order: Vec<usize>,
@@ -848,8 +857,11 @@ pub struct ResultWriter {
     /// Result values of one element: as long as the longest list of
     /// result names of the model.
     values: Vec<f64>,
-    pvd: Vec<(f64, String)>,
     pvd_file: vtk::PvdFile,
+    /// Output steps written (a grid at some of them: `vtk_every`).
+    output_steps: usize,
+    /// The time of the last output step written.
+    last_output: Option<f64>,
     /// Every converged increment, for the summary.
     pub log: Vec<IncrementRecord>,
     /// The files of a run with dynamics.
@@ -989,6 +1001,8 @@ impl ResultWriter {
             "nodes_velocities.csv" | "energies.csv" | "events.csv" => dynamics,
             // written again by whoever writes the summary
             "summary.json" => false,
+            // the page of earlier results: `unfold view` makes it again
+            "view.html" => false,
             _ => ElementKind::ALL
                 .into_iter()
                 .find(|k| k.results_file() == Some(name))
@@ -1044,6 +1058,7 @@ impl ResultWriter {
             dir: dir.to_path_buf(),
             lock,
             encoding: vtk::Encoding::default(),
+            vtk_every: 1,
             nodes: CsvFile::create(
                 dir.join("nodes.csv"),
                 "step,time,node,x,y,z,ux,uy,uz,qw,qx,qy,qz",
@@ -1064,7 +1079,8 @@ impl ResultWriter {
             supported,
             tables,
             values: vec![0.0; longest],
-            pvd: Vec::new(),
+            output_steps: 0,
+            last_output: None,
             pvd_file: vtk::PvdFile::new(dir.join("unfold.pvd")),
             log: Vec::new(),
             motion: dynamics
@@ -1094,6 +1110,17 @@ impl ResultWriter {
         self.energies = None;
     }
 
+    /// Writes a VTK grid at every `every`-th output step (the first
+    /// included), none if `every` is 0 (`[output] vtk`, `vtk_every`).
+    pub fn with_vtk_every(mut self, every: usize) -> Self {
+        self.vtk_every = every;
+        if every == 0 {
+            // no grid will be written: no empty directory either
+            let _ = std::fs::remove_dir(self.dir.join("vtk"));
+        }
+        self
+    }
+
     /// Writes the grids in `encoding` (binary by default).
     pub fn with_vtk_encoding(mut self, encoding: vtk::Encoding) -> Self {
         self.encoding = encoding;
@@ -1107,12 +1134,12 @@ impl ResultWriter {
 
     /// Number of output steps written.
     pub fn output_steps(&self) -> usize {
-        self.pvd.len()
+        self.output_steps
     }
 
     /// The load parameter of the last output step written, if any.
     pub fn last_output_time(&self) -> Option<f64> {
-        self.pvd.last().map(|p| p.0)
+        self.last_output
     }
 
     /// Writes `summary.json` (through a temporary file, so that it is
@@ -1131,7 +1158,7 @@ impl ResultWriter {
     /// Appends `row` to `events.csv` (a run with dynamics; its step, the
     /// last output step, was written before).
     pub fn write_event(&mut self, row: &EventRow) -> io::Result<()> {
-        let step = self.pvd.len().saturating_sub(1);
+        let step = self.output_steps.saturating_sub(1);
         let Some(m) = self.motion.as_mut() else {
             return Ok(());
         };
@@ -1225,11 +1252,14 @@ impl ResultWriter {
                 let w = &mut table.file.pending;
                 w.push_str(&lead);
                 let _ = write!(w, "{}", e.id());
-                for v in values.iter() {
+                for (v, name) in values.iter().zip(e.result_names()) {
                     // absent quantities (a joint with fewer coordinates) are empty
                     w.push(',');
-                    // + 0.0: a load −f of f = 0 is written 0, not −0
-                    if !v.is_nan() {
+                    if INTEGER_RESULTS.contains(name) && v.is_finite() {
+                        // a state or a side: 0, 1, −1
+                        let _ = write!(w, "{}", v.round() as i64);
+                    } else if !v.is_nan() {
+                        // + 0.0: a load −f of f = 0 is written 0, not −0
                         Sci::<9>(*v + 0.0).push_to(w);
                     }
                 }
@@ -1331,23 +1361,29 @@ impl ResultWriter {
         state: &State,
         residual: &[f64],
     ) -> io::Result<()> {
-        let step = self.pvd.len();
+        let step = self.output_steps;
         self.format_step(step, info, model, state, residual);
-        let name = format!("step_{step:05}.vtu");
-        let grid = self.dir.join("vtk").join(&name);
-        let ctx = model.context(info.time, Need::RESIDUAL);
-        let velocities = self.motion.is_some().then_some(self.moving);
-        if let Err(e) = vtk::write_step_vtu(&grid, model, &ctx, state, self.encoding, velocities) {
-            self.csv_files().for_each(CsvFile::rollback);
-            return Err(e);
+        // the grid of this output step, if one is written
+        let grid = (self.vtk_every > 0 && step.is_multiple_of(self.vtk_every)).then(|| {
+            let name = format!("step_{step:05}.vtu");
+            (self.dir.join("vtk").join(&name), format!("vtk/{name}"))
+        });
+        if let Some((path, _)) = &grid {
+            let ctx = model.context(info.time, Need::RESIDUAL);
+            let velocities = self.motion.is_some().then_some(self.moving);
+            if let Err(e) = vtk::write_step_vtu(path, model, &ctx, state, self.encoding, velocities)
+            {
+                self.csv_files().for_each(CsvFile::rollback);
+                return Err(e);
+            }
         }
         let mut result = self.csv_files().try_for_each(|f| f.append());
+        if let (true, Some((_, file))) = (result.is_ok(), &grid) {
+            result = self.pvd_file.append(info.time, file);
+        }
         if result.is_ok() {
-            let file = format!("vtk/{name}");
-            result = self.pvd_file.append(info.time, &file);
-            if result.is_ok() {
-                self.pvd.push((info.time, file));
-            }
+            self.output_steps += 1;
+            self.last_output = Some(info.time);
         }
         match result {
             Ok(()) => {
@@ -1356,7 +1392,9 @@ impl ResultWriter {
             }
             Err(e) => {
                 self.csv_files().for_each(CsvFile::rollback);
-                let _ = std::fs::remove_file(&grid);
+                if let Some((path, _)) = &grid {
+                    let _ = std::fs::remove_file(path);
+                }
                 Err(e)
             }
         }

@@ -59,8 +59,8 @@ use crate::analysis::impact::{self, LatchEventKind};
 use crate::analysis::statics::StaticError;
 use crate::analysis::{
     AnalysisSettings, ContactInfo, Continuation, CutbackInfo, DynamicAnalysis, DynamicError,
-    Energies, EventInfo, IncrementInfo, IterationInfo, LockInfo, Observer, StaticAnalysis,
-    StaticOutcome, WarningInfo,
+    Energies, EventInfo, IncrementInfo, IterationInfo, LockInfo, Observer, RejectionInfo,
+    StaticAnalysis, StaticOutcome, WarningInfo,
 };
 use crate::elements::ElementKind;
 use crate::joints::latch::Latch;
@@ -402,18 +402,22 @@ fn events_summary(records: &[&DynamicRecord]) -> Option<String> {
 /// The size of a model in one line: nodes and elements of each kind.
 pub fn describe(model: &Model) -> String {
     let count = |k: ElementKind| model.elements.iter().filter(|e| e.kind() == k).count();
-    let hinge_laws = match count(ElementKind::HingeLaw) {
-        0 => String::new(),
-        n => format!(", {n} hinge laws"),
-    };
-    let superelements = match count(ElementKind::Superelement) {
-        0 => String::new(),
-        n => format!(", {n} superelements"),
-    };
-    let shells = match count(ElementKind::Shell) {
-        0 => String::new(),
-        n => format!(", {n} shells"),
-    };
+    // the kinds a model may lack, named only when present
+    let extra: String = [
+        (ElementKind::HingeLaw, "hinge laws"),
+        (ElementKind::Latch, "latches"),
+        (ElementKind::Stop, "stops"),
+        (ElementKind::Contact, "contacts"),
+        (ElementKind::RollingDisc, "rolling discs"),
+        (ElementKind::Shell, "shells"),
+        (ElementKind::Superelement, "superelements"),
+    ]
+    .into_iter()
+    .filter_map(|(kind, name)| match count(kind) {
+        0 => None,
+        n => Some(format!(", {n} {name}")),
+    })
+    .collect();
     format!(
         "{} nodes, {} beams, {} rigid bodies, {} point masses, {} springs, {} joints, {} joint springs, {} drivers, {} loads",
         model.n_nodes(),
@@ -425,9 +429,7 @@ pub fn describe(model: &Model) -> String {
         count(ElementKind::JointSpring),
         count(ElementKind::Driver),
         count(ElementKind::NodalLoad),
-    ) + &hinge_laws
-        + &superelements
-        + &shells
+    ) + &extra
 }
 
 /// `log.txt`: a line per increment, iteration, cut-back and note. A write
@@ -1131,6 +1133,13 @@ impl Recorder {
         self
     }
 
+    /// A VTK grid at every `every`-th output step, none if 0
+    /// ([`ResultWriter::with_vtk_every`]).
+    pub fn with_vtk_every(mut self, every: usize) -> Self {
+        self.writer = self.writer.with_vtk_every(every);
+        self
+    }
+
     /// Writes the grids in `encoding` (binary by default).
     pub fn with_vtk_encoding(mut self, encoding: Encoding) -> Self {
         self.writer = self.writer.with_vtk_encoding(encoding);
@@ -1508,6 +1517,12 @@ impl Recorder {
             ),
             (Some(e), None, _) => (RunStatus::Failed, Some(e.clone())),
         };
+        // rigid locks onto beams or shells whose peak is the impact's
+        for w in self.peaks.mark_impact_peaks() {
+            self.log.line(&format!("warning: {w}"));
+            self.console.warning(&w);
+            self.summary.warnings.push(w);
+        }
         let mut output_errors = Vec::new();
         if let Some((restart, first)) = &self.restart {
             let _writing = self.stop.output();
@@ -1839,6 +1854,22 @@ impl Observer for Recorder {
         self.summary.warnings.push(text);
     }
 
+    fn rejected(&mut self, info: &RejectionInfo) {
+        let at = if info.at.is_empty() {
+            String::new()
+        } else {
+            format!(", largest at {}", info.at)
+        };
+        self.log.line(&format!(
+            "step {:4}  from t = {:.6}: step {:.3e} rejected: local error estimate {:.3e} times its tolerance{at}; retrying with {:.3e}",
+            info.increment + self.increment_offset,
+            info.time,
+            info.step,
+            info.error,
+            info.next_step
+        ));
+    }
+
     fn cutback(&mut self, info: &CutbackInfo) {
         let word = if self.current.kind == "dynamic" {
             "step"
@@ -1860,7 +1891,7 @@ impl Observer for Recorder {
             self.vibrating_lock(info);
         }
         self.peaks
-            .unlatched(info, info.increment + self.increment_offset);
+            .event(info, info.increment + self.increment_offset);
         self.write_event(&EventRow {
             increment: info.increment + self.increment_offset,
             time: info.time,

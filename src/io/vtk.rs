@@ -15,14 +15,22 @@
 //!
 //! Grid contents (docs/results.md, "VTK files"):
 //! - points: the nodes, then the joint points (each joint's point on body
-//!   A, unless A is the ground, and on body B), with point data `node_id`
-//!   (−1 at joint points), `joint_id` (−1 at nodes), `displacement` (from
-//!   the reference), `rotation` (rotation vector of `R R₀ᵀ`, global frame;
-//!   at a joint point that of its node) and `axis_1`, `axis_2`, `axis_3`
-//!   (unit vectors: a node's material axes, a joint point's joint axes);
+//!   A, unless A is the ground, and on body B), then the points of the
+//!   rigid bodies' shapes (corners of boxes and plates, points around
+//!   cylinders), with point data `node_id` (−1 at joint and shape
+//!   points), `joint_id` (−1 at nodes and shape points), `displacement`
+//!   (from the reference), `rotation` (rotation vector of `R R₀ᵀ`, global
+//!   frame; at a joint or shape point that of its node) and `axis_1`,
+//!   `axis_2`, `axis_3` (unit vectors: a node's material axes, a joint
+//!   point's joint axes, a shape point's shape axes);
 //! - cells: each element as its [`CellShape`] says (beams and two-node
-//!   springs as lines, rigid bodies, point masses and springs to ground as
-//!   vertices, four-node elements as quadrilaterals); for each joint, a
+//!   springs as lines, point masses and springs to ground as vertices,
+//!   four-node elements as quadrilaterals), a rigid body as the cells of
+//!   its shape ([`crate::elements::shape`]: a hexahedron for a box or a
+//!   thick plate, a quadrilateral for a thin plate, quadrilaterals and
+//!   polygons for a cylinder, a line for a rod; a vertex at its node for a
+//!   body without inertia or of shape `point`), each point of which moves
+//!   with the body's node; for each joint, a
 //!   line from each of its nodes to its joint point on that node (a rigid
 //!   link) and a vertex at its point on body B (the joint marker). Cell
 //!   data `kind` ([`ElementKind::code`]; 10 for a rigid link),
@@ -38,6 +46,7 @@ use std::path::{Path, PathBuf};
 use flate2::{Compress, Compression, FlushCompress, Status};
 
 use super::results::file_error;
+use crate::elements::shape::Outline;
 use crate::elements::shell::SkinStress;
 use crate::elements::{Attachment, CellField, CellShape, Element, ElementKind, EvalContext};
 use crate::model::Model;
@@ -282,6 +291,20 @@ fn attachments(model: &Model, state: &State) -> Vec<(usize, Attachment)> {
     all
 }
 
+/// The outline of every rigid body drawn with a solid shape, with the
+/// element's index and node (points in the node's material frame).
+fn body_outlines(model: &Model) -> Vec<(usize, usize, Outline)> {
+    model
+        .elements
+        .iter()
+        .enumerate()
+        .filter_map(|(k, e)| {
+            let shape = e.body_shape().filter(|s| s.is_solid())?;
+            Some((k, e.nodes()[0], shape.outline()))
+        })
+        .collect()
+}
+
 fn push3(out: &mut Vec<f64>, v: &Vec3) {
     out.extend_from_slice(&[v.x, v.y, v.z]);
 }
@@ -385,8 +408,12 @@ fn write_grid(
         attachments(model, &model.initial_state())
     };
 
-    // points: nodes, joint points, then the recovered meshes
-    let n_points = n_nodes + joints.len();
+    let bodies = body_outlines(model);
+    let n_body_points: usize = bodies.iter().map(|(_, _, o)| o.points.len()).sum();
+
+    // points: nodes, joint points, then the points of the bodies' shapes
+    let n_joint_points = n_nodes + joints.len();
+    let n_points = n_joint_points + n_body_points;
     let mut position = Vec::with_capacity(3 * n_points);
     let mut displacement = Vec::with_capacity(3 * n_points);
     let mut rotation = Vec::with_capacity(3 * n_points);
@@ -422,6 +449,14 @@ fn write_grid(
             push3(&mut mode_u, &u);
             push3(&mut mode_theta, &theta);
         }
+        for (_, n, outline) in &bodies {
+            let theta = m.rotation[*n];
+            for p in &outline.points {
+                let arm = state.q[*n] * p;
+                push3(&mut mode_u, &(m.translation[*n] + theta.cross(&arm)));
+                push3(&mut mode_theta, &theta);
+            }
+        }
     }
     // velocities (global) at the nodes, then at the joint points
     let mut velocity = Vec::new();
@@ -448,6 +483,13 @@ fn write_grid(
             push3(&mut velocity, &v);
             push3(&mut angular_velocity, &w);
         }
+        for (_, n, outline) in &bodies {
+            let (v, w) = omega(*n);
+            for p in &outline.points {
+                push3(&mut velocity, &(v + w.cross(&(state.q[*n] * p))));
+                push3(&mut angular_velocity, &w);
+            }
+        }
     }
     for (j, (k, a)) in joints.iter().enumerate() {
         push3(&mut position, &a.point);
@@ -459,6 +501,26 @@ fn write_grid(
         }
         node_id.push(-1);
         joint_id.push(model.elements[*k].id() as i64);
+    }
+    // a shape's point p (node frame) at x + R p, from x₀ + R₀ p
+    for (k, n, outline) in &bodies {
+        let q_shape = model.elements[*k]
+            .body_shape()
+            .map_or(so3::Mat3::identity(), |s| s.axes);
+        let r = so3::matrix(&state.q[*n]);
+        let shape_axes = r * q_shape;
+        for p in &outline.points {
+            let x = state.x[*n] + r * p;
+            push3(&mut position, &x);
+            let x0 = model.reference_x[*n] + model.reference_q[*n] * p;
+            push3(&mut displacement, &(x - x0));
+            push3(&mut rotation, &node_rotation(*n));
+            for (c, ax) in axes.iter_mut().enumerate() {
+                push3(ax, &shape_axes.column(c).into_owned());
+            }
+            node_id.push(-1);
+            joint_id.push(-1);
+        }
     }
     // the original meshes of superelements, recovered (docs/results.md,
     // "VTK files"): their points after the joint points
@@ -559,6 +621,7 @@ fn write_grid(
         .unwrap_or(0);
     let mut results = vec![0.0; longest];
     let mut cell = |points: &[usize],
+                    vtk_type: u8,
                     kind: i32,
                     id: i64,
                     superelement: i64,
@@ -566,11 +629,7 @@ fn write_grid(
                     skin: Option<[f64; 6]>| {
         connectivity.extend(points.iter().map(|&p| p as i64));
         offsets.push(connectivity.len() as i64);
-        types.push(
-            CellShape::with_nodes(points.len())
-                .vtk_type()
-                .unwrap_or(VTK_VERTEX),
-        );
+        types.push(vtk_type);
         kinds.push(kind);
         ids.push(id);
         superelement_ids.push(superelement);
@@ -586,22 +645,41 @@ fn write_grid(
             }
         }
     };
+    let line = CellShape::Line.vtk_type().unwrap_or(VTK_VERTEX);
     let mut next_joint_point = n_nodes;
-    let joint_points_end = n_nodes + joints.len();
+    let mut next_body = bodies.iter().peekable();
+    let mut next_body_point = n_joint_points;
+    let mut shape_cell = Vec::new();
     for (k, e) in model.elements.iter().enumerate() {
         let id = e.id() as i64;
         let nodes = e.nodes();
         // joints: links from the nodes to the joint points, a marker at B's
         let first = next_joint_point;
-        while next_joint_point < joint_points_end && joints[next_joint_point - n_nodes].0 == k {
+        while next_joint_point < n_joint_points && joints[next_joint_point - n_nodes].0 == k {
             let a = &joints[next_joint_point - n_nodes].1;
             if let Some(node) = a.node {
-                cell(&[node, next_joint_point], KIND_LINK, id, -1, None, None);
+                cell(
+                    &[node, next_joint_point],
+                    line,
+                    KIND_LINK,
+                    id,
+                    -1,
+                    None,
+                    None,
+                );
             }
             next_joint_point += 1;
         }
         if next_joint_point > first {
-            cell(&[next_joint_point - 1], e.kind().code(), id, -1, None, None);
+            cell(
+                &[next_joint_point - 1],
+                VTK_VERTEX,
+                e.kind().code(),
+                id,
+                -1,
+                None,
+                None,
+            );
             continue;
         }
         // a superelement: the cells of its original mesh, each with its
@@ -617,23 +695,29 @@ fn write_grid(
                     .element
                     .zip(body.elements.as_ref())
                     .map(|(el, m)| &m.elements[el]);
+                let vtk_type = CellShape::with_nodes(points.len())
+                    .vtk_type()
+                    .unwrap_or(VTK_VERTEX);
                 match original {
                     Some(o) => {
                         let at = c.element.unwrap_or(0);
                         let values = r.results.get(at).map(|v| (o.kind(), &v[..]));
                         let skin = r.skins.get(at).copied().flatten().map(|s| skin_row(&s));
-                        cell(&points, o.kind().code(), o.id() as i64, id, values, skin);
+                        cell(
+                            &points,
+                            vtk_type,
+                            o.kind().code(),
+                            o.id() as i64,
+                            id,
+                            values,
+                            skin,
+                        );
                     }
-                    None => cell(&points, e.kind().code(), id, id, None, None),
+                    None => cell(&points, vtk_type, e.kind().code(), id, id, None, None),
                 }
             }
             continue;
         }
-        let shape = e.cell_shape();
-        if shape == CellShape::None {
-            continue;
-        }
-        let points = &nodes[..shape.nodes()];
         let kind = e.kind();
         let values = if kind.cell_fields().is_empty() {
             None
@@ -643,7 +727,29 @@ fn write_grid(
             e.results(ctx, state, r);
             Some((kind, &*r))
         };
-        cell(points, kind.code(), id, -1, values, None);
+        // a body's shape: its cells through its points
+        if let Some((_, _, outline)) = next_body.next_if(|(b, _, _)| *b == k) {
+            for c in &outline.cells {
+                shape_cell.clear();
+                shape_cell.extend(c.points.iter().map(|p| next_body_point + p));
+                cell(&shape_cell, c.vtk_type, kind.code(), id, -1, values, None);
+            }
+            next_body_point += outline.points.len();
+            continue;
+        }
+        let shape = e.cell_shape();
+        let Some(vtk_type) = shape.vtk_type() else {
+            continue;
+        };
+        cell(
+            &nodes[..shape.nodes()],
+            vtk_type,
+            kind.code(),
+            id,
+            -1,
+            values,
+            None,
+        );
     }
     let n_cells = types.len();
 

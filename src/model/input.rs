@@ -295,6 +295,25 @@ pub struct OutputInput {
     /// output directory.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plots: Vec<String>,
+    /// Whether the VTK grids (`vtk/step_NNNNN.vtu`, `unfold.pvd`) are
+    /// written (default true); the CSV histories are written either way.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vtk: Option<bool>,
+    /// A VTK grid at every `vtk_every`-th output step (the first, then
+    /// every N-th; default 1, every output step).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vtk_every: Option<u64>,
+}
+
+impl OutputInput {
+    /// Every how many output steps a VTK grid is written; 0: none.
+    pub fn vtk_interval(output: Option<&Self>) -> usize {
+        match output {
+            Some(o) if o.vtk == Some(false) => 0,
+            Some(o) => o.vtk_every.map_or(1, |n| n.max(1) as usize),
+            None => 1,
+        }
+    }
 }
 
 /// A kinematic pair between node A and node B (or the ground).
@@ -1489,6 +1508,138 @@ pub struct RigidBodyInput {
     /// material frame. Default: at the node.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub center_of_mass: Option<[f64; 3]>,
+    /// The shape drawn in the VTK files and the viewer (no part of the
+    /// mechanics). Default: the box of uniform density with the body's
+    /// mass and inertia ([`crate::elements::shape::BodyShape::from_inertia`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ShapeInput>,
+}
+
+/// The kind of a rigid body's drawn shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShapeKind {
+    /// A box: `size` = three edges along the shape's axes 1, 2, 3.
+    Box,
+    /// A rectangular plate: `size` = two edges along axes 1 and 2,
+    /// `thickness` along axis 3 (default zero: a quadrilateral).
+    Plate,
+    /// A circular cylinder about axis 3: `radius` and `length`.
+    Cylinder,
+    /// A point: the body is drawn as a vertex at its node.
+    Point,
+}
+
+impl ShapeKind {
+    /// Name used in files and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Box => "box",
+            Self::Plate => "plate",
+            Self::Cylinder => "cylinder",
+            Self::Point => "point",
+        }
+    }
+}
+
+/// The drawn shape of a rigid body (`shape = { type = "box", … }`):
+/// which fields a kind takes is in [`ShapeKind`]; the shape's axes are the
+/// node's material axes turned by `rotation`, its centre at `center`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeInput {
+    /// Box, plate, cylinder or point.
+    #[serde(rename = "type")]
+    pub kind: ShapeKind,
+    /// Edge lengths: three for a box, two for a plate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<Vec<f64>>,
+    /// Thickness of a plate (default zero).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+    /// Radius of a cylinder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Length of a cylinder along its axis (zero: a disc).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<f64>,
+    /// Centre of the shape relative to the node, in the node's material
+    /// frame. Default: the centre of mass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center: Option<[f64; 3]>,
+    /// Rotation vector from the node's material axes to the shape's axes
+    /// (in the node's material frame). Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<[f64; 3]>,
+    /// Unit of `rotation` (radians by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+}
+
+impl ShapeInput {
+    /// A shape of `kind` with no dimensions given yet.
+    fn of(kind: ShapeKind) -> Self {
+        Self {
+            kind,
+            size: None,
+            thickness: None,
+            radius: None,
+            length: None,
+            center: None,
+            rotation: None,
+            unit: None,
+        }
+    }
+
+    /// A box of edges `size` along the shape's axes.
+    pub fn box_of(size: [f64; 3]) -> Self {
+        Self {
+            size: Some(size.to_vec()),
+            ..Self::of(ShapeKind::Box)
+        }
+    }
+
+    /// A plate of edges `size` along the shape's axes 1 and 2, of zero
+    /// thickness ([`ShapeInput::thickness`] gives it one).
+    pub fn plate(size: [f64; 2]) -> Self {
+        Self {
+            size: Some(size.to_vec()),
+            ..Self::of(ShapeKind::Plate)
+        }
+    }
+
+    /// A cylinder of `radius` and `length` about the shape's axis 3.
+    pub fn cylinder(radius: f64, length: f64) -> Self {
+        Self {
+            radius: Some(radius),
+            length: Some(length),
+            ..Self::of(ShapeKind::Cylinder)
+        }
+    }
+
+    /// A point: the body drawn as a vertex at its node.
+    pub fn point() -> Self {
+        Self::of(ShapeKind::Point)
+    }
+
+    /// The thickness of a plate.
+    pub fn thickness(mut self, t: f64) -> Self {
+        self.thickness = Some(t);
+        self
+    }
+
+    /// The centre of the shape relative to the node (node material frame).
+    pub fn center(mut self, c: impl Into<[f64; 3]>) -> Self {
+        self.center = Some(c.into());
+        self
+    }
+
+    /// The rotation vector (radians) from the node's material axes to the
+    /// shape's.
+    pub fn rotation(mut self, psi: impl Into<[f64; 3]>) -> Self {
+        self.rotation = Some(psi.into());
+        self
+    }
 }
 
 /// An inertia tensor: principal values or the full symmetric matrix.

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use super::{Checker, LARGEST_ELEMENT_VALUE};
 use crate::elements::{Element, ElementKind};
+use crate::io::number::plain;
 use crate::model::{Id, Model, ModelError, ModelErrorKind};
 
 /// Elements whose forces or tangent are not finite, or beyond
@@ -163,4 +164,102 @@ pub(super) fn check_restraint(
             "form a free body: no support, prescribed motion or spring to ground restrains them (unrestrained rigid-body motion)",
         );
     }
+}
+
+/// A joint point farther from a body's node than this many times the
+/// body's reach (the farthest point of its shape from its node) is
+/// warned of as a likely slip in `position` or in the nodes joined.
+pub const JOINT_REACH_FACTOR: f64 = 2.0;
+
+/// Rigid bodies and point masses whose masses differ by this factor or
+/// more are warned of as a likely unit slip (grams among kilograms).
+pub const MASS_RATIO_WARNING: f64 = 500.0;
+
+/// Warnings about a model that is valid but likely not the one meant
+/// (docs/model-format.md, "Checks, warnings and limits"):
+///
+/// - a joint whose point lies far from a rigid body it joins, beyond
+///   [`JOINT_REACH_FACTOR`] times the body's reach from its node (the
+///   farthest point of its drawn shape: by default the box of its mass
+///   and inertia) and beyond a tenth of the model's size: a hinge 4.5 m
+///   from the panels it joins, or an axis given through the wrong point.
+///   Nodes without a body of finite extent (a beam's node, a point mass,
+///   the bob of a pendulum modelled as a node with joints) are not
+///   judged: their links to their joints are rigid by construction;
+/// - bodies and point masses whose masses span [`MASS_RATIO_WARNING`] or
+///   more: grams among kilograms.
+pub(super) fn suspect_model(model: &Model) -> Vec<(String, String)> {
+    let mut warnings = Vec::new();
+    let state = model.initial_state();
+    // the reach of the bodies on each node, and the body
+    let mut reach: HashMap<usize, (f64, Id)> = HashMap::new();
+    for e in &model.elements {
+        let (Some(shape), Some(&node)) = (e.body_shape(), e.nodes().first()) else {
+            continue;
+        };
+        let r = shape
+            .outline()
+            .points
+            .iter()
+            .fold(0.0f64, |m, p| m.max(p.norm()));
+        let entry = reach.entry(node).or_insert((0.0, e.id()));
+        if r > entry.0 {
+            *entry = (r, e.id());
+        }
+    }
+    let size = model.length_scale;
+    let mut points = Vec::new();
+    for e in &model.elements {
+        if e.kind() != ElementKind::Joint {
+            continue;
+        }
+        points.clear();
+        e.attachments(&state, &mut points);
+        // the first far point of the joint, if any
+        let far = points.iter().find_map(|a| {
+            let node = a.node?;
+            let &(r, body) = reach.get(&node)?;
+            let d = (a.point - state.x[node]).norm();
+            (r > 0.0 && d > JOINT_REACH_FACTOR * r && d > 0.1 * size).then_some((node, d, r, body))
+        });
+        if let Some((node, d, r, body)) = far {
+            warnings.push((
+                format!("joint {}", e.id()),
+                format!(
+                    "its point lies {} from node {}, whose rigid body {body} reaches {} from it (the farthest point of its shape, by default the box of its mass and inertia): a joint is usually on or near the bodies it joins; check the joint's position and nodes, and the body's inertia",
+                    plain(d),
+                    model.node_ids[node],
+                    plain(r)
+                ),
+            ));
+        }
+    }
+    // masses of the bodies and point masses
+    let masses: Vec<(f64, &dyn Element)> = model
+        .elements
+        .iter()
+        .filter(|e| matches!(e.kind(), ElementKind::RigidBody | ElementKind::PointMass))
+        .map(|e| (e.mass(), e.as_ref()))
+        .filter(|(m, _)| *m > 0.0)
+        .collect();
+    let lightest = masses.iter().min_by(|a, b| a.0.total_cmp(&b.0));
+    let heaviest = masses.iter().max_by(|a, b| a.0.total_cmp(&b.0));
+    if let (Some(&(low, light)), Some(&(high, heavy))) = (lightest, heaviest) {
+        if high >= MASS_RATIO_WARNING * low {
+            warnings.push((
+                "model".to_string(),
+                format!(
+                    "the masses of its bodies span a factor of {}: {} {} has {} and {} {} has {}; if that is not meant, a mass is in other units than the rest (grams among kilograms)",
+                    plain((high / low).round()),
+                    light.kind().name(),
+                    light.id(),
+                    plain(low),
+                    heavy.kind().name(),
+                    heavy.id(),
+                    plain(high)
+                ),
+            ));
+        }
+    }
+    warnings
 }

@@ -546,13 +546,16 @@ impl Model {
             sizes: Default::default(),
         };
         model.place_elements();
-        let model = model.with_default_scaling(
+        let mut model = model.with_default_scaling(
             input.analysis.constraint_scale,
             input.analysis.constraint_penalty,
         );
         let errors = checks::non_finite_elements(&model, plan.end_time);
         if !errors.is_empty() {
             return Err(ModelErrors(errors));
+        }
+        for (entity, message) in checks::suspect_model(&model) {
+            model.warnings.push(ModelWarning { entity, message });
         }
         Ok(model)
     }

@@ -55,6 +55,13 @@ pub(super) fn check(ck: &mut Checker, output: Option<&OutputInput>, end_time: f6
             "restart_times must be in increasing order",
         );
     }
+    if o.vtk_every == Some(0) {
+        ck.push(
+            ModelErrorKind::Invalid,
+            "output",
+            "vtk_every must be 1 or more (a grid every N-th output step); write vtk = false for no grid",
+        );
+    }
     for name in &o.plots {
         if crate::io::histories::Group::from_name(name).is_none() {
             ck.push(

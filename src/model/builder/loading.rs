@@ -444,6 +444,34 @@ impl Analysis {
         self
     }
 
+    /// Dynamics: the smallest time step (default `time_step · 1e-6`).
+    pub fn min_step(mut self, h: f64) -> Self {
+        self.0.min_step = Some(h);
+        self
+    }
+
+    /// Dynamics: the largest time step (default a tenth of the span, or
+    /// `time_step` with fixed steps).
+    pub fn max_step(mut self, h: f64) -> Self {
+        self.0.max_step = Some(h);
+        self
+    }
+
+    /// Dynamics: the relative tolerance of the local error estimate
+    /// (default 1e-4).
+    pub fn error_tolerance(mut self, tolerance: f64) -> Self {
+        self.0.error_tolerance = Some(tolerance);
+        self
+    }
+
+    /// Dynamics: the Newton method, `full` (default: the iteration matrix
+    /// factored at every iteration) or `modified` (its factors kept while
+    /// they serve).
+    pub fn newton(mut self, method: &str) -> Self {
+        self.0.newton = Some(method.into());
+        self
+    }
+
     /// Modal analysis: the `modes` lowest natural modes about the state
     /// reached (docs/theory.md §14.7).
     pub fn modal(modes: usize) -> Self {

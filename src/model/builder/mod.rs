@@ -55,7 +55,8 @@ pub use super::handles::{
     StopHandle,
 };
 pub use super::input::{
-    AngleUnit, Approach, PanelPoint, PanelSide, StartBranch, TapeSpringInput as TapeSpring,
+    AngleUnit, Approach, PanelPoint, PanelSide, ShapeInput as Shape, StartBranch,
+    TapeSpringInput as TapeSpring,
 };
 pub use super::{Id, Model, ModelErrors};
 pub use crate::joints::{Coordinate, JointType};

@@ -7,7 +7,7 @@ use crate::model::handles::{
 };
 use crate::model::input::{
     AngleUnit, BeamInput, BeamLineInput, InertiaInput, NodeInput, PointMassInput, RigidBodyInput,
-    SectionInput, SpringInput, StiffnessInput,
+    SectionInput, ShapeInput, SpringInput, StiffnessInput,
 };
 use crate::model::{Id, MAX_LINE_ELEMENTS};
 
@@ -344,6 +344,7 @@ impl RigidBody {
                 mass,
                 inertia: None,
                 center_of_mass: None,
+                shape: None,
             },
             id: None,
         }
@@ -367,6 +368,14 @@ impl RigidBody {
     /// material frame.
     pub fn center_of_mass(mut self, offset: impl Into<[f64; 3]>) -> Self {
         self.input.center_of_mass = Some(offset.into());
+        self
+    }
+
+    /// The shape it is drawn with (default: the box of its mass and
+    /// inertia): `Shape::box_of`, `Shape::plate`, `Shape::cylinder` or
+    /// `Shape::point`.
+    pub fn shape(mut self, shape: ShapeInput) -> Self {
+        self.input.shape = Some(shape);
         self
     }
 

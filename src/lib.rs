@@ -22,6 +22,8 @@
 //!   direct solver;
 //! - [`analysis`]: Newton–Raphson, the step controller, the nonlinear
 //!   static analysis and its settings;
+//! - [`reduction`]: Craig–Bampton reduction of flexible bodies (imported
+//!   matrices or the project's own elements) into superelements;
 //! - [`eigen`]: eigen-solvers of modal analysis (dense null-space and
 //!   shift-invert Lanczos);
 //! - [`io`]: model files in, results (CSV, JSON, VTK) out.
@@ -68,6 +70,7 @@ pub mod io;
 pub mod joints;
 pub mod linalg;
 pub mod model;
+pub mod reduction;
 pub mod so3;
 pub mod state;
 

@@ -40,6 +40,8 @@ pub enum ElementKind {
     RollingDisc,
     /// Flat four-node shell of a laminated section (linear).
     Shell,
+    /// Flexible body reduced by Craig–Bampton on a floating frame.
+    Superelement,
 }
 
 /// A cell data array of the VTK files filled from an element's results:
@@ -67,7 +69,7 @@ impl CellField {
 
 impl ElementKind {
     /// Every kind, in the order of their result files and VTK arrays.
-    pub const ALL: [ElementKind; 15] = [
+    pub const ALL: [ElementKind; 16] = [
         Self::Beam,
         Self::RigidBody,
         Self::PointMass,
@@ -83,6 +85,7 @@ impl ElementKind {
         Self::Contact,
         Self::RollingDisc,
         Self::Shell,
+        Self::Superelement,
     ];
 
     /// Lower-case name used in messages and output file names.
@@ -103,6 +106,7 @@ impl ElementKind {
             Self::Contact => "contact",
             Self::RollingDisc => "rolling disc",
             Self::Shell => "shell",
+            Self::Superelement => "superelement",
         }
     }
 
@@ -124,6 +128,7 @@ impl ElementKind {
             Self::Contact => 14,
             Self::RollingDisc => 13,
             Self::Shell => 15,
+            Self::Superelement => 16,
         }
     }
 
@@ -143,6 +148,7 @@ impl ElementKind {
             Self::Contact => Some("contacts.csv"),
             Self::RollingDisc => Some("rolling.csv"),
             Self::Shell => Some("shells.csv"),
+            Self::Superelement => Some("superelements.csv"),
             Self::RigidBody | Self::PointMass | Self::NodalLoad | Self::Constraint => None,
         }
     }
@@ -156,6 +162,7 @@ impl ElementKind {
             Self::Stop => "stop",
             Self::Contact => "contact",
             Self::RollingDisc => "joint",
+            Self::Superelement => "superelement",
             _ => "element",
         }
     }

@@ -36,6 +36,7 @@ pub mod mass;
 pub mod shape;
 pub mod shell;
 pub mod spring;
+pub mod superelement;
 
 use crate::curves::Curve;
 use crate::model::Id;
@@ -314,6 +315,12 @@ pub trait Element: Send + Sync {
     /// The element as a unilateral stop, for the analyses that watch
     /// contacts (docs/joints.md §6.3).
     fn as_stop(&self) -> Option<&crate::joints::Stop> {
+        None
+    }
+
+    /// The element as a superelement, for the recovery of its original
+    /// mesh in the outputs (docs/theory.md §18.7).
+    fn as_superelement(&self) -> Option<&superelement::Superelement> {
         None
     }
 

@@ -328,7 +328,8 @@ pub fn read_model(path: &Path) -> Result<ModelFile, ModelFileError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let input = parse_model(&text, path)?;
+    let mut input = parse_model(&text, path)?;
+    input.base_dir = path.parent().map(Path::to_path_buf);
     let invalid = |errors| ModelFileError::Invalid {
         path: path.to_path_buf(),
         errors,

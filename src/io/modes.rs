@@ -201,9 +201,12 @@ impl ModalFiles {
         for (k, mode) in outcome.modes.iter().enumerate() {
             let name = format!("{prefix}{:04}.vtu", k + 1);
             let (translation, rotation) = unit_shape(mode);
+            let scale = mode.generalized_mass.sqrt();
+            let coordinates: Vec<f64> = mode.coordinates.iter().map(|c| c * scale).collect();
             let field = ModeField {
                 translation: &translation,
                 rotation: &rotation,
+                coordinates: &coordinates,
             };
             vtk::write_mode_vtu(
                 &dir.join("vtk").join(&name),

@@ -124,11 +124,72 @@ struct Followed {
     lock_increment: Option<usize>,
 }
 
-/// Follows the loads of a model's latches, stops and contacts over a run.
+/// The largest value of a result of the original elements of a
+/// superelement over the run (`summary.json`, `superelements[].peaks`):
+/// a beam's section force, a shell's skin stress.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ResultPeak {
+    /// The result's name (`N`, `M3`...).
+    pub quantity: &'static str,
+    /// Its value of largest magnitude, with its sign.
+    pub value: f64,
+    /// Where: the original element (its id in the body).
+    pub element: Id,
+    /// Its kind.
+    pub kind: &'static str,
+    /// Its nodes (ids in the body).
+    pub nodes: Vec<Id>,
+    /// For a skin stress of a shell: the layer of its laminate (from the
+    /// bottom, 0) where it is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub layer: Option<usize>,
+    /// When (`null` if never reached: a body at rest).
+    pub time: Option<f64>,
+    /// At which increment, numbered across the run as in `steps.csv`.
+    pub increment: Option<usize>,
+}
+
+/// A superelement in `summary.json` (docs/results.md, "Superelements"):
+/// its reduction and the peak results of its original elements.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SuperelementRecord {
+    /// The superelement.
+    pub superelement: Id,
+    /// Its boundary nodes (model ids).
+    pub boundary_nodes: Vec<Id>,
+    /// The node of its floating frame.
+    pub frame_node: Id,
+    /// Fixed-interface modes kept.
+    pub modes: usize,
+    /// Their frequencies (Hz).
+    pub mode_frequencies: Vec<f64>,
+    /// `consistent` or `lumped`.
+    pub inertia: &'static str,
+    /// What the reduction found.
+    pub reduction: crate::reduction::ReductionReport,
+    /// The largest value of each result of the original elements over
+    /// the run (empty for imported matrices).
+    pub peaks: Vec<ResultPeak>,
+}
+
+/// The skin stresses of a shell followed over a run, `[bottom, top]`:
+/// von Mises and the principal stresses where it is largest.
+const SKIN_QUANTITIES: [[&str; 3]; 2] = [
+    [
+        "bottom_skin_von_mises",
+        "bottom_skin_sigma1",
+        "bottom_skin_sigma2",
+    ],
+    ["top_skin_von_mises", "top_skin_sigma1", "top_skin_sigma2"],
+];
+
+/// Follows the loads of a model's latches, stops and contacts over a run,
+/// and the results of the original elements of its superelements.
 #[derive(Clone, Debug, Default)]
 pub struct PeakLoads {
     latches: Vec<(Followed, LatchPeak)>,
     stops: Vec<(Followed, StopPeak)>,
+    superelements: Vec<(usize, SuperelementRecord)>,
     /// The model has deformable members (beams, shells).
     deformable: bool,
 }
@@ -207,6 +268,28 @@ impl PeakLoads {
                 ));
             }
         }
+        for (element, e) in model.elements.iter().enumerate() {
+            let Some(se) = e.as_superelement() else {
+                continue;
+            };
+            let body = se.body();
+            let record = SuperelementRecord {
+                superelement: e.id(),
+                boundary_nodes: e.nodes().iter().map(|&n| model.node_ids[n]).collect(),
+                frame_node: model.node_ids[e.nodes()[se.frame_node()]],
+                modes: body.n_modes(),
+                mode_frequencies: body
+                    .omega_squared
+                    .iter()
+                    .map(|w2| w2.sqrt() / std::f64::consts::TAU)
+                    .collect(),
+                inertia: body.inertia.name(),
+                reduction: body.report.clone(),
+                peaks: Vec::new(),
+            };
+            peaks.superelements.push((element, record));
+        }
+        peaks.superelements.sort_by_key(|(_, r)| r.superelement);
         // in increasing id, as the rows of the result files
         peaks.latches.sort_by_key(|(_, p)| p.latch);
         peaks.stops.sort_by_key(|(_, p)| p.stop.or(p.contact));
@@ -215,7 +298,7 @@ impl PeakLoads {
 
     /// Whether the model has nothing to follow.
     pub fn is_empty(&self) -> bool {
-        self.latches.is_empty() && self.stops.is_empty()
+        self.latches.is_empty() && self.stops.is_empty() && self.superelements.is_empty()
     }
 
     /// Takes the loads at the converged increment `increment` (numbered
@@ -251,6 +334,79 @@ impl PeakLoads {
                 p.peak.take(load, time, increment);
             }
         }
+    }
+
+    /// Takes the results of the original elements of the superelements
+    /// (a beam's section forces, a shell's skin stresses) at the output
+    /// step `increment` (numbered as in [`PeakLoads::sample`]): the mesh
+    /// recovered at output steps only, where the results are written.
+    pub fn sample_recovered(&mut self, model: &Model, state: &State, increment: usize) {
+        let time = state.time;
+        for (element, record) in &mut self.superelements {
+            let Some(se) = model
+                .elements
+                .get(*element)
+                .and_then(|e| e.as_superelement())
+            else {
+                continue;
+            };
+            let Some(originals) = &se.body().body.elements else {
+                continue;
+            };
+            let mesh = se.recovered_mesh(state);
+            let results = se.element_results(&mesh);
+            let skins = se.skin_stresses(&mesh);
+            let mut take =
+                |e: &dyn Element, quantity: &'static str, value: f64, layer: Option<usize>| {
+                    let at = match record.peaks.iter().position(|p| p.quantity == quantity) {
+                        Some(at) => at,
+                        None => {
+                            record.peaks.push(ResultPeak {
+                                quantity,
+                                value: 0.0,
+                                element: e.id(),
+                                kind: e.kind().name(),
+                                nodes: e.nodes().iter().map(|&n| originals.node_ids[n]).collect(),
+                                layer,
+                                time: None,
+                                increment: None,
+                            });
+                            record.peaks.len() - 1
+                        }
+                    };
+                    let p = &mut record.peaks[at];
+                    if value.abs() > p.value.abs() {
+                        p.value = value;
+                        p.element = e.id();
+                        p.kind = e.kind().name();
+                        p.nodes = e.nodes().iter().map(|&n| originals.node_ids[n]).collect();
+                        p.layer = layer;
+                        p.time = Some(time);
+                        p.increment = Some(increment);
+                    }
+                };
+            for (e, values) in originals.elements.iter().zip(&results) {
+                for (&quantity, &value) in e.result_names().iter().zip(values) {
+                    take(e.as_ref(), quantity, value, None);
+                }
+            }
+            for (e, skin) in originals.elements.iter().zip(&skins) {
+                let Some(skin) = skin else {
+                    continue;
+                };
+                for (s, names) in skin.iter().zip(SKIN_QUANTITIES) {
+                    let values = [s.von_mises, s.principal[0], s.principal[1]];
+                    for (quantity, value) in names.into_iter().zip(values) {
+                        take(e.as_ref(), quantity, value, Some(s.layer));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The superelements' records, in increasing id.
+    pub fn superelements(&self) -> Vec<SuperelementRecord> {
+        self.superelements.iter().map(|(_, r)| r.clone()).collect()
     }
 
     /// A latch event `event` (numbered across the run as `increment`):

@@ -418,6 +418,10 @@ pub struct Summary {
     /// The same for each contact between bodies.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub contacts: Vec<super::peaks::StopPeak>,
+    /// Each superelement: its reduction and the peak results of its
+    /// original elements (docs/results.md, "Superelements").
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub superelements: Vec<super::peaks::SuperelementRecord>,
     /// Iterations of the initial equilibria, left out of the average.
     #[serde(skip)]
     initial_iterations: usize,
@@ -489,6 +493,7 @@ impl Summary {
             latches: Vec::new(),
             stops: Vec::new(),
             contacts: Vec::new(),
+            superelements: Vec::new(),
             initial_iterations: 0,
             unknowns: dofs,
         }

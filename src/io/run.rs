@@ -410,6 +410,7 @@ pub fn describe(model: &Model) -> String {
         (ElementKind::Contact, "contacts"),
         (ElementKind::RollingDisc, "rolling discs"),
         (ElementKind::Shell, "shells"),
+        (ElementKind::Superelement, "superelements"),
     ]
     .into_iter()
     .filter_map(|(kind, name)| match count(kind) {
@@ -1554,6 +1555,7 @@ impl Recorder {
         self.summary.latches = self.peaks.latches();
         self.summary.stops = self.peaks.stops();
         self.summary.contacts = self.peaks.contacts();
+        self.summary.superelements = self.peaks.superelements();
         self.summary.finish(&self.writer, status, message);
         let s = &self.summary;
         // the initial equilibria's iterations are counted in the total,
@@ -1718,6 +1720,9 @@ impl Observer for Recorder {
             info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
         let info = &self.renumbered(info);
         self.peaks.sample(model, state, info.increment);
+        if info.output {
+            self.peaks.sample_recovered(model, state, info.increment);
+        }
         // a kinematic analysis has no loads: its residual is all constraint
         // violation, measured against the tolerance of each constraint
         let (what, values) = if self.current.kind == "kinematic" {

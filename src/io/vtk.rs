@@ -47,7 +47,8 @@ use flate2::{Compress, Compression, FlushCompress, Status};
 
 use super::results::file_error;
 use crate::elements::shape::Outline;
-use crate::elements::{Attachment, CellField, CellShape, ElementKind, EvalContext};
+use crate::elements::shell::SkinStress;
+use crate::elements::{Attachment, CellField, CellShape, Element, ElementKind, EvalContext};
 use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -308,6 +309,30 @@ fn push3(out: &mut Vec<f64>, v: &Vec3) {
     out.extend_from_slice(&[v.x, v.y, v.z]);
 }
 
+/// The recovered mesh of a superelement in a grid: the element, its first
+/// point and the results of its original elements.
+struct Recovered {
+    element: usize,
+    first: usize,
+    results: Vec<Vec<f64>>,
+    /// The skin stresses of its shells (`None` for its other elements).
+    skins: Vec<Option<[SkinStress; 2]>>,
+}
+
+/// A cell's skin stresses in the grid: von Mises of the bottom and top
+/// skins, then the principal stresses of each.
+fn skin_row(skins: &[SkinStress; 2]) -> [f64; 6] {
+    let [b, t] = skins;
+    [
+        b.von_mises,
+        t.von_mises,
+        b.principal[0],
+        b.principal[1],
+        t.principal[0],
+        t.principal[1],
+    ]
+}
+
 /// Writes the grid of `state` to `path`.
 pub fn write_vtu(
     path: &Path,
@@ -338,13 +363,16 @@ pub fn write_step_vtu(
 }
 
 /// A mode shape on the nodes: translation and rotation (global frame) of
-/// each node.
+/// each node, and the generalised coordinates of the elements (a
+/// superelement's modal amplitudes; empty: zero).
 #[derive(Clone, Copy, Debug)]
 pub struct ModeField<'a> {
     /// Translation of each node.
     pub translation: &'a [Vec3],
     /// Rotation (small rotation vector) of each node.
     pub rotation: &'a [Vec3],
+    /// Coordinates of the elements, as in [`State::coordinates`].
+    pub coordinates: &'a [f64],
 }
 
 /// Writes the grid of `state` to `path` with a mode shape as the point
@@ -494,6 +522,77 @@ fn write_grid(
             joint_id.push(-1);
         }
     }
+    // the original meshes of superelements, recovered (docs/results.md,
+    // "VTK files"): their points after the joint points
+    let recovered: Vec<Recovered> = model
+        .elements
+        .iter()
+        .enumerate()
+        .filter_map(|(k, e)| e.as_superelement().map(|s| (k, s)))
+        .map(|(k, s)| {
+            let first = node_id.len();
+            let mesh = s.recovered_mesh(state);
+            let body = &s.body().body;
+            for (i, x) in mesh.position.iter().enumerate() {
+                push3(&mut position, x);
+                push3(&mut displacement, &(x - body.positions[i]));
+                push3(
+                    &mut rotation,
+                    &so3::log(&(mesh.orientation[i] * body.orientations[i].inverse())),
+                );
+                let r = so3::matrix(&mesh.orientation[i]);
+                for (c, ax) in axes.iter_mut().enumerate() {
+                    push3(ax, &r.column(c).into_owned());
+                }
+                node_id.push(-1);
+                joint_id.push(-1);
+            }
+            if let Some(m) = &mode {
+                let boundary: Vec<(Vec3, Vec3)> = s
+                    .nodes()
+                    .iter()
+                    .map(|&n| (m.translation[n], m.rotation[n]))
+                    .collect();
+                let o = model.offsets(k).coordinates;
+                let eta: Vec<f64> = (0..s.n_coordinates())
+                    .map(|j| m.coordinates.get(o + j).copied().unwrap_or(0.0))
+                    .collect();
+                for (u, theta) in s.mode_shape(state, &boundary, &eta) {
+                    push3(&mut mode_u, &u);
+                    push3(&mut mode_theta, &theta);
+                }
+            }
+            if let Some(moving) = velocities {
+                for i in 0..mesh.position.len() {
+                    let (v, w) = if moving {
+                        (mesh.velocity[i], mesh.angular_velocity[i])
+                    } else {
+                        (Vec3::zeros(), Vec3::zeros())
+                    };
+                    push3(&mut velocity, &v);
+                    push3(&mut angular_velocity, &w);
+                }
+            }
+            let results = s.element_results(&mesh);
+            let skins = s.skin_stresses(&mesh);
+            Recovered {
+                element: k,
+                first,
+                results,
+                skins,
+            }
+        })
+        .collect();
+    let mut mesh_node_id = vec![-1i64; node_id.len()];
+    for r in &recovered {
+        let s = model.elements[r.element]
+            .as_superelement()
+            .expect("a superelement");
+        for (i, id) in s.body().body.node_ids.iter().enumerate() {
+            mesh_node_id[r.first + i] = *id as i64;
+        }
+    }
+    let n_points = node_id.len();
 
     // cells: the shape of each element, its results in the cell arrays of
     // its kind (ElementKind::cell_fields), zeros in the others
@@ -507,6 +606,13 @@ fn write_grid(
     let mut types: Vec<u8> = Vec::new();
     let mut kinds: Vec<i32> = Vec::new();
     let mut ids: Vec<i64> = Vec::new();
+    let mut superelement_ids: Vec<i64> = Vec::new();
+    // the skin stresses of the shells of recovered meshes (docs/results.md,
+    // "VTK files"), six a cell
+    let with_skins = recovered
+        .iter()
+        .any(|r| r.skins.iter().any(Option::is_some));
+    let mut skin_values: Vec<f64> = Vec::new();
     let longest = model
         .elements
         .iter()
@@ -518,12 +624,18 @@ fn write_grid(
                     vtk_type: u8,
                     kind: i32,
                     id: i64,
-                    values: Option<(ElementKind, &[f64])>| {
+                    superelement: i64,
+                    values: Option<(ElementKind, &[f64])>,
+                    skin: Option<[f64; 6]>| {
         connectivity.extend(points.iter().map(|&p| p as i64));
         offsets.push(connectivity.len() as i64);
         types.push(vtk_type);
         kinds.push(kind);
         ids.push(id);
+        superelement_ids.push(superelement);
+        if with_skins {
+            skin_values.extend(skin.unwrap_or([0.0; 6]));
+        }
         for ((k, f), column) in fields.iter().zip(&mut field_values) {
             match values {
                 Some((of, v)) if of == *k && f.first + f.components <= v.len() => {
@@ -546,7 +658,15 @@ fn write_grid(
         while next_joint_point < n_joint_points && joints[next_joint_point - n_nodes].0 == k {
             let a = &joints[next_joint_point - n_nodes].1;
             if let Some(node) = a.node {
-                cell(&[node, next_joint_point], line, KIND_LINK, id, None);
+                cell(
+                    &[node, next_joint_point],
+                    line,
+                    KIND_LINK,
+                    id,
+                    -1,
+                    None,
+                    None,
+                );
             }
             next_joint_point += 1;
         }
@@ -556,8 +676,46 @@ fn write_grid(
                 VTK_VERTEX,
                 e.kind().code(),
                 id,
+                -1,
+                None,
                 None,
             );
+            continue;
+        }
+        // a superelement: the cells of its original mesh, each with its
+        // original element's kind, id and results
+        if let Some(r) = recovered.iter().find(|r| r.element == k) {
+            let s = e.as_superelement().expect("a superelement");
+            let body = &s.body().body;
+            let mut points = Vec::new();
+            for c in &body.cells {
+                points.clear();
+                points.extend(c.nodes.iter().map(|&i| r.first + i));
+                let original = c
+                    .element
+                    .zip(body.elements.as_ref())
+                    .map(|(el, m)| &m.elements[el]);
+                let vtk_type = CellShape::with_nodes(points.len())
+                    .vtk_type()
+                    .unwrap_or(VTK_VERTEX);
+                match original {
+                    Some(o) => {
+                        let at = c.element.unwrap_or(0);
+                        let values = r.results.get(at).map(|v| (o.kind(), &v[..]));
+                        let skin = r.skins.get(at).copied().flatten().map(|s| skin_row(&s));
+                        cell(
+                            &points,
+                            vtk_type,
+                            o.kind().code(),
+                            o.id() as i64,
+                            id,
+                            values,
+                            skin,
+                        );
+                    }
+                    None => cell(&points, vtk_type, e.kind().code(), id, id, None, None),
+                }
+            }
             continue;
         }
         let kind = e.kind();
@@ -574,7 +732,7 @@ fn write_grid(
             for c in &outline.cells {
                 shape_cell.clear();
                 shape_cell.extend(c.points.iter().map(|p| next_body_point + p));
-                cell(&shape_cell, c.vtk_type, kind.code(), id, values);
+                cell(&shape_cell, c.vtk_type, kind.code(), id, -1, values, None);
             }
             next_body_point += outline.points.len();
             continue;
@@ -583,7 +741,15 @@ fn write_grid(
         let Some(vtk_type) = shape.vtk_type() else {
             continue;
         };
-        cell(&nodes[..shape.nodes()], vtk_type, kind.code(), id, values);
+        cell(
+            &nodes[..shape.nodes()],
+            vtk_type,
+            kind.code(),
+            id,
+            -1,
+            values,
+            None,
+        );
     }
     let n_cells = types.len();
 
@@ -626,12 +792,29 @@ fn write_grid(
         doc.array("velocity", 3, &velocity);
         doc.array("angular_velocity", 3, &angular_velocity);
     }
+    if !recovered.is_empty() {
+        doc.array("mesh_node_id", 1, &mesh_node_id);
+    }
     doc.xml.push_str("      </PointData>\n");
 
     // cell data
     doc.xml.push_str("      <CellData Scalars=\"kind\">\n");
     doc.array("kind", 1, &kinds);
     doc.array("element_id", 1, &ids);
+    if !recovered.is_empty() {
+        doc.array("superelement_id", 1, &superelement_ids);
+    }
+    if with_skins {
+        let column = |first: usize, n: usize| -> Vec<f64> {
+            skin_values
+                .chunks_exact(6)
+                .flat_map(|row| row[first..first + n].iter().copied())
+                .collect()
+        };
+        doc.array("skin_von_mises", 2, &column(0, 2));
+        doc.array("bottom_skin_principal", 2, &column(2, 2));
+        doc.array("top_skin_principal", 2, &column(4, 2));
+    }
     for ((_, f), column) in fields.iter().zip(&field_values) {
         doc.array(f.name, f.components, column);
     }

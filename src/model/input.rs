@@ -44,7 +44,7 @@ impl AngleUnit {
 }
 
 /// The keys of the top level of a model file ([`ModelInput`]'s fields).
-pub const TOP_LEVEL_KEYS: [&str; 28] = [
+pub const TOP_LEVEL_KEYS: [&str; 29] = [
     "title",
     "analysis",
     "nodes",
@@ -71,6 +71,7 @@ pub const TOP_LEVEL_KEYS: [&str; 28] = [
     "stops",
     "contacts",
     "rolling_discs",
+    "superelements",
     "initial_motion",
     "output",
 ];
@@ -162,12 +163,122 @@ pub struct ModelInput {
     /// §3.8).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub rolling_discs: Vec<RollingDiscInput>,
+    /// Flexible bodies reduced by Craig–Bampton (docs/model-format.md,
+    /// "Superelements").
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub superelements: Vec<SuperelementInput>,
     /// Rigid motions of sets of nodes at the start (dynamic analyses).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub initial_motion: Vec<InitialMotionInput>,
     /// What a run writes besides the result files (`[output]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output: Option<OutputInput>,
+    /// The directory of the model file, against which the files a
+    /// superelement names are found (set by
+    /// [`crate::io::model_file::read_model`]; none: the working
+    /// directory). Not part of the file.
+    #[serde(skip)]
+    pub base_dir: Option<std::path::PathBuf>,
+}
+
+/// A flexible body reduced by Craig–Bampton and moved as a superelement
+/// on a floating frame (docs/model-format.md, "Superelements";
+/// docs/theory.md §18). Its body comes from one source: `elements` of
+/// this model, a `model` file of the body, Matrix Market `stiffness`,
+/// `mass` and `dofs` files, or a Nastran `dmig` punch file.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SuperelementInput {
+    /// Element id.
+    pub id: Id,
+    /// The boundary nodes: ids of nodes of the body that keep their six
+    /// dofs and are nodes of the model (joints and beams attach to them).
+    pub boundary: Vec<Id>,
+    /// The model's nodes the boundary nodes are, in the same order, for a
+    /// body from a file (default: the same ids). Each must be where its
+    /// boundary node is placed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nodes: Option<Vec<Id>>,
+    /// The boundary node whose frame is the floating frame (default the
+    /// first).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame_node: Option<Id>,
+    /// Source: ids of beams (of `[[beams]]` or `[[beam_lines]]`), rigid
+    /// bodies and point masses of this model, reduced together; their
+    /// nodes that are not boundary nodes leave the model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elements: Option<Vec<Id>>,
+    /// Source: a model file of the body (its beams, rigid bodies and point
+    /// masses; supports, loads and analyses ignored), relative to this
+    /// file's directory.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
+    /// Source: the stiffness, a Matrix Market file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<String>,
+    /// Source: the mass, a Matrix Market file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<String>,
+    /// Source: the dof map of the Matrix Market files (`node component`
+    /// per row).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dofs: Option<String>,
+    /// Source: a Nastran punch file of DMIG entries.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dmig: Option<String>,
+    /// Name of the stiffness in the DMIG file (default `KAAX`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dmig_stiffness: Option<String>,
+    /// Name of the mass in the DMIG file (default `MAAX`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dmig_mass: Option<String>,
+    /// Imported matrices: the node coordinates (`id x y z` per line);
+    /// default the model's nodes of the same ids.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordinates: Option<String>,
+    /// Imported matrices: the cells to draw (`id n1 n2 [n3 [n4]]` per
+    /// line).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cells: Option<String>,
+    /// A body from a file: where its origin is placed in the model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<[f64; 3]>,
+    /// A body from a file: the rotation vector that turns its axes into
+    /// the model's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<[f64; 3]>,
+    /// Unit of `rotation`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unit: Option<AngleUnit>,
+    /// Number of fixed-interface modes kept...
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub modes: Option<usize>,
+    /// ...or every mode up to this frequency (Hz).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff_frequency: Option<f64>,
+    /// Modal damping ratio: one for every mode, or one per mode (default
+    /// 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping_ratio: Option<DampingRatioInput>,
+    /// `consistent` (default: the body's mass matrix) or `lumped` (point
+    /// masses at the nodes, the reference paper's eq. 27–29).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia: Option<crate::reduction::InertiaModel>,
+    /// Whether the free-free frequencies of the full body are computed to
+    /// check the reduction (default true; a Lanczos solve of the whole
+    /// body).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub check_frequencies: Option<bool>,
+}
+
+/// Modal damping ratios: one value or one per mode.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum DampingRatioInput {
+    /// The same ratio for every mode.
+    All(f64),
+    /// One ratio per mode, in increasing frequency.
+    PerMode(Vec<f64>),
 }
 
 /// `[output]`: files a run writes besides the results.

@@ -277,7 +277,9 @@ impl Model {
         };
         let (mut kf, mut km) = (0.0f64, 0.0f64);
         for e in &self.elements {
-            if e.n_coordinates() + e.n_multipliers() > 0 {
+            // constraints are what is scaled; a superelement's modal
+            // coordinates are not, its boundary nodes' stiffness counts
+            if e.n_multipliers() > 0 {
                 continue;
             }
             let n = e.n_local();

@@ -52,7 +52,7 @@ use crate::so3::{self, Mat3, Operator, Rotation, SkewSeries, Vec3};
 use crate::state::State;
 use mitc4::{Geometry, Mat24, Vec24};
 
-pub use stress::{NodalDisplacements, ShellResultants, ShellStrains, StressPoint};
+pub use stress::{NodalDisplacements, ShellResultants, ShellStrains, SkinStress, StressPoint};
 
 /// The drilling penalty `γ_d` of the Hughes–Brezzi term
 /// `½ γ_d ∫ (θz − ω)² dA` relative to the laminate's in-plane shear

@@ -200,3 +200,52 @@ impl Shell {
         self.laminate.layer_stresses(&e, &k, &q, out);
     }
 }
+
+/// The largest stress of one skin (face sheet) of a shell at a point:
+/// its von Mises stress and the principal stresses where it is largest,
+/// over the skin's layers and their two surfaces.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SkinStress {
+    /// The layer (index in [`crate::elements::laminate::Laminate::layers`],
+    /// from the bottom) where the von Mises stress is largest.
+    pub layer: usize,
+    /// von Mises stress there.
+    pub von_mises: f64,
+    /// Principal stresses `σ₁ ≥ σ₂` there.
+    pub principal: [f64; 2],
+}
+
+impl Shell {
+    /// The stresses of the two skins, `[bottom, top]`, from the layer
+    /// stresses `layers` of [`Shell::layer_stresses`] at one point: a
+    /// sandwich's face sheets (its `BottomFace` and `TopFace` layers), or,
+    /// for a plain stack of plies, its outermost plies. Each skin gives its
+    /// largest von Mises stress over its layers and their two surfaces,
+    /// with the layer and the principal stresses there (paper figure 15:
+    /// stresses on the upper skin of a panel).
+    pub fn skin_stresses(&self, layers: &[LayerStress]) -> [SkinStress; 2] {
+        use crate::elements::laminate::LayerRole;
+        let sandwich = layers.iter().any(|l| l.role == LayerRole::Core);
+        let last = layers.len().saturating_sub(1);
+        let mut skins = [SkinStress::default(); 2];
+        for (k, l) in layers.iter().enumerate() {
+            let skin = match l.role {
+                LayerRole::BottomFace => 0,
+                LayerRole::TopFace => 1,
+                LayerRole::Ply if !sandwich && k == 0 => 0,
+                LayerRole::Ply if !sandwich && k == last => 1,
+                _ => continue,
+            };
+            for s in [&l.bottom, &l.top] {
+                if s.von_mises > skins[skin].von_mises {
+                    skins[skin] = SkinStress {
+                        layer: l.layer,
+                        von_mises: s.von_mises,
+                        principal: s.principal,
+                    };
+                }
+            }
+        }
+        skins
+    }
+}

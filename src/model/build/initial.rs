@@ -23,6 +23,12 @@ impl Builder<'_> {
             let ok = self.ck.finite(&entity, "velocity", &v)
                 & self.ck.finite(&entity, "angular_velocity", &w);
             let Some(&i) = self.node_index.get(&n.id) else {
+                if let Some(holder) = self.absorbed_nodes.get(&n.id) {
+                    self.ck.warn(
+                        &entity,
+                        format!("is inside {holder}: its initial velocity is not used (a superelement starts with the velocities of its boundary nodes, its modes at rest)"),
+                    );
+                }
                 continue;
             };
             if ok {
@@ -48,11 +54,11 @@ impl Builder<'_> {
             for id in &m.nodes {
                 let Some(&i) = self.node_index.get(id) else {
                     if !self.invalid_nodes.contains(id) {
-                        self.ck.push(
-                            ModelErrorKind::UnknownNode,
-                            &entity,
-                            format!("nodes: node {id} does not exist"),
-                        );
+                        let message = match self.absorbed_nodes.get(id) {
+                            Some(holder) => format!("nodes: node {id} is inside {holder}, reduced away: list its boundary nodes"),
+                            None => format!("nodes: node {id} does not exist"),
+                        };
+                        self.ck.push(ModelErrorKind::UnknownNode, &entity, message);
                     }
                     continue;
                 };

@@ -12,6 +12,9 @@ impl Builder<'_> {
     pub(super) fn masses(&mut self) {
         let input = self.input;
         for rb in &input.rigid_bodies {
+            if self.absorbed_elements.contains(&rb.id) {
+                continue;
+            }
             let entity = format!("rigid body {}", rb.id);
             let id_ok = self.claim_id(&entity, rb.id);
             let node = self.node(&entity, rb.node);
@@ -37,6 +40,9 @@ impl Builder<'_> {
             }
         }
         for pm in &input.point_masses {
+            if self.absorbed_elements.contains(&pm.id) {
+                continue;
+            }
             let entity = format!("point mass {}", pm.id);
             let id_ok = self.claim_id(&entity, pm.id);
             let node = self.node(&entity, pm.node);

@@ -30,6 +30,7 @@ mod settings;
 mod shells;
 mod springs;
 mod stops;
+mod superelements;
 mod supports;
 
 use super::input::*;
@@ -328,6 +329,11 @@ struct Builder<'i> {
     shell_tables: shells::ShellTables,
     fixed: Vec<[bool; 6]>,
     prescribed: Vec<Prescribed>,
+    /// Nodes taken out of the model inside a superelement, with its
+    /// entity.
+    absorbed_nodes: HashMap<Id, String>,
+    /// Rigid bodies and point masses reduced into a superelement.
+    absorbed_elements: HashSet<Id>,
 }
 
 impl Builder<'_> {
@@ -336,11 +342,11 @@ impl Builder<'_> {
     fn node(&mut self, entity: &str, id: Id) -> Option<usize> {
         let found = self.node_index.get(&id).copied();
         if found.is_none() && !self.invalid_nodes.contains(&id) {
-            self.ck.push(
-                ModelErrorKind::UnknownNode,
-                entity,
-                format!("node {id} does not exist"),
-            );
+            let message = match self.absorbed_nodes.get(&id) {
+                Some(holder) => format!("node {id} is inside {holder}, reduced away with its interior: make it one of its boundary nodes to attach to it"),
+                None => format!("node {id} does not exist"),
+            };
+            self.ck.push(ModelErrorKind::UnknownNode, entity, message);
         }
         found
     }
@@ -417,6 +423,7 @@ fn model_size(input: &ModelInput) -> usize {
         input.stops.len(),
         input.contacts.len(),
         input.rolling_discs.len(),
+        input.superelements.len(),
         generated,
     ]
     .into_iter()
@@ -448,6 +455,8 @@ impl Model {
             shell_tables: Default::default(),
             fixed: Vec::new(),
             prescribed: Vec::new(),
+            absorbed_nodes: HashMap::new(),
+            absorbed_elements: HashSet::new(),
         };
         let size = model_size(input);
         let mesh = size <= MAX_MODEL_SIZE;
@@ -464,6 +473,7 @@ impl Model {
         b.sections();
         b.beams();
         b.beam_lines(mesh);
+        b.superelements();
         b.build_beams();
         b.ply_materials();
         b.laminates();

@@ -44,6 +44,15 @@ fn examples() -> Vec<(String, Table)> {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("toml"))
+        // the solar array's files: the array reads its panel as a body
+        // file beside it, which a mutant written elsewhere cannot find,
+        // and the panel alone is the sandwich panel's kind of model
+        // (tests/solar_array.rs and tests/superelements.rs run them)
+        .filter(|p| {
+            !p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("solar_"))
+        })
         .collect();
     files.sort();
     assert!(files.len() >= 4, "the examples are missing: {files:?}");

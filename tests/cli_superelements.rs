@@ -3,21 +3,17 @@
 //! problem, and exit code 2 (as tests/cli.rs for the other entities); a
 //! body of imported matrices runs.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("unfold-cli-se-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::cli::scratch("cli-se", name)
 }
 
+/// `unfold ARGS`: exit code, stdout and stderr.
 fn unfold(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .args(args)
-        .output()
-        .unwrap();
+    let out = common::cli::unfold(args);
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),

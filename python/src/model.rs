@@ -548,6 +548,25 @@ impl PyModel {
             err.value(py).setattr("results", results.clone_ref(py))?;
             return Err(err);
         }
+        // a Ctrl-C that came after the run's last look at the signals (a
+        // run shorter than SIGNAL_INTERVAL, or during its last step) would
+        // otherwise surface as a bare KeyboardInterrupt at the next Python
+        // line, losing the results: it is the same `Interrupted`, with the
+        // results complete
+        if let Err(e) = py.check_signals() {
+            let err = if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                let i = errors::Interrupted::new_err(format!(
+                    "{}: interrupted after its last step; the results are complete ({kept})",
+                    self.label()
+                ));
+                i.set_cause(py, Some(e));
+                i
+            } else {
+                e
+            };
+            err.value(py).setattr("results", results.clone_ref(py))?;
+            return Err(err);
+        }
         if let Some(message) = interrupted_message {
             let err = errors::Interrupted::new_err(message);
             err.value(py).setattr("results", results.clone_ref(py))?;

@@ -149,7 +149,13 @@ def test_ctrl_c_stops_the_run_keeping_results(tmp_path):
     # a Ctrl-C while the analysis runs without the GIL: SIGINT's handler
     # raises KeyboardInterrupt in the main thread when the run looks at the
     # signals, between two steps
-    model = unfold.load_model(EXAMPLES / "double_pendulum.toml")
+    # 2 s of the example run in about 30 ms, less than the 50 ms between
+    # two looks at the signals: 200 s make sure the Ctrl-C comes mid-run
+    text = (EXAMPLES / "double_pendulum.toml").read_text()
+    assert "end_time = 2.0" in text
+    path = tmp_path / "long_pendulum.toml"
+    path.write_text(text.replace("end_time = 2.0", "end_time = 200.0"))
+    model = unfold.load_model(path)
     started = threading.Event()
 
     def first(p):
@@ -158,12 +164,13 @@ def test_ctrl_c_stops_the_run_keeping_results(tmp_path):
     timer = threading.Thread(target=lambda: (started.wait(), _thread.interrupt_main()))
     timer.start()
     with pytest.raises(unfold.Interrupted) as e:
-        model.run(out=tmp_path, progress=first, every_seconds=1e9)
+        model.run(out=tmp_path / "out", progress=first, every_seconds=1e9)
     timer.join()
     results = e.value.results
-    assert 0 < len(results) and results.final_time < 10.0
+    assert 0 < len(results) and results.final_time < 200.0
+    assert results.status == "interrupted"
     assert results.times[-1] == results.final_time
-    summary = json.loads((tmp_path / "summary.json").read_text())
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["status"] == "interrupted" and summary["output_steps"] == len(results)
 
 

@@ -1009,6 +1009,7 @@ fn run(
     }
     // the analyses in order, each from the final state of the one before;
     // none after one that failed
+    let start_state = start.clone();
     let mut state = start;
     // the last static or dynamic analysis: how it ended, and its error
     let mut last: Option<AnalysisEnd> = None;
@@ -1072,6 +1073,9 @@ fn run(
                 }
             }
         }
+    }
+    if failure.is_none() && modal_error.is_none() {
+        recorder.final_configuration(&model, &start_state, &state);
     }
     let report = recorder.finish_after(last.as_ref(), &state);
     // the charts of `[output] plots`, from the files as they now stand

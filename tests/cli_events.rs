@@ -2,7 +2,7 @@
 //! coefficients: each lock or impact in the log with its element, time
 //! and energy lost, their count and loss in the line closing the analysis,
 //! the run's last line and `summary.json`; a note for a latch that a
-//! dynamic analysis never locked and for one a static or kinematic
+//! dynamic analysis never locked (a warning) and for one a static or kinematic
 //! analysis passes (docs/joints.md §6.2); a note giving a joint spring's
 //! or hinge law's coefficient per degree in N·m/rad (docs/model-format.md).
 
@@ -213,18 +213,20 @@ time_step = 0.01"#,
 /// the range its joint covered (0 to 318.56°: the panel swings through the
 /// spring's free angle and back).
 #[test]
-fn a_latch_that_never_locks_is_noted() {
+fn a_latch_that_never_locks_is_a_warning() {
     let dir = scratch("never");
     let model = dir.join("panel.toml");
     std::fs::write(&model, panel(DYNAMIC, -90.0, "")).unwrap();
     let out = dir.join("out");
     let o = run(&model, &out, &["--quiet"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let stdout = text(&o.stdout);
-    let note = stdout
+    // a latch is there to lock: one that never does is a warning, on
+    // the console even with --quiet, in the log and in summary.json
+    let stderr = text(&o.stderr);
+    let note = stderr
         .lines()
-        .find(|l| l.starts_with("note: latch 5 never locked in the dynamic analysis to t = 1"))
-        .unwrap_or_else(|| panic!("no note in {stdout}"));
+        .find(|l| l.starts_with("warning: latch 5 never locked in the dynamic analysis to t = 1"))
+        .unwrap_or_else(|| panic!("no warning in {stderr}"));
     assert!(
         note.contains("joint 3 stayed within [0 rad (0.00°), 5.5"),
         "{note}"
@@ -237,7 +239,15 @@ fn a_latch_that_never_locks_is_noted() {
     );
     let log = std::fs::read_to_string(out.join("log.txt")).unwrap();
     assert!(log.contains(note), "{log}");
-    assert_eq!(summary(&out)["analyses"][0]["dynamic"]["locks"], 0);
+    let s = summary(&out);
+    assert_eq!(s["analyses"][0]["dynamic"]["locks"], 0);
+    let warned = s["warnings"].as_array().unwrap();
+    assert!(
+        warned
+            .iter()
+            .any(|w| w.as_str().unwrap() == &note["warning: ".len()..]),
+        "{warned:?}"
+    );
 }
 
 /// Latches lock only in dynamics: a static analysis of the panel finds its

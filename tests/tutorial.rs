@@ -4,7 +4,8 @@
 //! deploys as the rigid one until its first lock; a rigid latch on
 //! flexible panels is reported as not giving a design load; a lean output
 //! for studies; the warnings about a likely wrong model (docs/model-format.md,
-//! "Checks, warnings and limits") and a collapse of the steps.
+//! "Checks, warnings and limits"), bodies that end inside one another, and
+//! a collapse of the steps.
 
 mod common;
 
@@ -77,7 +78,7 @@ fn the_rigid_wing_deploys_locks_flat_and_dissipates_its_springs_work() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{text}");
     assert!(
-        text.contains("3 rigid bodies") && text.contains("3 latches"),
+        text.contains("4 rigid bodies") && text.contains("3 latches"),
         "{text}"
     );
     // a well-made model: no warning (notes only: the springs' stiffness per
@@ -88,6 +89,14 @@ fn the_rigid_wing_deploys_locks_flat_and_dissipates_its_springs_work() {
     cli::run_model(&model, &out);
     let s = summary(&out);
     assert_eq!(s["status"], "completed");
+    // nor at the end: every latch locked, no body inside another or
+    // inside the spacecraft
+    assert_eq!(
+        s["warnings"].as_array().unwrap().len(),
+        0,
+        "{}",
+        s["warnings"]
+    );
     // the root locks first, then hinge 3, then hinge 2 (docs/tutorial.md)
     let locks = locks(&out);
     let order: Vec<u64> = locks.iter().map(|l| l.0).collect();
@@ -279,6 +288,67 @@ fn likely_wrong_models_are_warned_of() {
         err.contains("the masses of its bodies span a factor of 4000"),
         "{err}"
     );
+}
+
+/// A hinge axis along the panel instead of the hinge line: with hinge 2's
+/// axis along z the panels fold back into the spacecraft (the box behind
+/// its wall, x < -0.02), and with hinge 3's panel 2 turns in the plane of
+/// panel 1 and ends on it. Both runs complete, locks and all; the
+/// warnings name the bodies (docs/model-format.md, "Checks, warnings and
+/// limits"). The right model has none (above).
+#[test]
+fn bodies_that_end_inside_one_another_are_warned_of() {
+    let rigid = example("wing_rigid.toml");
+    let wrong_axis = |joint: u64| {
+        let line = format!("id = {joint}\ntype = \"revolute\"\n");
+        let at = rigid.find(&line).unwrap();
+        let axis = at + rigid[at..].find("axis = [0.0, 1.0, 0.0]").unwrap();
+        let mut text = rigid.clone();
+        text.replace_range(axis..axis + 22, "axis = [0.0, 0.0, 1.0]");
+        text
+    };
+    let run = |name: &str, text: &str| {
+        let dir = scratch(name);
+        let model = dir.join("m.toml");
+        std::fs::write(&model, text).unwrap();
+        let out = dir.join("out");
+        let o = cli::unfold(&[
+            "run",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert_eq!(o.status.code(), Some(0));
+        let s = summary(&out);
+        assert_eq!(s["status"], "completed");
+        let warnings: Vec<String> = s["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|w| w.as_str().unwrap().to_string())
+            .collect();
+        let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+        for w in &warnings {
+            assert!(stderr.contains(&format!("warning: {w}")), "{stderr}");
+        }
+        warnings
+    };
+    // panel 1's centre ends at x = -0.2, panel 2's at -1.2 (measured)
+    let w = run("hinge_2_along_z", &wrong_axis(200));
+    for panel in [21, 31] {
+        assert!(
+            w.iter().any(|w| w.contains(&format!("of rigid body {panel} lies inside rigid body 2 (fixed) at the end of the run (t = 5), and not at its start"))),
+            "{w:?}"
+        );
+    }
+    // panel 2 on panel 1, as stowed but turned half a turn about z
+    let w = run("hinge_3_along_z", &wrong_axis(300));
+    assert!(
+        w.iter().any(|w| w.starts_with("100% of rigid body 31 lies inside rigid body 21 at the end of the run (t = 5), as at its start, though they moved relative to each other")),
+        "{w:?}"
+    );
+    assert!(!w.iter().any(|w| w.contains("rigid body 2 ")), "{w:?}");
 }
 
 /// The flexible wing without damping, its panels of 10 elements, and a

@@ -314,6 +314,7 @@ impl PyModel {
         let end_time = plan.last().map_or(1.0, |a| a.end_time());
         let mut observer = PyObserver::new(recorded, model, recorder, stop, callback, end_time);
         let mut state = model.initial_state();
+        let start = state.clone();
         let mut last: Option<AnalysisEnd> = None;
         let mut ends = Vec::new();
         let mut failure = None;
@@ -428,7 +429,10 @@ impl PyModel {
             error: python_error,
             ..
         } = observer;
-        if let Some(r) = recorder {
+        if let Some(mut r) = recorder {
+            if failure.is_none() && interrupted.is_none() {
+                r.final_configuration(model, &start, &state);
+            }
             let report = r.finish_after(last.as_ref(), &state);
             if let (Some(e), None) = (report.output_errors.first(), &failure) {
                 failure = Some(Failure::Output(format!("cannot write results: {e}")));

@@ -259,6 +259,117 @@ impl BodyShape {
     pub fn is_solid(&self) -> bool {
         self.solid != Solid::Point
     }
+
+    /// Points spread over the solid (node material frame), for the checks
+    /// of bodies ending inside one another: the centres of the cells of a
+    /// regular grid ([`SAMPLES_PER_EDGE`] along each edge of a box or a
+    /// plate, rings and sectors of a cylinder), so that none lies on the
+    /// solid's boundary, where bodies that touch meet.
+    pub fn samples(&self) -> Vec<Vec3> {
+        let n = SAMPLES_PER_EDGE;
+        // cell centres of [−a/2, a/2] in n cells (one cell for a = 0)
+        let centres = |a: f64, n: usize| -> Vec<f64> {
+            let n = if a > 0.0 { n } else { 1 };
+            (0..n)
+                .map(|k| a * ((k as f64 + 0.5) / n as f64 - 0.5))
+                .collect()
+        };
+        let grid = |a: [f64; 3]| -> Vec<Vec3> {
+            let (u, v, w) = (centres(a[0], n), centres(a[1], n), centres(a[2], n));
+            let mut out = Vec::with_capacity(u.len() * v.len() * w.len());
+            for &z in &w {
+                for &y in &v {
+                    for &x in &u {
+                        out.push(Vec3::new(x, y, z));
+                    }
+                }
+            }
+            out
+        };
+        let local = match self.solid {
+            Solid::Point => vec![Vec3::zeros()],
+            Solid::Line { length } => grid([length, 0.0, 0.0]),
+            Solid::Box { size } => grid(size),
+            Solid::Plate { size, thickness } => grid([size[0], size[1], thickness]),
+            Solid::Cylinder { radius, length } => {
+                let sectors = 2 * n;
+                let mut out = Vec::new();
+                for z in centres(length, n) {
+                    for ring in 0..n / 2 {
+                        let r = radius * (ring as f64 + 0.5) / (n / 2) as f64;
+                        for k in 0..sectors {
+                            let a = std::f64::consts::TAU * (k as f64 + 0.5) / sectors as f64;
+                            out.push(Vec3::new(r * a.cos(), r * a.sin(), z));
+                        }
+                    }
+                }
+                out
+            }
+        };
+        local.iter().map(|p| self.center + self.axes * p).collect()
+    }
+
+    /// The distance from the node to the farthest point of the solid.
+    pub fn reach(&self) -> f64 {
+        self.outline()
+            .points
+            .iter()
+            .fold(0.0f64, |m, p| m.max(p.norm()))
+    }
+
+    /// Where a point `p` (node material frame) lies relative to the solid:
+    /// [`Side::Inside`] its volume (boxes, thick plates, cylinders of some
+    /// length: solids of no volume have no inside), or, for a plate, above
+    /// or below its faces within its outline ([`Side::Above`],
+    /// [`Side::Below`]); [`Side::Outside`] otherwise.
+    pub fn side(&self, p: &Vec3) -> Side {
+        let local = self.axes.transpose() * (p - self.center);
+        let within = |x: f64, a: f64| x.abs() < 0.5 * a;
+        match self.solid {
+            Solid::Box { size } => {
+                if (0..3).all(|i| within(local[i], size[i])) {
+                    Side::Inside
+                } else {
+                    Side::Outside
+                }
+            }
+            Solid::Plate { size, thickness } => {
+                if !(within(local.x, size[0]) && within(local.y, size[1])) {
+                    Side::Outside
+                } else if local.z >= 0.5 * thickness {
+                    Side::Above
+                } else if local.z <= -0.5 * thickness {
+                    Side::Below
+                } else {
+                    Side::Inside
+                }
+            }
+            Solid::Cylinder { radius, length } => {
+                if local.xy().norm() < radius && within(local.z, length) {
+                    Side::Inside
+                } else {
+                    Side::Outside
+                }
+            }
+            Solid::Point | Solid::Line { .. } => Side::Outside,
+        }
+    }
+}
+
+/// Sample points along each edge of a solid ([`BodyShape::samples`]).
+pub const SAMPLES_PER_EDGE: usize = 8;
+
+/// Where a point lies relative to a solid ([`BodyShape::side`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// Inside its volume.
+    Inside,
+    /// Within a plate's outline, on the side of its axis 3.
+    Above,
+    /// Within a plate's outline, on the other side.
+    Below,
+    /// Anywhere else.
+    Outside,
 }
 
 #[cfg(test)]

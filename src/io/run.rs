@@ -1219,15 +1219,17 @@ impl Recorder {
         }
     }
 
-    /// At the end of a dynamic analysis that reached its end: a note for
-    /// each latch open at its start that it never locked, with the range
-    /// its coordinate covered.
+    /// At the end of a dynamic analysis that reached its end: a warning
+    /// for each latch open at its start that it never locked, with the
+    /// range its coordinate covered (a latch is there to lock: one that
+    /// does not is most often a value or an approach of the wrong sign, or
+    /// a deployment too short or too weak).
     fn never_locked(&mut self, end: &AnalysisEnd) {
         if self.current.kind != "dynamic" || end.error.is_some() {
             return;
         }
         let span = self.span(end);
-        let notes: Vec<String> = self
+        let warnings: Vec<String> = self
             .latches
             .iter()
             .filter(|w| !w.locked_at_start && !w.locked)
@@ -1250,8 +1252,8 @@ impl Recorder {
                 )
             })
             .collect();
-        for n in notes {
-            self.note_line(&n);
+        for w in warnings {
+            self.warning_line(&w);
         }
         self.never_struck(end);
         self.unresolved_contacts();
@@ -1428,6 +1430,14 @@ impl Recorder {
         }
     }
 
+    /// A warning on the run's outcome: in `log.txt`, on the console and
+    /// in `summary.json`.
+    fn warning_line(&mut self, text: &str) {
+        self.log.line(&format!("warning: {text}"));
+        self.console.warning(text);
+        self.summary.warnings.push(text.to_string());
+    }
+
     /// A note of the run's outcome: in `log.txt`, and shown even when the
     /// increments are not.
     fn note_line(&mut self, text: &str) {
@@ -1495,6 +1505,15 @@ impl Recorder {
     pub fn finish_with(self, outcome: Option<&StaticOutcome>, state: &State) -> RunReport {
         let end = outcome.map(AnalysisEnd::from);
         self.finish_after(end.as_ref(), state)
+    }
+
+    /// Warnings for the bodies that end the run inside one another and
+    /// did not start so ([`crate::model::overlaps`]), for a run whose
+    /// analyses all completed, from `start` to `end`.
+    pub fn final_configuration(&mut self, model: &Model, start: &State, end: &State) {
+        for o in crate::model::overlaps::new_overlaps(model, start, end) {
+            self.warning_line(&o.message(&format_time(end.time)));
+        }
     }
 
     /// As [`Recorder::finish_with`], for a run whose last static or

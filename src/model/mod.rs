@@ -14,6 +14,7 @@ mod build;
 pub mod builder;
 mod handles;
 pub mod input;
+pub mod overlaps;
 
 use std::fmt;
 

@@ -186,7 +186,7 @@ pub const MASS_RATIO_WARNING: f64 = 500.0;
 ///   Nodes without a body of finite extent (a beam's node, a point mass,
 ///   the bob of a pendulum modelled as a node with joints) are not
 ///   judged: their links to their joints are rigid by construction;
-/// - bodies and point masses whose masses span [`MASS_RATIO_WARNING`] or
+/// - bodies and point masses (not held fixed) whose masses span [`MASS_RATIO_WARNING`] or
 ///   more: grams among kilograms.
 pub(super) fn suspect_model(model: &Model) -> Vec<(String, String)> {
     let mut warnings = Vec::new();
@@ -197,11 +197,7 @@ pub(super) fn suspect_model(model: &Model) -> Vec<(String, String)> {
         let (Some(shape), Some(&node)) = (e.body_shape(), e.nodes().first()) else {
             continue;
         };
-        let r = shape
-            .outline()
-            .points
-            .iter()
-            .fold(0.0f64, |m, p| m.max(p.norm()));
+        let r = shape.reach();
         let entry = reach.entry(node).or_insert((0.0, e.id()));
         if r > entry.0 {
             *entry = (r, e.id());
@@ -239,6 +235,12 @@ pub(super) fn suspect_model(model: &Model) -> Vec<(String, String)> {
         .elements
         .iter()
         .filter(|e| matches!(e.kind(), ElementKind::RigidBody | ElementKind::PointMass))
+        // a body held fixed (a spacecraft drawn for the view) moves no mass
+        .filter(|e| {
+            e.nodes()
+                .first()
+                .is_none_or(|&n| !model.fixed[n].iter().all(|&f| f))
+        })
         .map(|e| (e.mass(), e.as_ref()))
         .filter(|(m, _)| *m > 0.0)
         .collect();

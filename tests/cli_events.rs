@@ -248,6 +248,15 @@ fn a_latch_that_never_locks_is_a_warning() {
             .any(|w| w.as_str().unwrap() == &note["warning: ".len()..]),
         "{warned:?}"
     );
+    // its peak is no design load
+    let latch = &s["latches"][0];
+    assert_eq!(latch["latch"], 5);
+    assert!(latch["locked_at"].is_null(), "{latch}");
+    assert_eq!(latch["design_load"], false, "{latch}");
+    assert!(
+        latch["note"].as_str().unwrap().contains("never locked"),
+        "{latch}"
+    );
 }
 
 /// Latches lock only in dynamics: a static analysis of the panel finds its

@@ -429,15 +429,25 @@ impl PyModel {
             error: python_error,
             ..
         } = observer;
+        // bodies that end inside one another (crate docs: model::overlaps)
+        let overlaps: Vec<String> = if failure.is_none() && interrupted.is_none() {
+            unfold::model::overlaps::new_overlaps(model, &start, &state)
+                .iter()
+                .map(|o| o.message(&format_time(state.time)))
+                .collect()
+        } else {
+            Vec::new()
+        };
         if let Some(mut r) = recorder {
-            if failure.is_none() && interrupted.is_none() {
-                r.final_configuration(model, &start, &state);
+            for w in &overlaps {
+                r.outcome_warning(w);
             }
             let report = r.finish_after(last.as_ref(), &state);
             if let (Some(e), None) = (report.output_errors.first(), &failure) {
                 failure = Some(Failure::Output(format!("cannot write results: {e}")));
             }
         }
+        recorded.warnings.extend(overlaps);
         recorded
             .warnings
             .splice(0..0, model.warnings.iter().map(|w| w.to_string()));

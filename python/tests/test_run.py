@@ -227,3 +227,26 @@ def test_elements_kept_and_lookup():
         results.element(("beam", 1))
     with pytest.raises(ValueError, match="no kind of element"):
         model.run(elements=["beems"])
+
+
+def test_bodies_ending_inside_one_another_are_warned_of(tmp_path):
+    # the tutorial's wing with hinge 3's axis along the panel (z) instead
+    # of the hinge line (y): panel 2 turns in the plane of panel 1 and ends
+    # on it; the warning of `unfold run` is in the results, with or without
+    # result files (docs/model-format.md, "Checks, warnings and limits")
+    text = (EXAMPLES / "wing_rigid.toml").read_text()
+    hinge_3 = 'id = 300\ntype = "revolute"\nnodes = [20, 30]\naxis = [0.0, 1.0, 0.0]'
+    assert hinge_3 in text
+    path = tmp_path / "wrong_axis.toml"
+    path.write_text(text.replace(hinge_3, hinge_3.replace("[0.0, 1.0, 0.0]", "[0.0, 0.0, 1.0]")))
+    expected = "100% of rigid body 31 lies inside rigid body 21 at the end of the run (t = 5)"
+    results = unfold.load_model(path).run()
+    assert results.status == "completed"
+    assert [w for w in results.warnings if w.startswith(expected)], results.warnings
+    written = unfold.load_model(path).run(out=tmp_path / "out")
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert [w for w in summary["warnings"] if w.startswith(expected)], summary["warnings"]
+    assert [w for w in written.warnings if w.startswith(expected)]
+    # the right model: none
+    right = unfold.load_model(EXAMPLES / "wing_rigid.toml").run()
+    assert not [w for w in right.warnings if "lies inside" in w], right.warnings

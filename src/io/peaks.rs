@@ -53,7 +53,8 @@ pub struct LatchPeak {
     /// members (beams, shells) and whose peak came at or after that lock:
     /// the loads after such a lock follow a velocity jump imposed in one
     /// step on members with distributed mass, and depend on the step and
-    /// on the damping of the highest modes, not on the structure alone.
+    /// on the damping of the highest modes, not on the structure alone;
+    /// false also for a latch that never locked.
     pub design_load: bool,
     /// Why `design_load` is false (absent when it is true).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -431,6 +432,14 @@ impl PeakLoads {
     /// ([`LatchPeak::design_load`]). Returns a warning for each.
     pub fn mark_impact_peaks(&mut self) -> Vec<String> {
         let mut warnings = Vec::new();
+        // a latch that never locked held nothing: its peak is no load of
+        // a lock (the run warns of the latch itself)
+        for (_, p) in &mut self.latches {
+            if p.locked_at.is_none() {
+                p.design_load = false;
+                p.note = Some("it never locked: its peak is not the load of a lock".to_string());
+            }
+        }
         if !self.deformable {
             return warnings;
         }

@@ -1516,6 +1516,12 @@ impl Recorder {
         }
     }
 
+    /// A warning on the outcome of the run, found by the caller: on the
+    /// console, in `log.txt` and in `summary.json`.
+    pub fn outcome_warning(&mut self, text: &str) {
+        self.warning_line(text);
+    }
+
     /// As [`Recorder::finish_with`], for a run whose last static or
     /// dynamic analysis ended as `last` says.
     pub fn finish_after(mut self, last: Option<&AnalysisEnd>, state: &State) -> RunReport {

@@ -2,11 +2,12 @@
 //! of the structure is held, and every element gives finite forces and
 //! stiffness in the reference configuration.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 use super::{Checker, LARGEST_ELEMENT_VALUE};
 use crate::elements::{Element, ElementKind};
 use crate::io::number::plain;
+use crate::model::input::ModelInput;
 use crate::model::{Id, Model, ModelError, ModelErrorKind};
 
 /// Elements whose forces or tangent are not finite, or beyond
@@ -187,9 +188,28 @@ pub const MASS_RATIO_WARNING: f64 = 500.0;
 ///   the bob of a pendulum modelled as a node with joints) are not
 ///   judged: their links to their joints are rigid by construction;
 /// - bodies and point masses (not held fixed) whose masses span [`MASS_RATIO_WARNING`] or
-///   more: grams among kilograms.
-pub(super) fn suspect_model(model: &Model) -> Vec<(String, String)> {
+///   more: grams among kilograms;
+/// - a rigid body (not held fixed) given a mass and no `inertia`: it turns
+///   without rotational inertia;
+/// - two latches on one joint at the same value: the second locks nothing
+///   the first does not (a latch put on the wrong joint);
+/// - a joint driven by a joint spring or a hinge law with neither latch
+///   nor stop, in a model whose other driven joints have them: its latch
+///   is missing, or on another joint.
+pub(super) fn suspect_model(model: &Model, input: &ModelInput) -> Vec<(String, String)> {
     let mut warnings = Vec::new();
+    latched_joints(model, input, &mut warnings);
+    for b in &input.rigid_bodies {
+        let fixed = model
+            .node_index(b.node)
+            .is_some_and(|n| model.fixed[n].iter().all(|&f| f));
+        if b.inertia.is_none() && b.mass > 0.0 && !fixed {
+            warnings.push((
+                format!("rigid body {}", b.id),
+                "has a mass and no `inertia` (zero by default): it turns without rotational inertia, as a point mass would, and is drawn as a point; give its inertia about its centre of mass, or `inertia = [0, 0, 0]` if that is meant".to_string(),
+            ));
+        }
+    }
     let state = model.initial_state();
     // the reach of the bodies on each node, and the body
     let mut reach: HashMap<usize, (f64, Id)> = HashMap::new();
@@ -264,4 +284,68 @@ pub(super) fn suspect_model(model: &Model) -> Vec<(String, String)> {
         }
     }
     warnings
+}
+
+/// The latches of a model against its joints ([`suspect_model`]): two
+/// latches at one value on one joint, and driven joints left without a
+/// latch or a stop where the others have one.
+fn latched_joints(model: &Model, input: &ModelInput, warnings: &mut Vec<(String, String)>) {
+    // (latch id, value, is angle) by joint, in the order of the elements
+    let mut by_joint: BTreeMap<Id, Vec<(Id, f64, bool)>> = BTreeMap::new();
+    for e in &model.elements {
+        if let Some(l) = e.as_latch() {
+            by_joint
+                .entry(l.joint())
+                .or_default()
+                .push((e.id(), l.value(), l.is_angle()));
+        }
+    }
+    for (joint, latches) in &by_joint {
+        for (k, &(id, value, angle)) in latches.iter().enumerate() {
+            // the same value to 1e-9 rad, or 1e-9 of the model's size
+            let scale = if angle { 1.0 } else { model.length_scale };
+            let twin = latches[..k]
+                .iter()
+                .find(|l| (l.1 - value).abs() <= 1e-9 * scale);
+            if let Some(&(first, _, _)) = twin {
+                warnings.push((
+                    format!("latch {id}"),
+                    format!(
+                        "locks joint {joint} at the value at which latch {first} locks it already: it locks nothing latch {first} does not; if it is meant for another joint, its `joint` is wrong"
+                    ),
+                ));
+            }
+        }
+    }
+    let ended: BTreeSet<Id> = by_joint
+        .keys()
+        .copied()
+        .chain(input.stops.iter().map(|s| s.joint))
+        .collect();
+    // joints driven by a spring or a hinge law, with the element that drives each
+    let mut driven: BTreeMap<Id, String> = BTreeMap::new();
+    for s in &input.joint_springs {
+        driven
+            .entry(s.joint)
+            .or_insert_with(|| format!("joint spring {}", s.id));
+    }
+    for h in &input.hinge_laws {
+        driven
+            .entry(h.joint)
+            .or_insert_with(|| format!("hinge law {}", h.id));
+    }
+    let with = driven.keys().filter(|j| ended.contains(j)).count();
+    if with == 0 {
+        return;
+    }
+    for (joint, by) in driven.iter().filter(|(j, _)| !ended.contains(j)) {
+        warnings.push((
+            format!("joint {joint}"),
+            format!(
+                "is driven by {by} and has neither latch nor stop, where {with} other driven joint{} {}: if it is meant to lock at the end of its travel, its latch is missing or was given another joint",
+                if with == 1 { "" } else { "s" },
+                if with == 1 { "has one" } else { "have one" }
+            ),
+        ));
+    }
 }

@@ -554,7 +554,7 @@ impl Model {
         if !errors.is_empty() {
             return Err(ModelErrors(errors));
         }
-        for (entity, message) in checks::suspect_model(&model) {
+        for (entity, message) in checks::suspect_model(&model, input) {
             model.warnings.push(ModelWarning { entity, message });
         }
         Ok(model)

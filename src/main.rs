@@ -151,8 +151,9 @@ enum Command {
         /// (named by dimension, for a model in other units).
         #[arg(long, value_enum, default_value = "si")]
         units: PlotUnits,
-        /// The model file, which tells angles from lengths (default: the
-        /// one named in summary.json).
+        /// The model file, which says which joint coordinate each spring,
+        /// hinge law, latch and driver acts on (default: the one named in
+        /// summary.json).
         #[arg(long, value_name = "FILE")]
         model: Option<PathBuf>,
     },

@@ -137,6 +137,12 @@ fn handles_find_their_nodes_and_elements() {
     assert_eq!(r.names[..3], ["coordinate", "target", "load"]);
     assert_eq!(r.get("coordinate"), Some(0.0));
     assert_eq!(r.get("no such quantity"), None);
+    // a joint's coordinates by name, as in joints.csv: a revolute joint
+    // has an angle, and no slide
+    let r = model.results(hinge, &state);
+    assert_eq!(r.names[..4], ["angle", "F1", "F2", "F3"]);
+    assert_eq!(r.get("angle"), Some(0.0));
+    assert_eq!(r.get("slide"), None);
 }
 
 #[test]

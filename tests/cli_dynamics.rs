@@ -146,7 +146,7 @@ fn pendulum_run_writes_velocities_and_a_small_energy_balance() {
         assert!((num(e, "gravity") - potential).abs() <= 1e-9 * mgd);
         // the rate of the hinge angle (differences along the motion) is the
         // body's angular velocity about z, to the digits of the files
-        let rate = num(j, "c1_rate");
+        let rate = num(j, "angle_rate");
         assert!((num(v, "wz") - rate).abs() <= 1e-8 * (1.0 + rate.abs()));
         // the centre of mass turns about the hinge, |v| = d|θ̇|: the
         // index-3 equations hold the joint on positions, the projection
@@ -609,7 +609,7 @@ curve = \"s\"
         // step kept); with two drivers the first step stops it
         let angles: Vec<f64> = table(&out.join("joints.csv"))
             .iter()
-            .map(|r| num(r, "c1"))
+            .map(|r| num(r, "angle"))
             .collect();
         assert!(!angles.is_empty(), "{name}");
         let limit = std::f64::consts::FRAC_PI_2 + 1e-6;

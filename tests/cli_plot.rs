@@ -154,7 +154,6 @@ fn dynamic_run_with_a_latch() {
         "Joint 10 (revolute): angle",
         "time t (s)",
         "angle (rad)",
-        "angle (c1)",
         "latch 20 locks",
     ] {
         assert!(joint.contains(text), "joint_10.svg lacks {text:?}");
@@ -297,12 +296,35 @@ fn static_run_and_bad_input() {
         .split(',')
         .map(str::to_string)
         .collect();
-    cells[3] = "1.2.3".into();
+    assert_eq!(lines[0].split(',').nth(4), Some("angle"));
+    cells[4] = "1.2.3".into();
     lines[2] = cells.join(",");
     std::fs::write(out.join("joints.csv"), lines.join("\n")).unwrap();
     fails(
         &["plot", s(&out)],
-        &["joints.csv, line 3", "`c1`", "\"1.2.3\" is not a number"],
+        &["joints.csv, line 3", "`angle`", "\"1.2.3\" is not a number"],
+    );
+    let mut cells: Vec<&str> = joints.lines().nth(2).unwrap().split(',').collect();
+    cells[3] = "hinge";
+    lines[2] = cells.join(",");
+    std::fs::write(out.join("joints.csv"), lines.join("\n")).unwrap();
+    fails(
+        &["plot", s(&out)],
+        &[
+            "joints.csv, line 3",
+            "`type`",
+            "\"hinge\" is not a joint type",
+        ],
+    );
+    // a joints.csv of an earlier version, with coordinates c1…c3
+    std::fs::write(
+        out.join("joints.csv"),
+        "step,time,joint,c1,c2,c3\n0,0,10,0.5,,\n",
+    )
+    .unwrap();
+    fails(
+        &["plot", s(&out)],
+        &["joints.csv, line 1", "`c1`", "run the model again"],
     );
     std::fs::write(out.join("joints.csv"), "step,joint\n0,1\n").unwrap();
     fails(

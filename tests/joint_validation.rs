@@ -106,20 +106,38 @@ fn tight(m: &mut ModelInput) {
     m.analysis.rotation_tolerance = Some(1e-12);
 }
 
+/// The results of an element, by name (`r["F3"]`; a joint's coordinates
+/// `r["angle"]`, `r["slide"]`...).
+struct Named {
+    names: &'static [&'static str],
+    values: Vec<f64>,
+}
+
+impl std::ops::Index<&str> for Named {
+    type Output = f64;
+    fn index(&self, name: &str) -> &f64 {
+        match self.names.iter().position(|n| *n == name) {
+            Some(k) => &self.values[k],
+            None => panic!("no result {name} among {:?}", self.names),
+        }
+    }
+}
+
 /// The results of element `id` of kind `kind` at `state`.
-fn results(model: &Model, state: &State, kind: ElementKind, id: Id) -> Vec<f64> {
+fn results(model: &Model, state: &State, kind: ElementKind, id: Id) -> Named {
     let e = model
         .elements
         .iter()
         .find(|e| e.kind() == kind && e.id() == id)
         .unwrap_or_else(|| panic!("no {} {id}", kind.name()));
-    let mut out = vec![0.0; e.result_names().len()];
+    let names = e.result_names();
+    let mut values = vec![0.0; names.len()];
     e.results(
         &model.context(state.time, unfold::elements::Need::RESIDUAL),
         state,
-        &mut out,
+        &mut values,
     );
-    out
+    Named { names, values }
 }
 
 /// Load joint `id` applies to its first node, global components: force
@@ -130,8 +148,8 @@ fn results(model: &Model, state: &State, kind: ElementKind, id: Id) -> Vec<f64> 
 fn joint_reaction(model: &Model, state: &State, id: Id, axes: &Mat3) -> (Vec3, Vec3) {
     let r = results(model, state, ElementKind::Joint, id);
     (
-        axes * Vec3::new(r[3], r[4], r[5]),
-        axes * Vec3::new(r[6], r[7], r[8]),
+        axes * Vec3::new(r["F1"], r["F2"], r["F3"]),
+        axes * Vec3::new(r["M1"], r["M2"], r["M3"]),
     )
 }
 
@@ -344,8 +362,8 @@ fn crank_torque_error(model: &Model, path: &Path) -> f64 {
     let mut worst = 0.0f64;
     for state in &path.states {
         let d = results(model, state, ElementKind::Driver, 201);
-        // d = [coordinate, target, load]: crank angle θ, torque on the crank
-        let (theta, torque) = (d[0], d[2]);
+        // the crank angle θ, the torque on the crank
+        let (theta, torque) = (d["coordinate"], d["load"]);
         let (x, rigid) = rigid_crank(theta);
         let dx = (state.x[slider].x - x) / CRANK;
         let err = (torque - rigid).abs() / (RESISTANCE * CRANK);
@@ -407,7 +425,7 @@ fn flexible_slider_crank() {
     );
     assert_eq!(iterations.len(), 20);
     let last = path.states.last().unwrap();
-    let crank_angle = results(&model, last, ElementKind::Driver, 201)[0];
+    let crank_angle = results(&model, last, ElementKind::Driver, 201)["coordinate"];
     assert!((crank_angle - PI).abs() < 1e-10, "crank at {crank_angle}");
 
     // (b) global equilibrium at every increment
@@ -420,7 +438,7 @@ fn flexible_slider_crank() {
     for state in &path.states {
         let (f1, m1) = joint_reaction(&model, state, 101, &e_rev);
         let (f4, m4) = joint_reaction(&model, state, 104, &e_pri);
-        let q = results(&model, state, ElementKind::Driver, 201)[2];
+        let q = results(&model, state, ElementKind::Driver, 201)["load"];
         let driver_moment = Vec3::new(0.0, 0.0, q);
         let (x1, x5) = (state.x[pivot], state.x[slider]);
         let sum_f = f1 + f4 + load;
@@ -428,10 +446,10 @@ fn flexible_slider_crank() {
         worst_f = worst_f.max(sum_f.norm() / p);
         worst_m = worst_m.max(sum_m.norm() / (p * r));
         let rev = results(&model, state, ElementKind::Joint, 101);
-        worst_m3 = worst_m3.max(rev[8].abs() / (p * r));
+        worst_m3 = worst_m3.max(rev["M3"].abs() / (p * r));
         // the prismatic carries no force along its axis: the rod does
         let pri = results(&model, state, ElementKind::Joint, 104);
-        worst_f3 = worst_f3.max(pri[5].abs() / p);
+        worst_f3 = worst_f3.max(pri["F3"].abs() / p);
     }
     let moment_floor = 10.0 * f64::EPSILON * ea * (r + l) / (p * r);
     println!(
@@ -506,13 +524,13 @@ fn screw_motion(model: &Model, path: &Path, n: Id) -> Vec<(f64, f64)> {
 /// full axial force.
 fn check_screw_load(model: &Model, s: &State, force: f64, scale: f64, lead: f64) {
     let r = results(model, s, ElementKind::Joint, 101);
-    assert!((r[5] + force).abs() <= 1e-9 * scale, "F3 = {}", r[5]);
+    assert!((r["F3"] + force).abs() <= 1e-9 * scale, "F3 = {}", r["F3"]);
     assert!(
-        (r[8] + lead * r[5]).abs() <= 1e-9 * scale * lead,
+        (r["M3"] + lead * r["F3"]).abs() <= 1e-9 * scale * lead,
         "M3 = {}",
-        r[8]
+        r["M3"]
     );
-    let others = [r[3], r[4], r[6], r[7]];
+    let others = [r["F1"], r["F2"], r["M1"], r["M2"]];
     assert!(others.iter().all(|v| v.abs() <= 1e-9 * scale), "{others:?}");
 }
 
@@ -556,9 +574,9 @@ fn helical_joint_advances_by_pitch_per_turn() {
         worst = worst.max((u - lead * theta).abs() / (lead * 5.0 * PI));
         // joint coordinates: (angle, slide) = (θ, u)
         let c = results(&model, s, ElementKind::Joint, 101);
-        assert!((c[0] - theta).abs() < 1e-12 && (c[1] - u).abs() < 1e-12);
+        assert!((c["angle"] - theta).abs() < 1e-12 && (c["slide"] - u).abs() < 1e-12);
         // driver torque by virtual work, at the load F·t
-        let q = results(&model, s, ElementKind::Driver, 201)[2];
+        let q = results(&model, s, ElementKind::Driver, 201)["load"];
         let tau = -force * time * lead;
         assert!(
             (q - tau).abs() <= 1e-9 * (force * lead).abs(),
@@ -766,18 +784,18 @@ fn revolute_joint_spring_carries_the_axial_moment() {
         let iterations: Vec<usize> = path.infos[1..].iter().map(|i| i.iterations).collect();
         println!(
             "{name}: θ = {:.15} (expected {expected:.15}), hinge node {theta:.15}, spring {:.12}, joint M3 {:.1e}, |F| {:.1e}, |M| {:.1e}; iterations {iterations:?}",
-            joint[0],
-            spring[2],
-            joint[8],
+            joint["angle"],
+            spring["spring"],
+            joint["M3"],
             fj.norm(),
             mj.norm()
         );
-        assert!((joint[0] - expected).abs() < 1e-10);
+        assert!((joint["angle"] - expected).abs() < 1e-10);
         assert!((theta - expected).abs() < 1e-10);
-        assert!((spring[0] - joint[0]).abs() < 1e-14);
-        assert!((spring[2] - moment).abs() < 1e-9 * moment);
-        assert!(joint[8].abs() < 1e-9 * moment);
-        assert!((joint[8] - spring[2] + moment).abs() < 1e-9 * moment);
+        assert!((spring["coordinate"] - joint["angle"]).abs() < 1e-14);
+        assert!((spring["spring"] - moment).abs() < 1e-9 * moment);
+        assert!(joint["M3"].abs() < 1e-9 * moment);
+        assert!((joint["M3"] - spring["spring"] + moment).abs() < 1e-9 * moment);
         assert!(fj.norm() < 1e-9 * moment && mj.norm() < 1e-9 * moment);
     }
 }
@@ -862,8 +880,8 @@ fn universal_joint_follows_the_cardan_law() {
         let out = model.node_index(2).unwrap();
         let (mut worst, mut previous) = (0.0f64, 0.0);
         for s in &path.states {
-            let phi1 = results(&model, s, ElementKind::Joint, 101)[0];
-            let phi2 = results(&model, s, ElementKind::Joint, 102)[0];
+            let phi1 = results(&model, s, ElementKind::Joint, 101)["angle"];
+            let phi2 = results(&model, s, ElementKind::Joint, 102)["angle"];
             previous = angle_about(&s.q[out], &Vec3::from(u), previous);
             let formula = law(phi1, cb);
             let expected = phi1 + (formula - phi1 + PI).rem_euclid(TAU) - PI;
@@ -874,7 +892,7 @@ fn universal_joint_follows_the_cardan_law() {
         let iterations: Vec<usize> = path.infos[1..].iter().map(|i| i.iterations).collect();
         println!("{name}: |φ₂ − law| ≤ {worst:.2e} rad over a turn; iterations {iterations:?}");
         let last = path.states.last().unwrap();
-        let phi1 = results(&model, last, ElementKind::Joint, 101)[0];
+        let phi1 = results(&model, last, ElementKind::Joint, 101)["angle"];
         assert!((phi1 - TAU).abs() < 1e-10, "input at {phi1}");
         assert!(worst < 1e-8);
     }
@@ -969,7 +987,7 @@ fn prismatic_cylindrical_planar_carry_constrained_loads() {
         // each spring carries the load along its coordinate
         let mut ds = 0.0f64;
         for (k, (coordinate, _)) in springs.iter().enumerate() {
-            let fs = results(&model, s, ElementKind::JointSpring, 301 + k as u64)[2];
+            let fs = results(&model, s, ElementKind::JointSpring, 301 + k as u64)["spring"];
             let expected = match *coordinate {
                 "slide" => f.dot(&e3),
                 "slide1" => f.dot(&e1),
@@ -1114,22 +1132,22 @@ fn slider_follows_a_circular_spline() {
     let n = model.node_index(1).unwrap();
     let (mut on_spline, mut on_circle, mut along, mut driver) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     // the node starts on the curve node at 0°, two chords along the curve
-    let s0 = results(&model, &path.states[0], ElementKind::Joint, 101)[0];
+    let s0 = results(&model, &path.states[0], ElementKind::Joint, 101)["s"];
     assert!((s0 - 2.0 * len).abs() < 1e-12, "s0 = {s0}");
     let mut last_s = f64::NEG_INFINITY;
     for st in &path.states {
         let x = st.x[n];
         let joint = results(&model, st, ElementKind::Joint, 101);
-        let s = joint[0];
+        let s = joint["s"];
         assert!(s > last_s, "s does not increase: {s} after {last_s}");
         last_s = s;
         let (c, dc) = catmull_rom(&nodes, s);
         on_spline = on_spline.max((x - c).norm() / r);
         on_circle = on_circle.max((x.norm() - r).abs() / r);
         // the slider's load on the node, in its (fixed) material axes
-        let reaction = Vec3::new(joint[3], joint[4], joint[5]);
+        let reaction = Vec3::new(joint["F1"], joint["F2"], joint["F3"]);
         along = along.max(reaction.dot(&dc).abs() / (dc.norm() * f.norm()));
-        let q = results(&model, st, ElementKind::Driver, 201)[2];
+        let q = results(&model, st, ElementKind::Driver, 201)["load"];
         driver = driver.max((q + f.dot(&dc) / d.dot(&dc)).abs() / f.norm());
     }
     let end = path.states.last().unwrap().x[n];

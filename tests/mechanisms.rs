@@ -117,8 +117,9 @@ fn carried(model: &Model, state: &State, n: usize, p: &Vec3) -> Vec3 {
     state.x[n] + so3::matrix(&state.q[n]) * (p - model.reference_x[n])
 }
 
-/// Result `k` (`c1`, `F1`, ...) of the joint or driver `id` at `state`.
-fn result(model: &Model, state: &State, kind: ElementKind, id: Id, k: usize) -> f64 {
+/// Result `name` (`angle`, `slide`, `F1`, ...; `coordinate` of a driver)
+/// of the joint or driver `id` at `state`.
+fn result(model: &Model, state: &State, kind: ElementKind, id: Id, name: &str) -> f64 {
     let e = model
         .elements
         .iter()
@@ -130,7 +131,8 @@ fn result(model: &Model, state: &State, kind: ElementKind, id: Id, k: usize) -> 
         state,
         &mut out,
     );
-    out[k]
+    let k = e.result_names().iter().position(|n| *n == name);
+    out[k.unwrap_or_else(|| panic!("{} {id} has no result {name}", kind.name()))]
 }
 
 /// Number of constraint equations found redundant in the reference
@@ -289,7 +291,7 @@ fn four_bar_rocker_follows_freudenstein() {
         theta4_prev = theta4;
         max_rocker = max_rocker.max((theta4 - near(reference, theta4)).abs());
         // the joint coordinate of the rocker joint is the rocker's rotation
-        let c = result(&model, s, ElementKind::Joint, 4, 0);
+        let c = result(&model, s, ElementKind::Joint, 4, "angle");
         max_coord = max_coord.max((c - (theta4 - theta4_0)).abs());
         // the motion stays in its plane
         for n in 0..model.n_nodes() {
@@ -319,12 +321,12 @@ fn four_bar_rocker_follows_freudenstein() {
 
     // after the turn: crank coordinate 2π (unwrapped), everything back home
     let last = path.states.last().unwrap();
-    let crank_coordinate = result(&model, last, ElementKind::Joint, 1, 0);
+    let crank_coordinate = result(&model, last, ElementKind::Joint, 1, "angle");
     assert!(
         (crank_coordinate - TAU).abs() <= LIMIT,
         "crank coordinate {crank_coordinate}"
     );
-    let driven = result(&model, last, ElementKind::Driver, 10, 0);
+    let driven = result(&model, last, ElementKind::Driver, 10, "coordinate");
     assert!((driven - TAU).abs() <= LIMIT, "driver coordinate {driven}");
     assert!(
         (theta4_prev - theta4_0).abs() <= LIMIT,
@@ -423,7 +425,7 @@ fn slider_crank_follows_closed_form() {
         max_x = max_x.max((s.x[slider].x - slider_x(theta)).abs() / l);
         max_y = max_y.max((s.x[slider].y + e).abs() / l);
         slides.push((
-            result(&model, s, ElementKind::Joint, 4, 0),
+            result(&model, s, ElementKind::Joint, 4, "slide"),
             s.x[slider].x - x0,
         ));
     }
@@ -637,7 +639,7 @@ fn bricard_linkage_turns_through_its_cycle() {
             max_axis = max_axis.max(misalignment);
             // joint angle relative to the reference, unwrapped
             turns[i] = near(angle, turns[i]);
-            let c = result(&model, s, ElementKind::Joint, i as Id + 1, 0);
+            let c = result(&model, s, ElementKind::Joint, i as Id + 1, "angle");
             max_coord = max_coord.max((c - turns[i]).abs());
         }
         // threefold symmetry and the input-output relation

@@ -50,11 +50,10 @@ fn locks(s: &serde_json::Value) -> Vec<f64> {
 /// The angle of each active hinge (joints 2, 3, 4) at the last step.
 fn final_angles(out: &Path) -> Vec<f64> {
     let text = std::fs::read_to_string(out.join("joints.csv")).unwrap();
-    let rows: Vec<Vec<&str>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let angle = header.iter().position(|c| *c == "angle").unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     let last = rows.last().unwrap()[0];
     [2, 3, 4]
         .iter()
@@ -63,7 +62,7 @@ fn final_angles(out: &Path) -> Vec<f64> {
                 .iter()
                 .find(|r| r[0] == last && r[2] == j.to_string())
                 .unwrap();
-            r[3].parse().unwrap()
+            r[angle].parse().unwrap()
         })
         .collect()
 }

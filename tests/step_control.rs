@@ -156,7 +156,7 @@ fn a_driver_handing_over_has_the_rank_analysed_again() {
         log.notes
     );
 
-    let hinge_angle = |s: &State| model.results(hinge, s).get("c1").unwrap();
+    let hinge_angle = |s: &State| model.results(hinge, s).get("angle").unwrap();
     let driver = |d: DriverHandle, s: &State, what: &str| model.results(d, s).get(what).unwrap();
     let (hub, end) = (model.node(hub), model.node(end));
     let mut at_half = false;

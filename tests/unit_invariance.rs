@@ -167,7 +167,7 @@ fn a_ball_on_a_stop_takes_the_same_steps_in_mm_as_in_m() {
         let (out, _) = run_text(&dir, &ball_on_stop(units));
         let s = summary(&out);
         let d = &s["analyses"][0]["dynamic"];
-        let stroke = column(&out.join("joints.csv"), "c1");
+        let stroke = column(&out.join("joints.csv"), "slide");
         runs.push((
             d["steps"].as_u64().unwrap(),
             d["impacts"].as_u64().unwrap(),

@@ -169,7 +169,7 @@ fn a_spring_latch_inside_its_band_carries_its_dashpot_load_with_contact_0() {
     let mut dashpot_only = 0;
     for r in &latched {
         let x = num(r, "coordinate") - std::f64::consts::FRAC_PI_2;
-        let rate = num(&joints[&r["step"]], "c1_rate");
+        let rate = num(&joints[&r["step"]], "angle_rate");
         let spring = if x > h {
             k * (x - h)
         } else if x < -h {

@@ -286,6 +286,30 @@ fn the_page_holds_the_steps_fields_histories_and_events_of_the_run() {
         .unwrap();
     assert_eq!(latches["entity"], "latch");
     assert_eq!(latches["entities"][0]["id"], 32);
+    // the hinge's, named by its type, its angle a series and its type not
+    let joints = m["histories"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["file"] == "joints.csv")
+        .unwrap();
+    assert_eq!(joints["entity"], "joint");
+    let hinge = &joints["entities"][0];
+    assert_eq!(
+        (&hinge["id"], &hinge["type"]),
+        (&30.into(), &"revolute".into())
+    );
+    let columns: Vec<&str> = hinge["series"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["column"].as_str().unwrap())
+        .collect();
+    assert!(
+        columns.contains(&"angle") && columns.contains(&"M3"),
+        "{columns:?}"
+    );
+    assert!(!columns.contains(&"type"), "{columns:?}");
 
     // the lock, as events.csv has it
     let events = m["events"].as_array().unwrap();
@@ -612,7 +636,7 @@ fn the_page_runs_in_a_headless_browser() {
         &browser,
         &profile("dom"),
         "--dump-dom",
-        &url("t=end&field=M3"),
+        &url("t=end&field=M3&history=joints.csv:30:angle"),
     );
 
     // loads, with no script error, at the frame asked for
@@ -640,6 +664,10 @@ fn the_page_runs_in_a_headless_browser() {
         .collect();
     let (x0, y0, w, h) = (canvas[0], canvas[1], canvas[2], canvas[3]);
     assert!(w > 300 && h > 300, "{canvas:?}");
+    // the hinge's angle plotted, the hinge named by its type
+    for text in [">joint 30 (revolute)<", "angle (joint 30, revolute)"] {
+        assert!(dom.contains(text), "the page lacks {text:?}");
+    }
 
     // the view drawn in each picture
     let pictures: Vec<Picture> = shots.iter().map(|png| Picture::read(png)).collect();

@@ -12,7 +12,7 @@
 //
 // Address fragment (for links and tests): #t=0.5 or #t=end, #frame=12 or
 // #frame=last, #field=M3 (or none), #history=energies.csv:kinetic or
-// joints.csv:23:c1, #range=frame (colours over the step shown),
+// joints.csv:23:angle, #range=frame (colours over the step shown),
 // #surfaces=see-through, #size=1 (tube size, log2 steps), #play. Without t
 // or frame the page starts playing from the first frame.
 //
@@ -652,7 +652,7 @@ class History {
     const f = this.files[k];
     this.entitySelect.innerHTML = '';
     f.entities.forEach((e, i) => {
-      this.entitySelect.add(new Option(f.entity ? `${f.entity} ${e.id}` : '–', i));
+      this.entitySelect.add(new Option(f.entity ? `${f.entity} ${e.id}${e.type ? ` (${e.type})` : ''}` : '–', i));
     });
     this.entitySelect.hidden = !f.entity;
     let i = 0;
@@ -699,7 +699,7 @@ class History {
       const v = s.min + (c / TOP) * (s.max - s.min);
       return s.log ? 10 ** v : v;
     });
-    const label = `${s.column}${f.entity ? ` (${f.entity} ${e.id})` : ''}`;
+    const label = `${s.column}${f.entity ? ` (${f.entity} ${e.id}${e.type ? `, ${e.type}` : ''})` : ''}`;
     const chart = document.getElementById('chart');
     if (this.plot) this.plot.destroy();
     const app = this.app;

@@ -44,7 +44,11 @@ pub struct ElementHistory {
     pub id: Id,
     /// Its index among the model's elements.
     pub index: usize,
-    /// The names of its results (the columns of its result file).
+    /// A joint's type (`revolute`...), as the column `type` of
+    /// `joints.csv`; `None` for other elements.
+    pub joint_type: Option<&'static str>,
+    /// The names of its results (columns of its result file: a joint's
+    /// coordinates by name, `angle`, `slide`..., then its loads).
     pub names: &'static [&'static str],
     /// Steps × names, by rows.
     pub values: Vec<f64>,
@@ -151,6 +155,7 @@ impl Recorded {
                 kind: e.kind(),
                 id: e.id(),
                 index,
+                joint_type: e.as_joint().map(|j| j.joint_type().name()),
                 names: e.result_names(),
                 values: Vec::new(),
             })

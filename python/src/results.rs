@@ -51,7 +51,8 @@ fn array2<'py>(py: Python<'py>, values: &[f64], cols: usize) -> Bound<'py, PyArr
 
 /// The history of one element over the output steps: `names` (the
 /// columns of its result file, docs/results.md) and `values`
-/// (steps × names); `history["Fz"]` is one column.
+/// (steps × names); `history["Fz"]` is one column, `history["angle"]` a
+/// joint's angle.
 #[pyclass(name = "ElementHistory", module = "unfold", frozen)]
 pub struct PyElementHistory {
     history: ElementHistory,
@@ -72,14 +73,24 @@ impl PyElementHistory {
         self.history.id
     }
 
-    /// The names of its results.
+    /// A joint's type (`revolute`, `prismatic`...), as the column `type`
+    /// of `joints.csv`; `None` for the other elements.
+    #[getter]
+    fn joint_type(&self) -> Option<&'static str> {
+        self.history.joint_type
+    }
+
+    /// The names of its results: those of its columns in its result file
+    /// (a joint's own coordinates, `angle`, `slide`, `slide1`, `slide2`,
+    /// `angle1`, `angle2` or `s`, then its loads `F1` … `Mz`).
     #[getter]
     fn names(&self) -> Vec<&'static str> {
         self.history.names.to_vec()
     }
 
-    /// Steps × names (NaN for a quantity it does not have, as the empty
-    /// cells of its result file).
+    /// Steps × names (NaN for a quantity it does not have at a step, as
+    /// the empty cells of its result file: the target of a released
+    /// driver).
     #[getter]
     fn values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         array2(py, &self.history.values, self.history.names.len())
@@ -111,8 +122,12 @@ impl PyElementHistory {
     }
 
     fn __repr__(&self) -> String {
+        let joint_type = self
+            .history
+            .joint_type
+            .map_or(String::new(), |t| format!(" ({t})"));
         format!(
-            "ElementHistory({} {}: {} steps of {})",
+            "ElementHistory({} {}{joint_type}: {} steps of {})",
             self.history.kind.name(),
             self.history.id,
             self.steps,
@@ -472,7 +487,8 @@ impl PyResults {
 
     /// The results of every element of `kind` kept: `(ids, names,
     /// values)` with values steps × elements × names (NaN where a
-    /// quantity is absent).
+    /// quantity is absent: a coordinate the joint does not have), the
+    /// names those of the columns of its result file.
     #[allow(clippy::type_complexity)]
     fn table<'py>(
         &self,
@@ -486,11 +502,7 @@ impl PyResults {
             .iter()
             .filter(|h| h.kind == kind)
             .collect();
-        let names: Vec<&'static str> = hs
-            .iter()
-            .max_by_key(|h| h.names.len())
-            .map(|h| h.names.to_vec())
-            .unwrap_or_default();
+        let names = kind.result_columns(hs.iter().map(|h| h.names));
         let width = names.len();
         let steps = self.steps();
         let mut values = vec![f64::NAN; steps * hs.len() * width];

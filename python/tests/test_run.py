@@ -59,6 +59,45 @@ def test_rollup_arrays_match_the_result_files(tmp_path):
     assert summary["status"] == "completed" and summary["output_steps"] == steps
 
 
+def test_joint_results_are_named_as_the_columns_of_joints_csv(tmp_path):
+    # three revolute joints and a prismatic one: joints.csv has `angle`
+    # and `slide`, each joint's row empty in the coordinate it lacks
+    model = unfold.load_model(EXAMPLES / "slider_crank.toml")
+    results = model.run(out=tmp_path)
+    with open(tmp_path / "joints.csv") as f:
+        header = f.readline().strip().split(",")
+    assert header[:6] == ["step", "time", "joint", "type", "angle", "slide"]
+    ids, names, values = results.table("joint")
+    assert names == header[4:]
+    assert ids == [1, 2, 3, 4]
+    rows = read_csv(tmp_path / "joints.csv")
+    assert len(rows) == len(results) * len(ids)
+    for j in ids:
+        h = results.element(("joint", j))
+        mine = [r for r in rows if int(r["joint"]) == j]
+        assert h.joint_type == mine[0]["type"] == ("prismatic" if j == 4 else "revolute")
+        coordinate = "slide" if j == 4 else "angle"
+        other = "angle" if j == 4 else "slide"
+        # its own coordinate, then the loads, as the file names them
+        assert h.names == [coordinate] + header[6:]
+        assert other not in h
+        with pytest.raises(KeyError, match=f'no result named "{other}"'):
+            h[other]
+        e = ids.index(j)
+        for s, row in enumerate(mine):
+            assert row[other] == ""
+            assert np.isnan(values[s, e, names.index(other)])
+            for name in h.names:
+                v = float(row[name])
+                assert abs(v - h[name][s]) <= 1e-9 * max(1.0, abs(v)), (j, name, v)
+                assert values[s, e, names.index(name)] == h[name][s]
+    # the crank turns once, driven: its angle goes from 0 to 2π, and the
+    # slider is back where it started
+    crank, slider = results.element(("joint", 1)), results.element(("joint", 4))
+    assert crank["angle"][0] == 0.0 and abs(crank["angle"][-1] - 2 * math.pi) < 1e-9
+    assert abs(slider["slide"][-1]) < 1e-9 < np.max(np.abs(slider["slide"]))
+
+
 def test_dynamics_energies_and_events_match_the_files(tmp_path):
     model = unfold.load_model(EXAMPLES / "bar_drop.toml")
     results = model.run(out=tmp_path)

@@ -454,10 +454,18 @@ def model_from_toml(text: str, name: str = "model.toml") -> Model: ...
 def model_from_dict(d: Dict[str, Any]) -> Model: ...
 
 class ElementHistory:
+    """The results of one element at each output step, named as the
+    columns of its result file: a joint's coordinates by name (`angle`,
+    `slide`, `slide1`, `slide2`, `angle1`, `angle2`, `s`: those of its
+    type), then its loads `F1` … `Mz`; `history["angle"]` is a column."""
     @property
     def kind(self) -> str: ...
     @property
     def id(self) -> int: ...
+    @property
+    def joint_type(self) -> Optional[str]:
+        """A joint's type (`revolute`...), as the `type` column of
+        `joints.csv`; None for the other elements."""
     @property
     def names(self) -> List[str]: ...
     @property

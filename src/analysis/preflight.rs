@@ -36,7 +36,7 @@ use super::observers::History;
 use super::settings::{DynamicSettings, StaticSettings};
 use super::statics::StaticError;
 use crate::dofs::DofKind;
-use crate::elements::ElementKind;
+use crate::elements::{Element, ElementKind};
 use crate::linalg::{smallest_relative_pivot, SparseLu};
 use crate::model::{Model, ModelWarning};
 use crate::state::State;
@@ -214,8 +214,8 @@ fn singular_direction(
     }
 }
 
-/// The joints whose coordinates (`c1`–`c3` of their results) the motion
-/// `direction` (by equation) moves, largest first, at most
+/// The joints whose coordinates ([`crate::joints::Joint::coordinates`])
+/// the motion `direction` (by equation) moves, largest first, at most
 /// [`FREE_JOINTS_NAMED`]: `direction` scaled to a turn of 1e-6 rad (or a
 /// translation of 1e-6 of the model size) at its largest, a joint whose
 /// coordinate changes by more than 1e-2 of that (in radians or model
@@ -252,26 +252,20 @@ fn moving_joints(
         .collect();
     let mut moved = state.clone();
     moved.update(dofs, &step);
-    let ctx = model.context(state.time, crate::elements::Need::RESIDUAL);
     let mut found: Vec<(f64, String)> = Vec::new();
     let (mut before, mut after) = ([0.0; 3], [0.0; 3]);
-    for el in model
-        .elements
-        .iter()
-        .filter(|el| el.kind() == ElementKind::Joint)
-    {
-        before.fill(f64::NAN);
-        after.fill(f64::NAN);
-        el.results(&ctx, state, &mut before);
-        el.results(&ctx, &moved, &mut after);
-        let change = before
+    for j in model.elements.iter().filter_map(|el| el.as_joint()) {
+        let n = j.joint_type().coordinates().len();
+        j.coordinates(state, &mut before[..n]);
+        j.coordinates(&moved, &mut after[..n]);
+        let change = before[..n]
             .iter()
-            .zip(&after)
+            .zip(&after[..n])
             .filter(|(b, a)| b.is_finite() && a.is_finite())
             .map(|(b, a)| (a - b).abs())
             .fold(0.0f64, f64::max);
         if change > 1e-2 * 1e-6 {
-            found.push((change, format!("joint {}", el.id())));
+            found.push((change, format!("joint {}", j.id())));
         }
     }
     found.sort_by(|a, b| b.0.total_cmp(&a.0));

@@ -167,6 +167,33 @@ impl ElementKind {
         }
     }
 
+    /// The result columns of the file of this kind (after its id column)
+    /// for elements reporting `names` (their
+    /// [`super::Element::result_names`]): every name any of them reports,
+    /// once. A joint reports its own coordinates only: the columns of
+    /// joints are those of its joints in the order of
+    /// [`crate::joints::joint::JOINT_COLUMNS`] (docs/results.md). The
+    /// elements of every other kind report the same names.
+    pub fn result_columns<'a>(
+        self,
+        names: impl IntoIterator<Item = &'a [&'static str]>,
+    ) -> Vec<&'static str> {
+        let mut columns: Vec<&'static str> = Vec::new();
+        for list in names {
+            for name in list {
+                if !columns.contains(name) {
+                    columns.push(name);
+                }
+            }
+        }
+        if self == Self::Joint {
+            use crate::joints::joint::JOINT_COLUMNS;
+            let place = |n: &&str| JOINT_COLUMNS.iter().position(|c| c == n);
+            columns.sort_by_key(|n| place(n).unwrap_or(JOINT_COLUMNS.len()));
+        }
+        columns
+    }
+
     /// The VTK cell arrays filled from the results of this kind.
     pub fn cell_fields(self) -> &'static [CellField] {
         const BEAM: [CellField; 6] = [

@@ -306,6 +306,12 @@ pub trait Element: Send + Sync {
         true
     }
 
+    /// The element as a joint of the joint library, for its type and
+    /// coordinates in the outputs (`joints.csv`, docs/results.md).
+    fn as_joint(&self) -> Option<&crate::joints::Joint> {
+        None
+    }
+
     /// The element as a latch, for the analyses that lock latches
     /// (docs/joints.md §6.2).
     fn as_latch(&self) -> Option<&crate::joints::Latch> {

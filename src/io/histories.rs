@@ -4,9 +4,10 @@
 //! the energies of a dynamic analysis with its balance error on a chart
 //! of its own.
 //!
-//! The files are read as `unfold run` writes them (docs/results.md);
-//! which coordinates are angles and which joint each spring, law, latch
-//! and driver acts on is read from the model file named in
+//! The files are read as `unfold run` writes them (docs/results.md): the
+//! type of each joint and its coordinates from `joints.csv` (its columns
+//! `type`, `angle`, `slide`...); which joint and coordinate each spring,
+//! law, latch and driver acts on from the model file named in
 //! `summary.json` (or given). The instants at which latches lock (the
 //! first step with `locked = 1` in `latches.csv`) and the events of
 //! `events.csv`, when the run wrote one, are vertical lines on the charts
@@ -501,8 +502,9 @@ pub struct Histories {
 
 impl Histories {
     /// Reads the result files in `dir`; `model` is the model file that
-    /// says which coordinates are angles (default: the one named in
-    /// `summary.json`, relative to the current directory if relative).
+    /// says which joint coordinate each spring, law, latch and driver acts
+    /// on (default: the one named in `summary.json`, relative to the
+    /// current directory if relative).
     pub fn read(dir: &Path, model: Option<&Path>) -> Result<Self, HistoryError> {
         if !dir.is_dir() {
             return Err(HistoryError::NoDirectory(dir.to_path_buf()));
@@ -559,7 +561,11 @@ impl Histories {
     /// not found, so angles and lengths are not told apart.
     pub fn notes(&self) -> Vec<String> {
         let mut notes = Vec::new();
-        let has_coordinates = self.joints.is_some()
+        // joints.csv names its coordinates and the type of each joint
+        let has_coordinates = self
+            .joints
+            .as_ref()
+            .is_some_and(|t| t.find("type").is_none())
             || self.joint_springs.is_some()
             || self.hinge_laws.is_some()
             || self.latches.is_some();
@@ -571,7 +577,7 @@ impl Histories {
                     format!("{} cannot be read", p.display())
                 });
             notes.push(format!(
-                "model file unknown ({which}; give it with --model): coordinates are plotted as the files give them, angles in rad and slides in length units, without telling them apart"
+                "model file unknown ({which}; give it with --model): the loads of joint springs, hinge laws, latches and drivers are drawn on one chart as the files give them, moments and forces (along angles in rad and slides in length units) without telling them apart"
             ));
         }
         notes
@@ -969,7 +975,34 @@ impl Histories {
         }
     }
 
-    /// One chart per joint and kind of coordinate (angles, lengths).
+    /// The type of each joint of `joints.csv`: its column `type`, or the
+    /// model file's for a file without one.
+    fn joint_types(&self, t: &Table) -> Result<BTreeMap<Id, JointType>, HistoryError> {
+        let Some(c) = t.find("type") else {
+            return Ok(self
+                .coordinates
+                .as_ref()
+                .map(|c| c.joints.clone())
+                .unwrap_or_default());
+        };
+        let id = t.column("joint")?;
+        let mut types = BTreeMap::new();
+        for r in 0..t.rows.len() {
+            let (line, fields) = &t.rows[r];
+            let name = &fields[c];
+            let kind = JointType::from_name(name).ok_or_else(|| HistoryError::Malformed {
+                path: t.path.clone(),
+                line: *line,
+                message: format!("column `type`: {name:?} is not a joint type"),
+            })?;
+            types.insert(t.id(r, id)?, kind);
+        }
+        Ok(types)
+    }
+
+    /// One chart per joint and kind of coordinate (angles, lengths): the
+    /// columns of `joints.csv` named after its coordinates (`angle`,
+    /// `slide`...; [`Coordinate::name`]).
     fn joint_figures(
         &self,
         request: &Request,
@@ -978,78 +1011,66 @@ impl Histories {
         let Some(t) = &self.joints else {
             return Ok(Vec::new());
         };
-        let names: Vec<&str> = ["c1", "c2", "c3"]
+        if t.find("c1").is_some() {
+            return Err(HistoryError::Malformed {
+                path: t.path.clone(),
+                line: 1,
+                message: "columns `c1`, `c2`, `c3`: written by an earlier version of unfold, before the coordinate columns were named (`angle`, `slide`...); run the model again".into(),
+            });
+        }
+        // the coordinates that have a column, in the file's order
+        let present: Vec<Coordinate> = Coordinate::ALL
             .into_iter()
-            .filter(|c| t.find(c).is_some())
+            .filter(|c| t.find(c.name()).is_some())
             .collect();
+        let names: Vec<&str> = present.iter().map(|c| c.name()).collect();
         let histories = t.histories("joint", &names)?;
+        let types = self.joint_types(t)?;
         let x = self.time_axis(request.units);
         let mut figures = Vec::new();
         for (id, columns) in histories {
             if !chosen(id) {
                 continue;
             }
-            let kind = self
-                .coordinates
-                .as_ref()
-                .and_then(|c| c.joints.get(&id))
-                .copied();
-            let Some(kind) = kind else {
-                // coordinates of unknown kind: as in the file
-                let mut chart = Chart::new(
-                    format!("Joint {id}: coordinates"),
-                    x.clone(),
-                    Axis::new("coordinate", format!("rad or {}", request.units.length())),
-                );
-                let mut any = false;
-                for (name, points) in names.iter().zip(columns) {
-                    if has_values(&points) {
-                        chart = chart.series(Series::new(*name, points));
-                        any = true;
-                    }
-                }
-                if any {
-                    figures.push(Figure {
-                        name: format!("joint_{id}"),
-                        chart: self.with_events(chart, Some(id), request.units),
-                    });
-                }
-                continue;
+            let kind = types.get(&id).copied();
+            // the joint's coordinates (by place among `present`): those of
+            // its type, or those it has values of
+            let coords: Vec<usize> = match kind {
+                Some(kind) => kind
+                    .coordinates()
+                    .iter()
+                    .map(|c| match present.iter().position(|p| p == c) {
+                        Some(k) => Ok(k),
+                        None => t.column(c.name()),
+                    })
+                    .collect::<Result<_, _>>()?,
+                None => (0..present.len())
+                    .filter(|&k| has_values(&columns[k]))
+                    .collect(),
             };
-            let coords = kind.coordinates();
-            if coords.is_empty() {
-                continue;
-            }
-            let angles: Vec<usize> = (0..coords.len())
-                .filter(|&k| coords[k].is_angle())
-                .collect();
-            let lengths: Vec<usize> = (0..coords.len())
-                .filter(|&k| !coords[k].is_angle())
-                .collect();
+            let (angles, lengths): (Vec<usize>, Vec<usize>) =
+                coords.into_iter().partition(|&k| present[k].is_angle());
             let split = !angles.is_empty() && !lengths.is_empty();
             for (part, members) in [("angles", angles), ("lengths", lengths)] {
                 if members.is_empty() {
                     continue;
                 }
-                let first = coords[members[0]];
+                let first = present[members[0]];
                 let (unit, factor) = Self::coordinate_unit(first, request);
                 let quantity = if first.is_angle() {
                     "angle"
                 } else {
                     "displacement"
                 };
-                let what: Vec<&str> = members.iter().map(|&k| coords[k].name()).collect();
-                let mut chart = Chart::new(
-                    format!("Joint {id} ({}): {}", kind.name(), what.join(", ")),
-                    x.clone(),
-                    Axis::new(quantity, unit),
-                );
+                let what: Vec<&str> = members.iter().map(|&k| names[k]).collect();
+                let title = match kind {
+                    Some(kind) => format!("Joint {id} ({}): {}", kind.name(), what.join(", ")),
+                    None => format!("Joint {id}: {}", what.join(", ")),
+                };
+                let mut chart = Chart::new(title, x.clone(), Axis::new(quantity, unit));
                 for &k in &members {
                     let points = columns[k].iter().map(|&(t, v)| (t, v * factor));
-                    chart = chart.series(Series::new(
-                        format!("{} (c{})", coords[k].name(), k + 1),
-                        points,
-                    ));
+                    chart = chart.series(Series::new(names[k], points));
                 }
                 let name = if split {
                     format!("joint_{id}_{part}")
@@ -1407,11 +1428,11 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("unfold-histories-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("t.csv");
-        std::fs::write(&path, "step,time,joint,c1\n0,0,1,0.5\n\n1,0.1,1,abc\n").unwrap();
+        std::fs::write(&path, "step,time,joint,angle\n0,0,1,0.5\n\n1,0.1,1,abc\n").unwrap();
         let t = Table::read(&path).unwrap().unwrap();
-        let e = t.histories("joint", &["c1"]).unwrap_err().to_string();
+        let e = t.histories("joint", &["angle"]).unwrap_err().to_string();
         assert!(
-            e.ends_with("t.csv, line 4: column `c1`: \"abc\" is not a number"),
+            e.ends_with("t.csv, line 4: column `angle`: \"abc\" is not a number"),
             "{e}"
         );
         std::fs::write(&path, "step,time\n0,0,3\n").unwrap();

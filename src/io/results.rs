@@ -5,7 +5,9 @@
 //! - one table per kind of element that reports results
 //!   ([`ElementKind::results_file`]: `beams.csv`, `springs.csv`,
 //!   `joints.csv`, `drivers.csv`, `joint_springs.csv`), whose columns are
-//!   the element's [`crate::elements::Element::result_names`];
+//!   the elements' [`crate::elements::Element::result_names`]
+//!   ([`ElementKind::result_columns`]: a joint's coordinates are named,
+//!   `angle`, `slide`..., and its type is in a column `type`);
 //! - `steps.csv`: one line per output step (increment, load parameter,
 //!   iterations, final relative residual);
 //! - in a run with a dynamic analysis: `nodes_velocities.csv` (velocity,
@@ -46,6 +48,7 @@ use crate::analysis::{
     LinearSolverCounts, Observer, StaticAnalysis, StaticOutcome,
 };
 use crate::elements::{ElementKind, Need};
+use crate::joints::Coordinate;
 use crate::model::Model;
 use crate::so3::{self, Vec3};
 use crate::state::State;
@@ -776,10 +779,15 @@ impl CsvFile {
 struct ElementTable {
     kind: ElementKind,
     file: CsvFile,
-    /// Elements (indices in `model.elements`) in increasing id.
-    elements: Vec<usize>,
-    /// Number of results whose rates follow them (the joint coordinates
-    /// in a run with dynamics), 0 otherwise.
+    /// The result columns ([`ElementKind::result_columns`]), after the id
+    /// column (and a joint's `type`).
+    columns: Vec<&'static str>,
+    /// Elements (indices in `model.elements`) in increasing id, each with
+    /// the column of each of its results.
+    elements: Vec<(usize, Vec<usize>)>,
+    /// Number of columns whose rates follow the results (the joint
+    /// coordinates, the first columns of joints.csv, in a run with
+    /// dynamics), 0 otherwise.
     rates: usize,
 }
 
@@ -788,8 +796,12 @@ struct ElementTable {
 /// laws (`branch`).
 const INTEGER_RESULTS: [&str; 4] = ["locked", "contact", "closed", "branch"];
 
-/// Names of the columns of the rates of the joint coordinates.
-const COORDINATE_RATES: [&str; 3] = ["c1_rate", "c2_rate", "c3_rate"];
+/// The number of results of `e` whose rates are written in a run with
+/// dynamics: a joint's coordinates, its first results.
+fn rated_results(e: &dyn crate::elements::Element) -> usize {
+    e.as_joint()
+        .map_or(0, |j| j.joint_type().coordinates().len())
+}
 
 /// The files of a run with a dynamic analysis.
 struct MotionFiles {
@@ -857,6 +869,8 @@ pub struct ResultWriter {
     /// Result values of one element: as long as the longest list of
     /// result names of the model.
     values: Vec<f64>,
+    /// A row of a table: its result columns, then its rates.
+    row: Vec<f64>,
     pvd_file: vtk::PvdFile,
     /// Output steps written (a grid at some of them: `vtk_every`).
     output_steps: usize,
@@ -1014,8 +1028,8 @@ impl ResultWriter {
 
         let mut node_order: Vec<usize> = (0..model.n_nodes()).collect();
         node_order.sort_by_key(|&i| model.node_ids[i]);
-        // one table per kind that has results, columns named by its
-        // elements (all of a kind report the same quantities)
+        // one table per kind that has results, a column for each quantity
+        // its elements report (a joint only its own coordinates)
         let mut tables = Vec::new();
         for kind in ElementKind::ALL {
             let Some(name) = kind.results_file() else {
@@ -1024,26 +1038,48 @@ impl ResultWriter {
             let mut elements: Vec<usize> = (0..model.elements.len())
                 .filter(|&k| model.elements[k].kind() == kind)
                 .collect();
-            let Some(&first) = elements.first() else {
+            if elements.is_empty() {
                 continue;
-            };
+            }
             elements.sort_by_key(|&k| model.elements[k].id());
-            let names = model.elements[first].result_names();
-            debug_assert!(elements
-                .iter()
-                .all(|&k| model.elements[k].result_names() == names));
-            let rates = if dynamics && kind == ElementKind::Joint {
-                COORDINATE_RATES.len()
+            let columns =
+                kind.result_columns(elements.iter().map(|&k| model.elements[k].result_names()));
+            let elements: Vec<(usize, Vec<usize>)> = elements
+                .into_iter()
+                .map(|k| {
+                    let names = model.elements[k].result_names();
+                    let at = |n: &&str| columns.iter().position(|c| c == n);
+                    (k, names.iter().filter_map(at).collect())
+                })
+                .collect();
+            // the rates of the columns of the coordinates, the first ones
+            let rates = if dynamics {
+                let mut rated: Vec<usize> = elements
+                    .iter()
+                    .flat_map(|(k, at)| &at[..rated_results(&*model.elements[*k])])
+                    .copied()
+                    .collect();
+                rated.sort_unstable();
+                rated.dedup();
+                debug_assert!(rated.iter().enumerate().all(|(i, &c)| i == c));
+                rated.len()
             } else {
                 0
             };
-            let mut header = format!("step,time,{},{}", kind.id_column(), names.join(","));
-            for r in &COORDINATE_RATES[..rates] {
-                header += &format!(",{r}");
+            let mut header = format!("step,time,{}", kind.id_column());
+            if kind == ElementKind::Joint {
+                header += ",type";
+            }
+            for c in &columns {
+                header += &format!(",{c}");
+            }
+            for c in &columns[..rates] {
+                header += &format!(",{c}_rate");
             }
             tables.push(ElementTable {
                 kind,
                 file: CsvFile::create(dir.join(name), &header)?,
+                columns,
                 elements,
                 rates,
             });
@@ -1079,6 +1115,7 @@ impl ResultWriter {
             supported,
             tables,
             values: vec![0.0; longest],
+            row: Vec::new(),
             output_steps: 0,
             last_output: None,
             pvd_file: vtk::PvdFile::new(dir.join("unfold.pvd")),
@@ -1240,20 +1277,32 @@ impl ResultWriter {
         } else {
             None
         };
-        let mut rates = [0.0; COORDINATE_RATES.len()];
+        let mut rates = [0.0; Coordinate::ALL.len()];
         for table in &mut self.tables {
-            for &k in &table.elements {
-                let e = &model.elements[k];
+            self.row.clear();
+            self.row.resize(table.columns.len() + table.rates, f64::NAN);
+            let (row, row_rates) = self.row.split_at_mut(table.columns.len());
+            for (k, at) in &table.elements {
+                let e = &model.elements[*k];
                 debug_assert_eq!(e.kind(), table.kind);
                 let n = e.result_names().len();
                 let values = &mut self.values[..n];
                 values.fill(0.0);
                 e.results(&ctx, state, values);
+                // absent quantities (a coordinate the joint does not have)
+                // are empty
+                row.fill(f64::NAN);
+                for (&c, &v) in at.iter().zip(values.iter()) {
+                    row[c] = v;
+                }
                 let w = &mut table.file.pending;
                 w.push_str(&lead);
                 let _ = write!(w, "{}", e.id());
-                for (v, name) in values.iter().zip(e.result_names()) {
-                    // absent quantities (a joint with fewer coordinates) are empty
+                if table.kind == ElementKind::Joint {
+                    let t = e.as_joint().map_or("", |j| j.joint_type().name());
+                    let _ = write!(w, ",{t}");
+                }
+                for (v, name) in row.iter().zip(&table.columns) {
                     w.push(',');
                     if INTEGER_RESULTS.contains(name) && v.is_finite() {
                         // a state or a side: 0, 1, −1
@@ -1264,14 +1313,20 @@ impl ResultWriter {
                     }
                 }
                 if table.rates > 0 {
-                    let r = &mut rates[..table.rates.min(n)];
+                    row_rates.fill(f64::NAN);
+                    let r = &mut rates[..rated_results(e.as_ref()).min(n)];
                     match &moved {
                         Some(probes) => result_rates(e.as_ref(), &ctx, probes, r),
                         None => r.fill(0.0),
                     }
-                    for (v, c) in r.iter().zip(values.iter()) {
+                    for ((&c, v), value) in at.iter().zip(r.iter()).zip(values.iter()) {
+                        if !value.is_nan() {
+                            row_rates[c] = *v;
+                        }
+                    }
+                    for v in row_rates.iter() {
                         w.push(',');
-                        if !c.is_nan() {
+                        if !v.is_nan() {
                             Sci::<9>(*v + 0.0).push_to(w);
                         }
                     }

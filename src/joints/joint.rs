@@ -344,13 +344,62 @@ impl Joint {
     }
 }
 
-/// Names of joint results: three coordinates (NaN when absent), then the
+/// Names of the loads among a joint's results, after its coordinates: the
 /// load the joint applies to its first node, in the joint axes of body A
 /// (see [`Joint::reaction`] and [`Joint::axes`]), then the same load in
 /// the global axes.
-pub const JOINT_RESULTS: [&str; 15] = [
-    "c1", "c2", "c3", "F1", "F2", "F3", "M1", "M2", "M3", "Fx", "Fy", "Fz", "Mx", "My", "Mz",
+pub const JOINT_LOADS: [&str; 12] = [
+    "F1", "F2", "F3", "M1", "M2", "M3", "Fx", "Fy", "Fz", "Mx", "My", "Mz",
 ];
+
+/// The names of `coordinates` ([`Coordinate::name`]) followed by `tail`,
+/// as an array of `N` names (evaluated at compile time).
+const fn named<const N: usize>(
+    coordinates: &[Coordinate],
+    tail: &[&'static str],
+) -> [&'static str; N] {
+    assert!(coordinates.len() + tail.len() == N);
+    let mut out = [""; N];
+    let mut k = 0;
+    while k < coordinates.len() {
+        out[k] = coordinates[k].name();
+        k += 1;
+    }
+    while k < N {
+        out[k] = tail[k - coordinates.len()];
+        k += 1;
+    }
+    out
+}
+
+/// Every column of a joint's results, in the order of `joints.csv`: the
+/// coordinates of [`Coordinate::ALL`], then [`JOINT_LOADS`]. A file (and
+/// a table of joints) has those of its joints.
+pub const JOINT_COLUMNS: [&str; 19] = named(&Coordinate::ALL, &JOINT_LOADS);
+
+/// Names of the results of a joint of type `t`: its coordinates by name
+/// (`angle`, `slide`...; [`JointType::coordinates`]), then
+/// [`JOINT_LOADS`].
+pub fn result_names(t: JointType) -> &'static [&'static str] {
+    use JointType::*;
+    const REVOLUTE: [&str; 13] = named(Revolute.coordinates(), &JOINT_LOADS);
+    const PRISMATIC: [&str; 13] = named(Prismatic.coordinates(), &JOINT_LOADS);
+    const CYLINDRICAL: [&str; 14] = named(Cylindrical.coordinates(), &JOINT_LOADS);
+    const HELICAL: [&str; 14] = named(Helical.coordinates(), &JOINT_LOADS);
+    const PLANAR: [&str; 15] = named(Planar.coordinates(), &JOINT_LOADS);
+    const UNIVERSAL: [&str; 14] = named(Universal.coordinates(), &JOINT_LOADS);
+    const SLIDER: [&str; 13] = named(Slider.coordinates(), &JOINT_LOADS);
+    match t {
+        Revolute => &REVOLUTE,
+        Prismatic => &PRISMATIC,
+        Cylindrical => &CYLINDRICAL,
+        Helical => &HELICAL,
+        Planar => &PLANAR,
+        Universal => &UNIVERSAL,
+        Slider => &SLIDER,
+        Spherical | Rigid | Glue => &JOINT_LOADS,
+    }
+}
 
 impl Element for Joint {
     fn kind(&self) -> ElementKind {
@@ -431,21 +480,24 @@ impl Element for Joint {
         }
     }
     fn result_names(&self) -> &'static [&'static str] {
-        &JOINT_RESULTS
+        result_names(self.joint_type)
     }
-    /// Fills the first `out.len()` values of [`JOINT_RESULTS`].
+    /// Fills the first `out.len()` values of [`result_names`].
     fn results(&self, ctx: &EvalContext, state: &State, out: &mut [f64]) {
-        let mut all = [f64::NAN; JOINT_RESULTS.len()];
-        self.coordinates(state, &mut all[..3]);
+        let nc = self.joint_type.coordinates().len();
+        let mut all = [f64::NAN; JOINT_COLUMNS.len()];
+        self.coordinates(state, &mut all[..nc]);
         let (f, m) = self.reaction(ctx, state);
         let e = self.axes(state);
         let (fl, ml) = (e.transpose() * f, e.transpose() * m);
-        all[3..6].copy_from_slice(fl.as_slice());
-        all[6..9].copy_from_slice(ml.as_slice());
-        all[9..12].copy_from_slice(f.as_slice());
-        all[12..15].copy_from_slice(m.as_slice());
-        let n = out.len().min(all.len());
+        for (k, v) in [fl, ml, f, m].iter().enumerate() {
+            all[nc + 3 * k..nc + 3 * k + 3].copy_from_slice(v.as_slice());
+        }
+        let n = out.len().min(nc + JOINT_LOADS.len());
         out[..n].copy_from_slice(&all[..n]);
+    }
+    fn as_joint(&self) -> Option<&Joint> {
+        Some(self)
     }
     /// The joint point and axes of body A (unless it is the ground) and
     /// of body B; a slider's joint point on its sliding node.

@@ -41,6 +41,25 @@ pub enum JointType {
 }
 
 impl JointType {
+    /// Every joint type.
+    pub const ALL: [JointType; 10] = [
+        Self::Revolute,
+        Self::Prismatic,
+        Self::Cylindrical,
+        Self::Spherical,
+        Self::Planar,
+        Self::Universal,
+        Self::Helical,
+        Self::Slider,
+        Self::Rigid,
+        Self::Glue,
+    ];
+
+    /// The type named `name` ([`Self::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|t| t.name() == name)
+    }
+
     /// Name used in files and messages.
     pub fn name(self) -> &'static str {
         match self {
@@ -57,8 +76,9 @@ impl JointType {
         }
     }
 
-    /// Relative coordinates the joint exposes.
-    pub fn coordinates(self) -> &'static [Coordinate] {
+    /// Relative coordinates the joint exposes, in the order of its
+    /// results ([`crate::joints::joint::result_names`]).
+    pub const fn coordinates(self) -> &'static [Coordinate] {
         use Coordinate::*;
         match self {
             Self::Revolute => &[Angle],
@@ -130,13 +150,30 @@ pub enum Coordinate {
 }
 
 impl Coordinate {
+    /// Every coordinate, in the order of the columns of `joints.csv`
+    /// (docs/results.md): the angle of the revolute-like joints, the slide
+    /// along their axis, the planar joint's in-plane slides, the universal
+    /// joint's two angles, the slider's curve parameter.
+    pub const ALL: [Coordinate; 7] = [
+        Self::Angle,
+        Self::Slide3,
+        Self::Slide1,
+        Self::Slide2,
+        Self::Cardan1,
+        Self::Cardan2,
+        Self::CurveParameter,
+    ];
+
     /// Whether the coordinate is an angle (unwrapped across turns).
     pub fn is_angle(self) -> bool {
         matches!(self, Self::Angle | Self::Cardan1 | Self::Cardan2)
     }
 
-    /// Name in files and outputs.
-    pub fn name(self) -> &'static str {
+    /// Name in model files (`coordinate = "slide"`), messages and result
+    /// files: the column of `joints.csv` and of the joints' results
+    /// ([`crate::model::Model::results`], Python), `<name>_rate` for its
+    /// rate in dynamics.
+    pub const fn name(self) -> &'static str {
         match self {
             Self::Angle => "angle",
             Self::Slide1 => "slide1",

@@ -251,10 +251,10 @@ pub struct ElementResults {
 }
 
 impl ElementResults {
-    /// The quantity named `name` (as in the header of the result file);
-    /// `None` if the element has no such quantity, or it is absent (a
-    /// coordinate the joint does not have, the target of a released
-    /// driver).
+    /// The quantity named `name` (as in the header of the result file:
+    /// `angle`, `slide`... for a joint's coordinates); `None` if the
+    /// element has no such quantity (a coordinate its joint type does not
+    /// have), or it is absent (the target of a released driver).
     pub fn get(&self, name: &str) -> Option<f64> {
         let i = self.names.iter().position(|n| *n == name)?;
         Some(self.values[i]).filter(|v| !v.is_nan())

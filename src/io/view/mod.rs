@@ -879,12 +879,18 @@ fn histories(
             .get(time + 1)
             .filter(|h| ID_COLUMNS.contains(&h.as_str()))
             .map(|_| time + 1);
+        // a column of text, a joint's `type`, says what the entity is
+        let label = entity.and_then(|_| table.find("type"));
         let skip = |c: usize| {
-            c == step || c == time || Some(c) == entity || table.header[c] == "increment"
+            c == step
+                || c == time
+                || Some(c) == entity
+                || Some(c) == label
+                || table.header[c] == "increment"
         };
         let columns: Vec<usize> = (0..table.header.len()).filter(|&c| !skip(c)).collect();
-        // values[entity][column][step]
-        let mut series: BTreeMap<u64, Vec<Vec<f64>>> = BTreeMap::new();
+        // values[entity][column][step], and the entity's type
+        let mut series: BTreeMap<u64, (Option<&str>, Vec<Vec<f64>>)> = BTreeMap::new();
         for r in 0..table.rows.len() {
             let s = table.id(r, step)? as usize;
             if s >= n_steps {
@@ -894,15 +900,16 @@ fn histories(
                 Some(c) => table.id(r, c)?,
                 None => 0,
             };
-            let entry = series
-                .entry(e)
-                .or_insert_with(|| vec![vec![f64::NAN; n_steps]; columns.len()]);
+            let entry = series.entry(e).or_insert_with(|| {
+                let kind = label.map(|c| table.rows[r].1[c].as_str());
+                (kind, vec![vec![f64::NAN; n_steps]; columns.len()])
+            });
             for (k, &c) in columns.iter().enumerate() {
-                entry[k][s] = table.number(r, c)?;
+                entry.1[k][s] = table.number(r, c)?;
             }
         }
         let mut entities = Vec::new();
-        for (e, values) in series {
+        for (e, (kind, values)) in series {
             let mut list = Vec::new();
             for (k, v) in values.iter().enumerate() {
                 let Some((lo, hi)) = range(v.iter().copied()) else {
@@ -927,7 +934,7 @@ fn histories(
                 count += 1;
             }
             if !list.is_empty() {
-                entities.push(json!({ "id": entity.map(|_| e), "series": list }));
+                entities.push(json!({ "id": entity.map(|_| e), "type": kind, "series": list }));
             }
         }
         if !entities.is_empty() {

@@ -7,6 +7,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use super::{Checker, LARGEST_ELEMENT_VALUE};
 use crate::elements::{Element, ElementKind};
 use crate::io::number::plain;
+use crate::io::run::format_time;
 use crate::model::input::ModelInput;
 use crate::model::{Id, Model, ModelError, ModelErrorKind};
 
@@ -243,9 +244,9 @@ pub(super) fn suspect_model(model: &Model, input: &ModelInput) -> Vec<(String, S
                 format!("joint {}", e.id()),
                 format!(
                     "its point lies {} from node {}, whose rigid body {body} reaches {} from it (the farthest point of its shape, by default the box of its mass and inertia): a joint is usually on or near the bodies it joins; check the joint's position and nodes, and the body's inertia",
-                    plain(d),
+                    format_time(d),
                     model.node_ids[node],
-                    plain(r)
+                    format_time(r)
                 ),
             ));
         }

@@ -376,7 +376,7 @@ fn other_inconsistencies_are_named() {
 /// revolute joint about y.
 fn hinged(extra: &str) -> String {
     format!(
-        "{CANTILEVER}\n[[nodes]]\nid = 4\nx = [1.0, 0.0, 0.0]\n\n[[rigid_bodies]]\nid = 20\nnode = 4\nmass = 1.0\n\n{extra}"
+        "{CANTILEVER}\n[[nodes]]\nid = 4\nx = [1.0, 0.0, 0.0]\n\n[[rigid_bodies]]\nid = 20\nnode = 4\nmass = 1.0\ninertia = [0.01, 0.01, 0.01]\n\n{extra}"
     )
 }
 

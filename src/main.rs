@@ -59,7 +59,7 @@ use unfold::io::run::{
 };
 use unfold::io::vtk::Encoding;
 use unfold::model::input::{ModelInput, OutputInput};
-use unfold::model::Model;
+use unfold::model::{overlaps, Model};
 
 // `println!` and `eprintln!` that ignore a failed write instead of
 // panicking: the std macros panic when the stream is closed or broken
@@ -1076,7 +1076,9 @@ fn run(
         }
     }
     if failure.is_none() && modal_error.is_none() {
-        recorder.final_configuration(&model, &start_state, &state);
+        for w in overlaps::overlap_warnings(&model, &start_state, &state) {
+            recorder.outcome_warning(&w);
+        }
     }
     let report = recorder.finish_after(last.as_ref(), &state);
     // the charts of `[output] plots`, from the files as they now stand

@@ -431,10 +431,7 @@ impl PyModel {
         } = observer;
         // bodies that end inside one another (crate docs: model::overlaps)
         let overlaps: Vec<String> = if failure.is_none() && interrupted.is_none() {
-            unfold::model::overlaps::new_overlaps(model, &start, &state)
-                .iter()
-                .map(|o| o.message(&format_time(state.time)))
-                .collect()
+            unfold::model::overlaps::overlap_warnings(model, &start, &state)
         } else {
             Vec::new()
         };

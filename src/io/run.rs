@@ -1253,7 +1253,7 @@ impl Recorder {
             })
             .collect();
         for w in warnings {
-            self.warning_line(&w);
+            self.outcome_warning(&w);
         }
         self.never_struck(end);
         self.unresolved_contacts();
@@ -1430,9 +1430,10 @@ impl Recorder {
         }
     }
 
-    /// A warning on the run's outcome: in `log.txt`, on the console and
-    /// in `summary.json`.
-    fn warning_line(&mut self, text: &str) {
+    /// A warning on the outcome of the run (its own, or one the caller
+    /// found, such as [`crate::model::overlaps::overlap_warnings`]): in
+    /// `log.txt`, on the console and in `summary.json`.
+    pub fn outcome_warning(&mut self, text: &str) {
         self.log.line(&format!("warning: {text}"));
         self.console.warning(text);
         self.summary.warnings.push(text.to_string());
@@ -1505,21 +1506,6 @@ impl Recorder {
     pub fn finish_with(self, outcome: Option<&StaticOutcome>, state: &State) -> RunReport {
         let end = outcome.map(AnalysisEnd::from);
         self.finish_after(end.as_ref(), state)
-    }
-
-    /// Warnings for the bodies that end the run inside one another and
-    /// did not start so ([`crate::model::overlaps`]), for a run whose
-    /// analyses all completed, from `start` to `end`.
-    pub fn final_configuration(&mut self, model: &Model, start: &State, end: &State) {
-        for o in crate::model::overlaps::new_overlaps(model, start, end) {
-            self.warning_line(&o.message(&format_time(end.time)));
-        }
-    }
-
-    /// A warning on the outcome of the run, found by the caller: on the
-    /// console, in `log.txt` and in `summary.json`.
-    pub fn outcome_warning(&mut self, text: &str) {
-        self.warning_line(text);
     }
 
     /// As [`Recorder::finish_with`], for a run whose last static or

@@ -124,17 +124,31 @@ impl Placed {
     }
 }
 
-/// The placement of `b` in the frame of `a`'s node: rotation and
-/// position.
-fn relative(a: &Placed, b: &Placed) -> (Mat3, Vec3) {
-    (a.r.transpose() * b.r, a.r.transpose() * (b.x - a.x))
+/// Where a body of a pair lies relative to the other.
+struct Relative {
+    /// The rotation and position of the second in the frame of the
+    /// first's node.
+    rotation: Mat3,
+    position: Vec3,
+    /// The larger reach of the two.
+    reach: f64,
+}
+
+impl Relative {
+    fn of(a: &Placed, b: &Placed) -> Self {
+        Self {
+            rotation: a.r.transpose() * b.r,
+            position: a.r.transpose() * (b.x - a.x),
+            reach: a.reach.max(b.reach),
+        }
+    }
 }
 
 /// The pairs of bodies overlapping in `state` (the larger fraction of
 /// each pair reaching [`OVERLAP_FRACTION`]), keyed by their indices in
-/// [`Placed::all`]'s order, with what each is and the placement of the
-/// second in the frame of the first.
-fn overlapping(model: &Model, state: &State) -> HashMap<(usize, usize), (Overlap, (Mat3, Vec3))> {
+/// [`Placed::all`]'s order, with what each is, the placement of the
+/// second in the frame of the first and the larger reach of the two.
+fn overlapping(model: &Model, state: &State) -> HashMap<(usize, usize), (Overlap, Relative)> {
     let placed = Placed::all(model, state);
     let samples: Vec<Vec<Vec3>> = placed.iter().map(|p| p.shape.samples()).collect();
     let mut found = HashMap::new();
@@ -171,7 +185,7 @@ fn overlapping(model: &Model, state: &State) -> HashMap<(usize, usize), (Overlap
                     fraction,
                     at_start: false,
                 };
-                found.insert((i, j), (overlap, relative(a, b)));
+                found.insert((i, j), (overlap, Relative::of(a, b)));
             }
         }
     }
@@ -183,16 +197,15 @@ fn overlapping(model: &Model, state: &State) -> HashMap<(usize, usize), (Overlap
 /// documentation), in the order of the model's elements.
 pub fn new_overlaps(model: &Model, start: &State, end: &State) -> Vec<Overlap> {
     let before = overlapping(model, start);
-    let reach: Vec<f64> = Placed::all(model, end).iter().map(|p| p.reach).collect();
     let mut after: Vec<((usize, usize), Overlap)> = overlapping(model, end)
         .into_iter()
-        .filter_map(|(pair, (mut overlap, (r1, x1)))| {
-            if let Some((_, (r0, x0))) = before.get(&pair) {
+        .filter_map(|(pair, (mut overlap, now))| {
+            if let Some((_, then)) = before.get(&pair) {
                 // the angle of the relative rotation, from its trace
-                let turned = (0.5 * ((r1 * r0.transpose()).trace() - 1.0))
+                let turned = (0.5 * ((now.rotation * then.rotation.transpose()).trace() - 1.0))
                     .clamp(-1.0, 1.0)
                     .acos();
-                let moved = (x1 - x0).norm() / reach[pair.0].max(reach[pair.1]);
+                let moved = (now.position - then.position).norm() / now.reach;
                 if turned <= RELATIVE_MOTION && moved <= RELATIVE_MOTION {
                     return None;
                 }
@@ -203,6 +216,15 @@ pub fn new_overlaps(model: &Model, start: &State, end: &State) -> Vec<Overlap> {
         .collect();
     after.sort_by_key(|(pair, _)| *pair);
     after.into_iter().map(|(_, o)| o).collect()
+}
+
+/// The warnings of [`new_overlaps`] between `start` and `end`, for a user.
+pub fn overlap_warnings(model: &Model, start: &State, end: &State) -> Vec<String> {
+    let time = crate::io::run::format_time(end.time);
+    new_overlaps(model, start, end)
+        .iter()
+        .map(|o| o.message(&time))
+        .collect()
 }
 
 impl Overlap {

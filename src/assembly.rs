@@ -21,10 +21,10 @@
 //! relative residual tolerance.
 
 use crate::dofs::{DofMap, NO_EQUATION};
-use crate::elements::{Element, ElementOutput, EvalContext, Need};
+use crate::elements::{Element, ElementOutput, EvalContext, InertiaWeights, Need};
 use crate::linalg::SparseMatrix;
 use crate::model::Model;
-use crate::so3::Mat3;
+use crate::so3::{Mat3, Vec3};
 use crate::state::State;
 
 const NONE: u32 = u32::MAX;
@@ -314,7 +314,7 @@ impl Assembler {
     /// [`Assembler::matrix`]: the stiffness, plus the inertia matrix
     /// `w_d ∂r/∂v + w_m ∂r/∂v̇` when asked.
     pub fn assemble(&mut self, model: &Model, ctx: &EvalContext, state: &State) {
-        self.assemble_into(model, ctx, state, None, Target::Own);
+        self.assemble_into(model, ctx, state, Columns::NONE, Target::Own);
     }
 
     /// As [`Assembler::assemble`], with the rotation columns of every local
@@ -331,7 +331,45 @@ impl Assembler {
         factors: &[Mat3],
     ) {
         assert_eq!(factors.len(), model.n_nodes(), "one factor per node");
-        self.assemble_into(model, ctx, state, Some(factors), Target::Own);
+        let columns = Columns {
+            tangent: Some(factors),
+            spatial: None,
+        };
+        self.assemble_into(model, ctx, state, columns, Target::Own);
+    }
+
+    /// As [`Assembler::assemble_factored`], for the spatial scheme of the
+    /// dynamic analysis (docs/theory.md §15.9): the rotation columns of
+    /// each node with `spatial[i] = Some(c)` become
+    ///
+    /// ```text
+    /// S_{·Θᵢ} = K_{·Θᵢ} Tᵢ + D_{·Θᵢ} Λᵢ + C_{·Θᵢ} Ω~ Tᵢ + M_{·Θᵢ} Ω̇~ Tᵢ,
+    /// ```
+    ///
+    /// `D = w_d C + w_m M` the inertia matrix asked for (both weights
+    /// positive), `C = ∂r/∂v`, `M = ∂r/∂v̇`: an element with such a node is
+    /// evaluated a second time for `w_d C` alone.
+    pub fn assemble_spatial(
+        &mut self,
+        model: &Model,
+        ctx: &EvalContext,
+        state: &State,
+        factors: &[Mat3],
+        spatial: &[Option<SpatialColumns>],
+    ) {
+        assert_eq!(factors.len(), model.n_nodes(), "one factor per node");
+        assert_eq!(spatial.len(), model.n_nodes(), "one entry per node");
+        assert!(
+            ctx.need
+                .inertia
+                .is_some_and(|w| w.damping > 0.0 && w.mass > 0.0),
+            "the spatial columns need both inertia weights"
+        );
+        let columns = Columns {
+            tangent: Some(factors),
+            spatial: Some(spatial),
+        };
+        self.assemble_into(model, ctx, state, columns, Target::Own);
     }
 
     /// Evaluates every element once and assembles the residual and the flux
@@ -356,7 +394,13 @@ impl Assembler {
             stiffness.nnz() == self.matrix.nnz() && inertia.nnz() == self.matrix.nnz(),
             "matrices on the assembler's pattern"
         );
-        self.assemble_into(model, ctx, state, None, Target::Split(stiffness, inertia));
+        self.assemble_into(
+            model,
+            ctx,
+            state,
+            Columns::NONE,
+            Target::Split(stiffness, inertia),
+        );
     }
 
     /// Evaluates every element without its stiffness and assembles the
@@ -387,7 +431,7 @@ impl Assembler {
             },
             ..*ctx
         };
-        self.assemble_into(model, &ctx, state, None, Target::Inertia(inertia));
+        self.assemble_into(model, &ctx, state, Columns::NONE, Target::Inertia(inertia));
     }
 
     fn assemble_into(
@@ -395,7 +439,7 @@ impl Assembler {
         model: &Model,
         ctx: &EvalContext,
         state: &State,
-        factors: Option<&[Mat3]>,
+        columns: Columns,
         target: Target,
     ) {
         let need = ctx.need;
@@ -424,7 +468,7 @@ impl Assembler {
             layout,
             ctx,
             state,
-            factors,
+            columns,
         );
 
         // scatter
@@ -569,10 +613,10 @@ fn evaluate_range(
     layout: Layout,
     ctx: &EvalContext,
     state: &State,
-    factors: Option<&[Mat3]>,
+    columns: Columns,
 ) {
     if elements.len() <= SEQUENTIAL_CHUNK {
-        evaluate_sequentially(elements, buffer, inertia, layout, ctx, state, factors);
+        evaluate_sequentially(elements, buffer, inertia, layout, ctx, state, columns);
         return;
     }
     let mid = elements.len() / 2;
@@ -586,8 +630,8 @@ fn evaluate_range(
     };
     let (ll, lr) = layout.split(mid);
     rayon::join(
-        || evaluate_range(&elements[..mid], left, il, ll, ctx, state, factors),
-        || evaluate_range(&elements[mid..], right, ir, lr, ctx, state, factors),
+        || evaluate_range(&elements[..mid], left, il, ll, ctx, state, columns),
+        || evaluate_range(&elements[mid..], right, ir, lr, ctx, state, columns),
     );
 }
 
@@ -599,7 +643,7 @@ fn evaluate_sequentially(
     layout: Layout,
     ctx: &EvalContext,
     state: &State,
-    factors: Option<&[Mat3]>,
+    columns: Columns,
 ) {
     let (base, ibase) = (layout.offsets[0], layout.inertia_offsets[0]);
     let mut inertia = inertia;
@@ -624,10 +668,107 @@ fn evaluate_sequentially(
             inertia: local_inertia,
         };
         e.evaluate(ctx, state, &mut out);
-        if let (Some(f), Some(k)) = (factors, out.stiffness) {
+        if let (Some(f), Some(k)) = (columns.tangent, out.stiffness) {
             factor_rotation_columns(k, n, e.nodes(), f);
         }
+        if let (Some(spatial), Some(d)) = (columns.spatial, out.inertia) {
+            if e.nodes().iter().any(|&i| spatial[i].is_some()) {
+                spatial_rotation_columns(e.as_ref(), ctx, state, d, spatial);
+            }
+        }
     }
+}
+
+/// The right factors of the rotation columns in an assembly: `T` of every
+/// node on the stiffness, and the spatial scheme's columns of the inertia
+/// matrix at some nodes ([`Assembler::assemble_spatial`]).
+#[derive(Clone, Copy)]
+struct Columns<'a> {
+    tangent: Option<&'a [Mat3]>,
+    spatial: Option<&'a [Option<SpatialColumns>]>,
+}
+
+impl Columns<'_> {
+    const NONE: Columns<'static> = Columns {
+        tangent: None,
+        spatial: None,
+    };
+}
+
+/// The right factors of a node's rotation columns of the inertia matrix in
+/// the spatial scheme (docs/theory.md §15.9): `Ω = Λ Ω′` and `Ω̇ = Λ Ω̇′`
+/// with `Λ = exp(−hΔΘ~)` give `δΩ = (γ′Λ + Ω~T) x` and
+/// `δΩ̇ = (β′Λ + Ω̇~T) x` for a correction `x = h δΔΘ`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpatialColumns {
+    /// `Λ`, on `D = w_d C + w_m M`.
+    pub turn: Mat3,
+    /// `Ω~ T`, on `C`.
+    pub damping: Mat3,
+    /// `Ω̇~ T`, on `M`.
+    pub mass: Mat3,
+}
+
+thread_local! {
+    /// `w_d C` and the residual of one element, for the spatial columns.
+    static DAMPING: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// `D_{·Θ} ← D_{·Θ} Λ + C_{·Θ} Ω~T + M_{·Θ} Ω̇~T` for the nodes of `e` in
+/// the spatial scheme, `d` its inertia matrix `w_d C + w_m M` (column
+/// major, `n × n`); `C` from a second evaluation of `e`, `M = (D − w_d C)/w_m`.
+fn spatial_rotation_columns(
+    e: &dyn Element,
+    ctx: &EvalContext,
+    state: &State,
+    d: &mut [f64],
+    spatial: &[Option<SpatialColumns>],
+) {
+    let n = e.n_local();
+    let w = ctx.need.inertia.expect("asked for by assemble_spatial");
+    DAMPING.with(|buffer| {
+        let mut buffer = buffer.borrow_mut();
+        buffer.clear();
+        buffer.resize(n * n + n, 0.0);
+        let (c, residual) = buffer.split_at_mut(n * n);
+        let damping = EvalContext {
+            need: Need {
+                stiffness: false,
+                inertia: Some(InertiaWeights {
+                    damping: w.damping,
+                    mass: 0.0,
+                }),
+            },
+            ..*ctx
+        };
+        e.evaluate(
+            &damping,
+            state,
+            &mut ElementOutput {
+                residual,
+                stiffness: None,
+                inertia: Some(c),
+            },
+        );
+        for (i, &node) in e.nodes().iter().enumerate() {
+            let Some(f) = &spatial[node] else {
+                continue;
+            };
+            let c0 = 6 * i + 3;
+            for r in 0..n {
+                let column = |m: &[f64], j: usize| m[(c0 + j) * n + r];
+                let dv = Vec3::new(column(d, 0), column(d, 1), column(d, 2));
+                let cv = Vec3::new(column(c, 0), column(c, 1), column(c, 2));
+                // rows of C and M: w_d C / w_d, (D − w_d C)/w_m
+                let mv = (dv - cv) / w.mass;
+                let cv = cv / w.damping;
+                let row = f.turn.tr_mul(&dv) + f.damping.tr_mul(&cv) + f.mass.tr_mul(&mv);
+                for j in 0..3 {
+                    d[(c0 + j) * n + r] = row[j];
+                }
+            }
+        }
+    });
 }
 
 /// `K_{·Θᵢ} ← K_{·Θᵢ} Fᵢ` for every node `i` of an element: the three

@@ -241,9 +241,16 @@ def main():
         default=unfold_side.RESIDUAL_TOLERANCE,
         help=f"unfold's Newton residual tolerance (default {unfold_side.RESIDUAL_TOLERANCE:g}, as Exudyn's; 0: unfold's own default)",
     )
+    ap.add_argument(
+        "--unfold-angular-velocities",
+        choices=("spatial", "material"),
+        default=unfold_side.ANGULAR_VELOCITIES,
+        help=f"the frame of the angular velocities in unfold's time scheme (default {unfold_side.ANGULAR_VELOCITIES})",
+    )
     args = ap.parse_args()
 
     unfold_side.RESIDUAL_TOLERANCE = args.unfold_residual_tolerance or None
+    unfold_side.ANGULAR_VELOCITIES = args.unfold_angular_velocities
     problems = [p.strip() for p in args.problems.split(",") if p.strip()]
     sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
     for p in problems:
@@ -285,6 +292,7 @@ def main():
         "threads": args.threads,
         "rho_infinity": RHO_INFINITY,
         "unfold_residual_tolerance": unfold_side.RESIDUAL_TOLERANCE,
+        "unfold_angular_velocities": unfold_side.ANGULAR_VELOCITIES,
         "unfold_available": unfold_ok,
         "unfold_unavailable_because": why,
         "load_average_start": os.getloadavg(),

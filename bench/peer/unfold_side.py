@@ -63,6 +63,12 @@ def _vec(v):
 # beam. Both codes get 1e-6 (`run.py --unfold-residual-tolerance`).
 RESIDUAL_TOLERANCE = 1.0e-6
 
+# The frame of the angular velocities in unfold's time scheme
+# (`[analysis] angular_velocities`, docs/theory.md §15.9): "spatial", whose
+# error constant on the heavy top is half the material scheme's, or
+# "material" (unfold's default; `run.py --unfold-angular-velocities`).
+ANGULAR_VELOCITIES = "spatial"
+
 
 def _analysis(end_time, h, dynamic=True, cutbacks=False):
     """The [analysis] table: fixed steps h; with `cutbacks` False also
@@ -79,6 +85,7 @@ def _analysis(end_time, h, dynamic=True, cutbacks=False):
         f"time_step = {h!r}\n"
         f"rho_infinity = {RHO_INFINITY!r}\n"
         + (f"residual_tolerance = {RESIDUAL_TOLERANCE!r}\n" if RESIDUAL_TOLERANCE else "")
+        + f'angular_velocities = "{ANGULAR_VELOCITIES}"\n'
         + "adaptive = false        # fixed steps, as Exudyn's (its step reduction is off)\n"
         + ("" if cutbacks else f"min_step = {h!r}        # no cut-back: a failed step stops the run\n")
         + f"output_every = {every}   # results every {OUTPUT_PERIOD} s\n"

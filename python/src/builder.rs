@@ -1659,6 +1659,12 @@ impl PyAnalysis {
         self.with(|x| x.newton(method))
     }
 
+    /// Dynamics: the frame of the angular velocities in the time scheme,
+    /// `material` or `spatial`.
+    fn angular_velocities(&self, frame: &str) -> Self {
+        self.with(|x| x.angular_velocities(frame))
+    }
+
     /// Modal analysis: the modes nearest to this frequency (Hz).
     fn shift(&self, frequency: f64) -> Self {
         self.with(|x| x.shift(frequency))

@@ -36,7 +36,8 @@ pub use impact::{ContactInfo, ContactKind, LatchEventKind, LockInfo};
 pub use modal::{ModalAnalysis, ModalError, ModalOutcome, NaturalMode};
 pub use newton::{ConvergenceNorms, NewtonFailure};
 pub use settings::{
-    AnalysisSettings, DynamicSettings, ModalSettings, NewtonMethod, StaticSettings,
+    AnalysisSettings, AngularVelocities, DynamicSettings, ModalSettings, NewtonMethod,
+    StaticSettings,
 };
 pub use statics::{StaticAnalysis, StaticOutcome, Step, LIMIT_POINT_WARNING};
 

@@ -884,6 +884,10 @@ pub struct AnalysisInput {
     /// iteration) or `modified` (its factors kept while they serve).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub newton: Option<String>,
+    /// Dynamics: the frame of the angular velocities in the time scheme,
+    /// `material` (default) or `spatial`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_velocities: Option<String>,
     /// Modal analysis: number of modes, default 10.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub modes: Option<usize>,
@@ -932,6 +936,7 @@ impl Default for AnalysisInput {
             error_tolerance: None,
             adaptive: None,
             newton: None,
+            angular_velocities: None,
             modes: None,
             shift: None,
             frequency_range: None,

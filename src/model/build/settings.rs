@@ -7,7 +7,8 @@ use super::{
 use crate::analysis::control::LANDING_SNAP;
 use crate::analysis::settings::{default_max_step, DEFAULT_ERROR_TOLERANCE, DEFAULT_RHO_INFINITY};
 use crate::analysis::{
-    AnalysisSettings, DynamicSettings, ModalSettings, NewtonMethod, StaticSettings,
+    AnalysisSettings, AngularVelocities, DynamicSettings, ModalSettings, NewtonMethod,
+    StaticSettings,
 };
 use crate::eigen::Method;
 use crate::model::input::{Analyses, AnalysisInput, ModelInput};
@@ -182,7 +183,7 @@ pub(super) fn analyses(ck: &mut Checker, analyses: &Analyses) -> Vec<AnalysisSet
 }
 
 /// The keys that only dynamic analyses take, and whether each is given.
-fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 8] {
+fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 9] {
     [
         ("output_interval", a.output_interval.is_some()),
         ("time_step", a.time_step.is_some()),
@@ -192,6 +193,7 @@ fn dynamic_keys(a: &AnalysisInput) -> [(&'static str, bool); 8] {
         ("error_tolerance", a.error_tolerance.is_some()),
         ("adaptive", a.adaptive.is_some()),
         ("newton", a.newton.is_some()),
+        ("angular_velocities", a.angular_velocities.is_some()),
     ]
 }
 
@@ -545,6 +547,20 @@ fn dynamic_settings(
                     format!("unknown newton \"{other}\" (available: modified, full)"),
                 );
                 NewtonMethod::default()
+            }
+        },
+        angular_velocities: match a.angular_velocities.as_deref() {
+            Some("material") | None => AngularVelocities::Material,
+            Some("spatial") => AngularVelocities::Spatial,
+            Some(other) => {
+                ck.push(
+                    ModelErrorKind::Invalid,
+                    entity,
+                    format!(
+                        "unknown angular_velocities \"{other}\" (available: material, spatial)"
+                    ),
+                );
+                AngularVelocities::default()
             }
         },
         output_every: a.output_every.unwrap_or(1),

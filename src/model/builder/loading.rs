@@ -472,6 +472,13 @@ impl Analysis {
         self
     }
 
+    /// Dynamics: the frame of the angular velocities in the time scheme,
+    /// `material` (default) or `spatial` (docs/theory.md §15.9).
+    pub fn angular_velocities(mut self, frame: &str) -> Self {
+        self.0.angular_velocities = Some(frame.into());
+        self
+    }
+
     /// Modal analysis: the `modes` lowest natural modes about the state
     /// reached (docs/theory.md §14.7).
     pub fn modal(modes: usize) -> Self {

@@ -672,7 +672,15 @@ fn evaluate_sequentially(
             factor_rotation_columns(k, n, e.nodes(), f);
         }
         if let (Some(spatial), Some(d)) = (columns.spatial, out.inertia) {
-            if e.nodes().iter().any(|&i| spatial[i].is_some()) {
+            // an element without inertia or damping on the rotations of
+            // its spatial nodes (a joint without damper) has nothing to add
+            let moving = e.nodes().iter().enumerate().any(|(i, &node)| {
+                spatial[node].is_some()
+                    && d[(6 * i + 3) * n..(6 * i + 6) * n]
+                        .iter()
+                        .any(|&v| v != 0.0)
+            });
+            if moving {
                 spatial_rotation_columns(e.as_ref(), ctx, state, d, spatial);
             }
         }

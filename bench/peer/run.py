@@ -245,7 +245,7 @@ def main():
         "--unfold-angular-velocities",
         choices=("spatial", "material"),
         default=unfold_side.ANGULAR_VELOCITIES,
-        help=f"the frame of the angular velocities in unfold's time scheme (default {unfold_side.ANGULAR_VELOCITIES})",
+        help=f"the frame of the angular velocities in unfold's time scheme for the heavy top (default {unfold_side.ANGULAR_VELOCITIES}; the pendulum keeps unfold's default)",
     )
     args = ap.parse_args()
 

@@ -63,14 +63,16 @@ def _vec(v):
 # beam. Both codes get 1e-6 (`run.py --unfold-residual-tolerance`).
 RESIDUAL_TOLERANCE = 1.0e-6
 
-# The frame of the angular velocities in unfold's time scheme
-# (`[analysis] angular_velocities`, docs/theory.md §15.9): "spatial", whose
-# error constant on the heavy top is half the material scheme's, or
-# "material" (unfold's default; `run.py --unfold-angular-velocities`).
+# The frame of the angular velocities in unfold's time scheme for the
+# heavy top (`[analysis] angular_velocities`, docs/theory.md §15.9):
+# "spatial", whose error constant on the top is half the material scheme's,
+# or "material" (unfold's default; `run.py --unfold-angular-velocities`).
+# The pendulum turns about a fixed axis, where both schemes give the same
+# steps, and keeps the default.
 ANGULAR_VELOCITIES = "spatial"
 
 
-def _analysis(end_time, h, dynamic=True, cutbacks=False):
+def _analysis(end_time, h, dynamic=True, cutbacks=False, angular_velocities=None):
     """The [analysis] table: fixed steps h; with `cutbacks` False also
     min_step = h, so that a step that fails stops the run, as Exudyn's
     (otherwise unfold cuts the step back, down to 1e-6 h, and may take
@@ -85,7 +87,7 @@ def _analysis(end_time, h, dynamic=True, cutbacks=False):
         f"time_step = {h!r}\n"
         f"rho_infinity = {RHO_INFINITY!r}\n"
         + (f"residual_tolerance = {RESIDUAL_TOLERANCE!r}\n" if RESIDUAL_TOLERANCE else "")
-        + f'angular_velocities = "{ANGULAR_VELOCITIES}"\n'
+        + (f'angular_velocities = "{angular_velocities}"\n' if angular_velocities else "")
         + "adaptive = false        # fixed steps, as Exudyn's (its step reduction is off)\n"
         + ("" if cutbacks else f"min_step = {h!r}        # no cut-back: a failed step stops the run\n")
         + f"output_every = {every}   # results every {OUTPUT_PERIOD} s\n"
@@ -146,7 +148,7 @@ def top_toml(h, t=HeavyTop, dynamic=True):
     return "\n".join(
         [
             'title = "Heavy top (Arnold & Brüls 2007) on a spherical joint"\n',
-            _analysis(t.end_time, h, dynamic),
+            _analysis(t.end_time, h, dynamic, angular_velocities=ANGULAR_VELOCITIES),
             _node(TOP_NODE, t.center_of_mass, velocity=t.com_velocity0(), angular_velocity=t.omega0, dynamic=dynamic),
             "[[rigid_bodies]]\n"
             "id = 1\n"

@@ -3674,7 +3674,7 @@ mod tests {
                 dense[r][c] += v;
             }
             let largest = dense.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-            let mut residual = |d: &mut Dynamics, x: &[f64]| {
+            let residual = |d: &mut Dynamics, x: &[f64]| {
                 d.correct(h, x);
                 d.assemble_iterate(h, false, false);
                 let r = d.solver.system().1.residual.clone();

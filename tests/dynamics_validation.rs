@@ -429,6 +429,38 @@ fn heavy_top_in_the_spatial_scheme_has_the_independent_integrators_error() {
     }
 }
 
+/// `angular_velocities` takes `material` (the default) or `spatial`; any
+/// other value is an input error naming the analysis and the values.
+#[test]
+fn the_frame_of_the_angular_velocities_is_read_from_the_model_file() {
+    let model = |line: &str| {
+        format!(
+            "[analysis]\ntype = \"dynamic\"\nend_time = 0.1\n{line}\n\n[[nodes]]\nid = 1\nx = [0.0, 1.0, 0.0]\n\n[[rigid_bodies]]\nid = 1\nnode = 1\nmass = 15.0\ninertia = [0.234375, 0.46875, 0.234375]\n"
+        )
+    };
+    let frame = |line: &str| {
+        let input: unfold::model::input::ModelInput =
+            toml::from_str(&model(line)).expect("valid toml");
+        input.analyses().map(|a| match &a[0] {
+            unfold::analysis::AnalysisSettings::Dynamic(d) => d.angular_velocities,
+            _ => panic!("a dynamic analysis"),
+        })
+    };
+    assert_eq!(frame("").unwrap(), AngularVelocities::Material);
+    assert_eq!(
+        frame("angular_velocities = \"spatial\"").unwrap(),
+        AngularVelocities::Spatial
+    );
+    let error = frame("angular_velocities = \"body\"")
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        error.contains("analysis")
+            && error.contains("unknown angular_velocities \"body\" (available: material, spatial)"),
+        "{error}"
+    );
+}
+
 /// Slope of the least-squares line through `(log h, log e)`.
 fn log_log_slope(h: &[f64], e: &[f64]) -> f64 {
     let n = h.len() as f64;

@@ -215,6 +215,18 @@ fn digits_by_shortest<const P: usize>(a: f64) -> Option<(u64, i32)> {
     Some((q, e))
 }
 
+/// The two digits of 0 to 99: `00`, `01`, …, `99`.
+const DIGIT_PAIRS: [u8; 200] = {
+    let mut pairs = [0u8; 200];
+    let mut i = 0;
+    while i < 100 {
+        pairs[2 * i] = b'0' + (i / 10) as u8;
+        pairs[2 * i + 1] = b'0' + (i % 10) as u8;
+        i += 1;
+    }
+    pairs
+};
+
 /// Writes `digits` (`count` of them, the first before the point) and the
 /// exponent `e` into `buf` after the sign, as `{:e}` does; the length.
 /// (Inlined: in `Sci<P>`, `count` is a constant and the loop unrolled.)
@@ -229,9 +241,18 @@ fn write_scientific(
     // the sign, overwritten by the first digit when there is none
     buf[0] = b'-';
     let first = usize::from(negative);
-    // the digits after the point (at `first + 2 ..`), from the last
+    // the digits after the point (at `first + 2 ..`), from the last, two
+    // at a time
     let mut v = digits;
-    for k in (first + 2..first + count + 1).rev() {
+    let mut k = first + count;
+    while k >= first + 3 {
+        let pair = 2 * (v % 100) as usize;
+        v /= 100;
+        buf[k - 1] = DIGIT_PAIRS[pair];
+        buf[k] = DIGIT_PAIRS[pair + 1];
+        k -= 2;
+    }
+    if k == first + 2 {
         buf[k] = b'0' + (v % 10) as u8;
         v /= 10;
     }

@@ -16,6 +16,8 @@
 //! - [`peaks`]: the largest loads of latches, stops and contacts over a
 //!   run, for `summary.json`;
 //! - [`number`]: numbers in scientific notation for `log.txt`;
+//! - [`line`]: a line of `log.txt` built as bytes, numbers written
+//!   straight into it;
 //! - [`residual`]: the relative residual as `log.txt` reports it, with
 //!   groups at round-off told apart;
 //! - [`plot`]: line charts of result histories, as SVG and PNG files;
@@ -25,6 +27,7 @@
 //!   (`unfold view`), made from its result files.
 
 pub mod histories;
+pub mod line;
 pub mod model_file;
 pub mod modes;
 pub mod number;

@@ -74,8 +74,16 @@ fn digits_by_product<const P: usize>(a: f64) -> Option<(u64, i32)> {
             (m, (-m).mul_add(p, a) / p)
         })
     };
-    let mut e = a.log10().floor() as i32;
-    let (mut m, mut err) = scaled(e)?;
+    // the exponent of `a` or one less (no `log10`), and then the one that
+    // puts `m` in [10^P, 10^(P+1))
+    let mut e = exponent_estimate(a);
+    let (mut m, mut err) = match scaled(e) {
+        Some(s) => s,
+        None => {
+            e += 1;
+            scaled(e)?
+        }
+    };
     if m < lo {
         e -= 1;
         (m, err) = scaled(e)?;
@@ -87,9 +95,11 @@ fn digits_by_product<const P: usize>(a: f64) -> Option<(u64, i32)> {
     if !(lo..hi).contains(&m) || (m == lo && err < 0.0) {
         return None;
     }
-    // (in integers: above 2⁵³ not every integer is a double)
-    let mut floor = m.floor() as u64;
-    let mut frac = (m - m.floor()) + err;
+    // (in integers: above 2⁵³ not every integer is a double; `m > 0`, so
+    // the conversion is its floor, through `i64`: one instruction,
+    // `m < 2⁶³`)
+    let mut floor = m as i64 as u64;
+    let mut frac = (m - floor as f64) + err;
     if frac < 0.0 {
         floor -= 1;
         frac += 1.0;
@@ -106,6 +116,14 @@ fn digits_by_product<const P: usize>(a: f64) -> Option<(u64, i32)> {
         e += 1;
     }
     Some((q, e))
+}
+
+/// `⌊log₁₀ a⌋` or one less, for a normal `a > 0`: from its binary
+/// exponent `b` (`2^b ≤ a < 2^(b+1)`), `⌊b log₁₀ 2⌋`, with
+/// `log₁₀ 2 ≈ 78913 / 2¹⁸` (exact floors for `|b| < 1700`).
+fn exponent_estimate(a: f64) -> i32 {
+    let b = ((a.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    (b * 78913) >> 18
 }
 
 /// The shortest decimal that reads back to `a` (finite, `a > 0`): its
@@ -197,8 +215,22 @@ fn digits_by_shortest<const P: usize>(a: f64) -> Option<(u64, i32)> {
     Some((q, e))
 }
 
+/// The two digits of 0 to 99: `00`, `01`, …, `99`.
+const DIGIT_PAIRS: [u8; 200] = {
+    let mut pairs = [0u8; 200];
+    let mut i = 0;
+    while i < 100 {
+        pairs[2 * i] = b'0' + (i / 10) as u8;
+        pairs[2 * i + 1] = b'0' + (i % 10) as u8;
+        i += 1;
+    }
+    pairs
+};
+
 /// Writes `digits` (`count` of them, the first before the point) and the
 /// exponent `e` into `buf` after the sign, as `{:e}` does; the length.
+/// (Inlined: in `Sci<P>`, `count` is a constant and the loop unrolled.)
+#[inline(always)]
 fn write_scientific(
     buf: &mut [u8; TEXT],
     negative: bool,
@@ -206,47 +238,58 @@ fn write_scientific(
     count: usize,
     e: i32,
 ) -> usize {
-    let mut n = 0;
-    if negative {
-        buf[n] = b'-';
-        n += 1;
-    }
-    let mut d = [0u8; 20];
+    // the sign, overwritten by the first digit when there is none
+    buf[0] = b'-';
+    let first = usize::from(negative);
+    // the digits after the point (at `first + 2 ..`), from the last, two
+    // at a time
     let mut v = digits;
-    for k in (0..count).rev() {
-        d[k] = b'0' + (v % 10) as u8;
+    let mut k = first + count;
+    while k >= first + 3 {
+        let pair = 2 * (v % 100) as usize;
+        v /= 100;
+        buf[k - 1] = DIGIT_PAIRS[pair];
+        buf[k] = DIGIT_PAIRS[pair + 1];
+        k -= 2;
+    }
+    if k == first + 2 {
+        buf[k] = b'0' + (v % 10) as u8;
         v /= 10;
     }
-    buf[n] = d[0];
-    n += 1;
-    if count > 1 {
-        buf[n] = b'.';
-        n += 1;
-        buf[n..n + count - 1].copy_from_slice(&d[1..count]);
-        n += count - 1;
-    }
+    buf[first] = b'0' + v as u8;
+    buf[first + 1] = b'.';
+    let mut n = if count > 1 {
+        first + count + 1
+    } else {
+        first + 1
+    };
     buf[n] = b'e';
     n += 1;
     if e < 0 {
         buf[n] = b'-';
         n += 1;
     }
-    let mut ed = [0u8; 4];
-    let mut ev = e.unsigned_abs();
-    let mut len = 0;
-    loop {
-        ed[len] = b'0' + (ev % 10) as u8;
-        ev /= 10;
-        len += 1;
-        if ev == 0 {
-            break;
-        }
-    }
-    for k in (0..len).rev() {
-        buf[n] = ed[k];
+    // at most three digits (|e| ≤ 324)
+    let ev = e.unsigned_abs();
+    if ev >= 100 {
+        buf[n] = b'0' + (ev / 100) as u8;
         n += 1;
     }
-    n
+    if ev >= 10 {
+        buf[n] = b'0' + (ev / 10 % 10) as u8;
+        n += 1;
+    }
+    buf[n] = b'0' + (ev % 10) as u8;
+    n + 1
+}
+
+/// Appends the first `n` bytes of `buf` to `out`: the whole buffer is
+/// copied (a fixed size, no call to `memcpy`) and the rest cut off.
+#[inline]
+fn push_text(out: &mut Vec<u8>, buf: &[u8; TEXT], n: usize) {
+    let len = out.len();
+    out.extend_from_slice(buf);
+    out.truncate(len + n);
 }
 
 impl<const P: usize> Sci<P> {
@@ -263,6 +306,19 @@ impl<const P: usize> Sci<P> {
             return None;
         };
         Some(write_scientific(buf, x.is_sign_negative(), q, P + 1, e))
+    }
+
+    /// Appends the text to `out`, as bytes.
+    pub fn push_bytes(self, out: &mut Vec<u8>) {
+        let mut buf = [0u8; TEXT];
+        match self.text(&mut buf) {
+            Some(n) => push_text(out, &buf, n),
+            None => {
+                use std::io::Write as _;
+                let x = self.0;
+                let _ = write!(out, "{x:.P$e}");
+            }
+        }
     }
 
     /// Appends the text to `out`.
@@ -295,6 +351,24 @@ impl<const P: usize> fmt::Display for Sci<P> {
 }
 
 impl Shortest {
+    /// Appends the text to `out`, as bytes.
+    pub fn push_bytes(self, out: &mut Vec<u8>) {
+        let x = self.0;
+        if !x.is_finite() {
+            use std::io::Write as _;
+            let _ = write!(out, "{x:e}");
+            return;
+        }
+        let (m, n, e) = if x == 0.0 {
+            (0, 1, 0)
+        } else {
+            shortest(x.abs())
+        };
+        let mut buf = [0u8; TEXT];
+        let len = write_scientific(&mut buf, x.is_sign_negative(), m, n as usize, e);
+        push_text(out, &buf, len);
+    }
+
     /// Appends the text to `out`.
     pub fn push_to(self, out: &mut String) {
         let x = self.0;
@@ -315,6 +389,79 @@ impl Shortest {
     }
 }
 
+/// `x` with `P` digits after the point, exactly as `format!("{x:.P$}")`
+/// (ties of the exact value, as `0.125` to two digits, to even).
+#[derive(Clone, Copy, Debug)]
+pub struct Fixed<const P: usize>(pub f64);
+
+impl<const P: usize> Fixed<P> {
+    /// Appends the text to `out`, as bytes.
+    pub fn push_bytes(self, out: &mut Vec<u8>) {
+        match self.scaled() {
+            Some(q) => {
+                let unit = 10u64.pow(P as u32);
+                push_integer(out, q / unit, 0);
+                if P > 0 {
+                    out.push(b'.');
+                    // the digits after the point, leading zeros kept
+                    let mut digits = [b'0'; 20];
+                    let mut v = q % unit;
+                    for d in digits[..P].iter_mut().rev() {
+                        *d = b'0' + (v % 10) as u8;
+                        v /= 10;
+                    }
+                    out.extend_from_slice(&digits[..P]);
+                }
+            }
+            None => {
+                use std::io::Write as _;
+                let x = self.0;
+                let _ = write!(out, "{x:.P$}");
+            }
+        }
+    }
+
+    /// `x·10^P` rounded to an integer, for `0 ≤ x < 10⁶` (no sign to
+    /// write) and `P ≤ 9`; `None` otherwise. The product of two doubles is
+    /// exactly `m + err` (both doubles, `err` by a fused multiply–add) and
+    /// `m < 2⁵⁰`, so `m`'s unit in the last place `u` is at most 1/8 and
+    /// divides both `m`'s fraction `f` and one half: `f − ½` is 0 or at
+    /// least `u` in size (exact unless it is near −½) against
+    /// `|err| ≤ u/2`, which then cannot change the side of one half.
+    fn scaled(self) -> Option<u64> {
+        let x = self.0;
+        if P > 9 || x.is_sign_negative() || !(0.0..1e6).contains(&x) {
+            return None;
+        }
+        let p = POW10[P];
+        let m = x * p;
+        let err = x.mul_add(p, -m);
+        // (through `i64`: one instruction)
+        let floor = m as i64 as u64;
+        let half = (m - floor as f64) - 0.5;
+        let up = if half != 0.0 {
+            half > 0.0
+        } else if err != 0.0 {
+            err > 0.0
+        } else {
+            // an exact tie: to the even integer
+            floor % 2 == 1
+        };
+        Some(floor + u64::from(up))
+    }
+}
+
+/// Appends `v` to `out` in decimal, right-aligned in `width` columns as
+/// `format!("{v:width$}")`.
+pub fn push_integer(out: &mut Vec<u8>, v: u64, width: usize) {
+    let mut buffer = itoa::Buffer::new();
+    let digits = buffer.format(v).as_bytes();
+    for _ in digits.len()..width {
+        out.push(b' ');
+    }
+    out.extend_from_slice(digits);
+}
+
 impl fmt::Display for Shortest {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let mut text = String::with_capacity(TEXT);
@@ -331,6 +478,76 @@ mod tests {
         let mut text = String::new();
         Sci::<P>(x).push_to(&mut text);
         text
+    }
+
+    fn fixed<const P: usize>(x: f64) -> String {
+        let mut text = Vec::new();
+        Fixed::<P>(x).push_bytes(&mut text);
+        String::from_utf8(text).unwrap()
+    }
+
+    /// `Fixed` equals the standard library's `{:.P}`: at exact ties (to
+    /// even), near them (multiples of a time step such as 0.0003125),
+    /// at random, and outside its range (negative, large, NaN).
+    #[test]
+    fn fixed_matches_the_standard_library() {
+        let mut seed = 5u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            seed
+        };
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            1.5,
+            2.5,
+            0.125,
+            0.375,
+            0.0078125,
+            0.0000005,
+            0.9999995,
+            999_999.9999995,
+            999_999.999_999_9,
+            1e6,
+            -1.25,
+            5e-324,
+            f64::NAN,
+            f64::INFINITY,
+        ];
+        for k in 0..20_000 {
+            values.push(k as f64 * 0.0003125);
+            values.push(k as f64 * 0.001);
+            values.push(k as f64 / 1024.0);
+        }
+        for _ in 0..400_000 {
+            let unit = (next() >> 11) as f64 / (1u64 << 53) as f64;
+            let exp = (next() % 16) as i32 - 9;
+            values.push(unit * 10f64.powi(exp));
+            // dyadic numbers: exact ties
+            values.push((next() % (1 << 30)) as f64 / (1u64 << (next() % 30)) as f64);
+        }
+        for x in values {
+            assert_eq!(fixed::<6>(x), format!("{x:.6}"), "{x:?}");
+            assert_eq!(fixed::<3>(x), format!("{x:.3}"), "{x:?}");
+            assert_eq!(fixed::<1>(x), format!("{x:.1}"), "{x:?}");
+            assert_eq!(fixed::<0>(x), format!("{x:.0}"), "{x:?}");
+            assert_eq!(fixed::<9>(x), format!("{x:.9}"), "{x:?}");
+        }
+    }
+
+    /// Integers as `{v}` and `{v:w}`.
+    #[test]
+    fn integers_match_the_standard_library() {
+        for v in [0u64, 7, 10, 99, 100, 12345, u64::MAX] {
+            for w in [0, 2, 4, 25] {
+                let mut text = Vec::new();
+                push_integer(&mut text, v, w);
+                assert_eq!(String::from_utf8(text).unwrap(), format!("{v:w$}"));
+            }
+        }
     }
 
     /// The text equals the standard library's for random numbers over the
@@ -389,6 +606,13 @@ mod tests {
         for x in values {
             assert_eq!(format!("{}", Sci::<3>(x)), format!("{x:.3e}"), "{x:?}");
             assert_eq!(format!("{}", Sci::<1>(x)), format!("{x:.1e}"), "{x:?}");
+            let mut bytes = Vec::new();
+            Sci::<3>(x).push_bytes(&mut bytes);
+            Shortest(x).push_bytes(&mut bytes);
+            let mut text = String::new();
+            Sci::<3>(x).push_to(&mut text);
+            Shortest(x).push_to(&mut text);
+            assert_eq!(bytes, text.as_bytes(), "{x:?}");
             // the precisions of the result files
             for (text, std) in [
                 (sci::<6>(x), format!("{x:.6e}")),

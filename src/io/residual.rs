@@ -19,6 +19,7 @@
 
 use std::fmt;
 
+use super::line::Line;
 use super::number::Sci;
 use crate::analysis::newton::ConvergenceNorms;
 
@@ -102,6 +103,16 @@ pub fn load_scale(norms: &ConvergenceNorms, length: f64) -> f64 {
 /// [`Reported`] in the log, `P` digits after the point.
 #[derive(Clone, Copy, Debug)]
 pub struct Shown<const P: usize>(pub Reported);
+
+impl<const P: usize> Shown<P> {
+    /// Appends the report to `line`.
+    pub fn push_to(self, line: &mut Line) {
+        match self.0 {
+            Reported::Ratio(r) => line.sci::<P>(r),
+            Reported::RoundOff => line.text("round-off"),
+        };
+    }
+}
 
 impl<const P: usize> fmt::Display for Shown<P> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -204,5 +215,10 @@ mod tests {
         let none = norms(1e-300, 2e-300, 0.0, 0.0, 0.5);
         assert_eq!(Reported::of(&none, 1.0), Reported::Ratio(0.5));
         assert_eq!(format!("{}", Shown::<3>(Reported::Ratio(0.5))), "5.000e-1");
+        let mut line = Line::default();
+        Shown::<3>(Reported::Ratio(0.5)).push_to(&mut line);
+        line.text(" ");
+        Shown::<1>(Reported::RoundOff).push_to(&mut line);
+        assert_eq!(line.bytes(), b"5.000e-1 round-off");
     }
 }

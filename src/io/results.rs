@@ -41,7 +41,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::number::{Sci, Shortest};
+use super::number::{push_integer, Sci, Shortest};
 use super::vtk;
 use crate::analysis::{
     AnalysisSettings, ContactKind, DynamicOutcome, Energies, IncrementInfo, LatchEventKind,
@@ -737,8 +737,9 @@ struct CsvFile {
     file: File,
     /// Length of the file after the last settled step.
     settled: u64,
-    /// Rows of the step being written.
-    pending: String,
+    /// Rows of the step being written (text, kept as bytes: the numbers
+    /// are written into it as bytes).
+    pending: Vec<u8>,
 }
 
 impl CsvFile {
@@ -751,13 +752,13 @@ impl CsvFile {
             path,
             file,
             settled: line.len() as u64,
-            pending: String::new(),
+            pending: Vec::new(),
         })
     }
 
     fn append(&mut self) -> io::Result<()> {
         self.file
-            .write_all(self.pending.as_bytes())
+            .write_all(&self.pending)
             .map_err(|e| file_error(&self.path, e))
     }
 
@@ -1211,7 +1212,8 @@ impl ResultWriter {
             row.rate_after,
             row.impulse,
             row.energy_lost
-        );
+        )
+        .into_bytes();
         match m.events.append() {
             Ok(()) => {
                 m.events.settle();
@@ -1247,28 +1249,28 @@ impl ResultWriter {
         state: &State,
         residual: &[f64],
     ) {
-        use std::fmt::Write as _;
         let t = info.time;
         // `step,time,` of every row
-        let mut lead = String::new();
-        let _ = write!(lead, "{step},");
-        Sci::<12>(t).push_to(&mut lead);
-        lead.push(',');
+        let mut lead = Vec::new();
+        push_integer(&mut lead, step as u64, 0);
+        lead.push(b',');
+        Sci::<12>(t).push_bytes(&mut lead);
+        lead.push(b',');
         for &i in &self.node_order {
             let x = state.x[i];
             let u = x - model.reference_x[i];
             let q = state.q[i].quaternion();
             let w = &mut self.nodes.pending;
-            w.push_str(&lead);
-            let _ = write!(w, "{}", model.node_ids[i]);
+            w.extend_from_slice(&lead);
+            push_integer(w, model.node_ids[i], 0);
             push_values::<12>(w, &[x.x, x.y, x.z, u.x, u.y, u.z]);
             // the quaternion to the last digit: it reads back to the same
             // unit quaternion
             for c in [q.w, q.i, q.j, q.k] {
-                w.push(',');
-                Shortest(c).push_to(w);
+                w.push(b',');
+                Shortest(c).push_bytes(w);
             }
-            w.push('\n');
+            w.push(b'\n');
         }
         let ctx = model.context(t, Need::RESIDUAL);
         // the state moved along its velocities, for the rates
@@ -1296,20 +1298,21 @@ impl ResultWriter {
                     row[c] = v;
                 }
                 let w = &mut table.file.pending;
-                w.push_str(&lead);
-                let _ = write!(w, "{}", e.id());
+                w.extend_from_slice(&lead);
+                push_integer(w, e.id(), 0);
                 if table.kind == ElementKind::Joint {
                     let t = e.as_joint().map_or("", |j| j.joint_type().name());
-                    let _ = write!(w, ",{t}");
+                    w.push(b',');
+                    w.extend_from_slice(t.as_bytes());
                 }
                 for (v, name) in row.iter().zip(&table.columns) {
-                    w.push(',');
+                    w.push(b',');
                     if INTEGER_RESULTS.contains(name) && v.is_finite() {
                         // a state or a side: 0, 1, −1
                         let _ = write!(w, "{}", v.round() as i64);
                     } else if !v.is_nan() {
                         // + 0.0: a load −f of f = 0 is written 0, not −0
-                        Sci::<9>(*v + 0.0).push_to(w);
+                        Sci::<9>(*v + 0.0).push_bytes(w);
                     }
                 }
                 if table.rates > 0 {
@@ -1325,13 +1328,13 @@ impl ResultWriter {
                         }
                     }
                     for v in row_rates.iter() {
-                        w.push(',');
+                        w.push(b',');
                         if !v.is_nan() {
-                            Sci::<9>(*v + 0.0).push_to(w);
+                            Sci::<9>(*v + 0.0).push_bytes(w);
                         }
                     }
                 }
-                w.push('\n');
+                w.push(b'\n');
             }
         }
         if let Some(m) = self.motion.as_mut() {
@@ -1347,11 +1350,11 @@ impl ResultWriter {
                 let w = r * Vec3::new(v[3], v[4], v[5]);
                 let dw = r * Vec3::new(a[3], a[4], a[5]);
                 let out = &mut m.velocities.pending;
-                out.push_str(&lead);
-                let _ = write!(out, "{}", model.node_ids[i]);
+                out.extend_from_slice(&lead);
+                push_integer(out, model.node_ids[i], 0);
                 push_values::<12>(out, &[v[0], v[1], v[2], w.x, w.y, w.z]);
                 push_values::<9>(out, &[a[0], a[1], a[2], dw.x, dw.y, dw.z]);
-                out.push('\n');
+                out.push(b'\n');
             }
             match (self.moving, &self.energies) {
                 (true, Some(e)) => {
@@ -1391,10 +1394,10 @@ impl ResultWriter {
                 );
                 let m = so3::matrix(&state.q[i]) * m_mat;
                 let out = &mut file.pending;
-                out.push_str(&lead);
-                let _ = write!(out, "{}", model.node_ids[i]);
+                out.extend_from_slice(&lead);
+                push_integer(out, model.node_ids[i], 0);
                 push_values::<9>(out, &[f.x, f.y, f.z, m.x, m.y, m.z]);
-                out.push('\n');
+                out.push(b'\n');
             }
         }
         let _ = writeln!(
@@ -1458,10 +1461,10 @@ impl ResultWriter {
 
 /// Appends `,v` for every value, with `P` digits after the point
 /// (`{:.Pe}`).
-fn push_values<const P: usize>(out: &mut String, values: &[f64]) {
+fn push_values<const P: usize>(out: &mut Vec<u8>, values: &[f64]) {
     for &v in values {
-        out.push(',');
-        Sci::<P>(v).push_to(out);
+        out.push(b',');
+        Sci::<P>(v).push_bytes(out);
     }
 }
 

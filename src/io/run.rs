@@ -40,7 +40,7 @@
 //! The library never prints: what a person should see goes to a
 //! [`Console`], which the caller provides.
 
-use std::fmt::Write as _;
+use std::borrow::Cow;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -70,7 +70,7 @@ use crate::state::State;
 
 mod modal;
 
-use super::number::Sci;
+use super::line::Line;
 use super::residual::{Reported, Shown};
 
 /// What a person watching the run sees. Every method has an empty
@@ -463,13 +463,22 @@ impl LogFile {
     }
 
     fn line(&mut self, text: &str) {
-        self.write_line(format_args!("{text}"));
+        self.write(text.as_bytes());
     }
 
-    /// A line formatted straight into the file's buffer.
-    fn write_line(&mut self, line: std::fmt::Arguments<'_>) {
+    /// A line built as bytes ([`Line`]).
+    fn write_bytes(&mut self, line: &Line) {
+        self.write(line.bytes());
+    }
+
+    /// `line` and its end, copied into the file's buffer.
+    fn write(&mut self, line: &[u8]) {
         if self.error.is_none() {
-            if let Err(e) = writeln!(self.file, "{line}") {
+            let written = self
+                .file
+                .write_all(line)
+                .and_then(|()| self.file.write_all(b"\n"));
+            if let Err(e) = written {
                 self.error = Some(file_error(&self.path, e));
             }
         }
@@ -579,8 +588,9 @@ pub struct Recorder {
     stops: Vec<StopWatch>,
     /// The largest loads of the latches, stops and contacts over the run.
     peaks: PeakLoads,
-    /// The line of an increment, its buffer kept from step to step.
-    text: String,
+    /// The line of an iteration or increment, its buffer kept from line
+    /// to line.
+    text: Line,
     /// The band crossings of spring latches written to `events.csv` by
     /// the running analysis: engages, disengages, rearms.
     crossings: [usize; 3],
@@ -1002,7 +1012,7 @@ impl Recorder {
             latches: Vec::new(),
             stops: Vec::new(),
             peaks: PeakLoads::of(model),
-            text: String::new(),
+            text: Line::default(),
             crossings: [0; 3],
         };
         let analyses = if plan.len() > 1 {
@@ -1111,12 +1121,16 @@ impl Recorder {
         self.increment_offset += end.increments;
     }
 
-    /// `info` numbered on across the analyses of the run.
-    fn renumbered(&self, info: &IncrementInfo) -> IncrementInfo {
-        IncrementInfo {
+    /// `info` numbered on across the analyses of the run (a copy only
+    /// after the first analysis).
+    fn renumbered<'a>(&self, info: &'a IncrementInfo) -> Cow<'a, IncrementInfo> {
+        if self.increment_offset == 0 {
+            return Cow::Borrowed(info);
+        }
+        Cow::Owned(IncrementInfo {
             increment: info.increment + self.increment_offset,
             ..info.clone()
-        }
+        })
     }
 
     /// Stops the run when `stop` is requested.
@@ -1678,25 +1692,38 @@ impl Observer for Recorder {
         let n = &info.norms;
         let reported = Reported::of(n, self.length_scale);
         self.reported.push((n.relative_residual, reported));
-        self.log.write_line(format_args!(
-            "    {} {} iteration {}: |r_F| {} (flux {})  |r_M| {} (flux {})  |r_C| {}  relative {}  max|c| {}  max|dx| {}  max|dθ| {}",
-            if self.current.kind == "dynamic" {
-                "step"
-            } else {
-                "increment"
-            },
-            info.increment + self.increment_offset,
-            info.iteration,
-            Sci::<3>(n.residual_force),
-            Sci::<3>(n.flux_force),
-            Sci::<3>(n.residual_moment),
-            Sci::<3>(n.flux_moment),
-            Sci::<3>(n.residual_coordinate),
-            Shown::<3>(reported),
-            Sci::<3>(n.residual_constraint),
-            Sci::<3>(n.displacement_correction),
-            Sci::<3>(n.rotation_correction),
-        ));
+        // `    step 3 iteration 1: |r_F| 1.323e-10 (flux 9.007e2)  …`
+        let word = if self.current.kind == "dynamic" {
+            "step"
+        } else {
+            "increment"
+        };
+        let line = self.text.clear();
+        line.text("    ")
+            .text(word)
+            .text(" ")
+            .int(info.increment + self.increment_offset)
+            .text(" iteration ")
+            .int(info.iteration)
+            .text(": |r_F| ")
+            .sci::<3>(n.residual_force)
+            .text(" (flux ")
+            .sci::<3>(n.flux_force)
+            .text(")  |r_M| ")
+            .sci::<3>(n.residual_moment)
+            .text(" (flux ")
+            .sci::<3>(n.flux_moment)
+            .text(")  |r_C| ")
+            .sci::<3>(n.residual_coordinate)
+            .text("  relative ");
+        Shown::<3>(reported).push_to(line);
+        line.text("  max|c| ")
+            .sci::<3>(n.residual_constraint)
+            .text("  max|dx| ")
+            .sci::<3>(n.displacement_correction)
+            .text("  max|dθ| ")
+            .sci::<3>(n.rotation_correction);
+        self.log.write_bytes(&self.text);
     }
 
     fn increment(
@@ -1729,7 +1756,7 @@ impl Observer for Recorder {
         // written already: its equilibrium there is logged, not written
         let restart =
             info.increment == 0 && self.current.index > 0 && self.writer.output_steps() > 0;
-        let info = &self.renumbered(info);
+        let info = &*self.renumbered(info);
         self.peaks.sample(model, state, info.increment);
         if info.output {
             self.peaks.sample_recovered(model, state, info.increment);
@@ -1761,47 +1788,49 @@ impl Observer for Recorder {
             }
             _ => false,
         };
-        // the line in a buffer kept from step to step
-        let mut text = std::mem::take(&mut self.text);
-        text.clear();
-        let _ = write!(
-            text,
-            "{word} {:4}  t = {:.6}  {size} = {}  iterations {:2}  ",
-            info.increment,
-            info.time,
-            Sci::<3>(info.step),
-            info.iterations,
-        );
+        // `step    1  t = 0.000313  h = 3.125e-4  iterations  1  …`, in
+        // the buffer kept from line to line
+        let line = self.text.clear();
+        line.text(word)
+            .text(" ")
+            .padded(info.increment, 4)
+            .text("  t = ")
+            .fixed::<6>(info.time)
+            .text("  ")
+            .text(size)
+            .text(" = ")
+            .sci::<3>(info.step)
+            .text("  iterations ")
+            .padded(info.iterations, 2)
+            .text("  ");
         if values.is_empty() {
             // the start of a dynamic analysis: its state, no equations
             // solved for a step
-            text.push_str("(the initial state)");
+            line.text("(the initial state)");
         } else {
-            let _ = write!(
-                text,
-                "{what}{}: ",
-                if stopped {
-                    " (stopped at round-off)"
-                } else {
-                    ""
-                }
-            );
+            line.text(what);
+            if stopped {
+                line.text(" (stopped at round-off)");
+            }
+            line.text(": ");
         }
         for (k, r) in values.iter().enumerate() {
-            let sep = if k == 0 { "" } else { " " };
+            if k > 0 {
+                line.text(" ");
+            }
             // the report of the iteration that gave this residual (the
             // same value), residuals at round-off told so
             match self.reported.get(k) {
                 Some(&(value, reported)) if !kinematic && value.to_bits() == r.to_bits() => {
-                    let _ = write!(text, "{sep}{}", Shown::<1>(reported));
+                    Shown::<1>(reported).push_to(line);
                 }
                 _ => {
-                    let _ = write!(text, "{sep}{}", Sci::<1>(*r));
+                    line.sci::<1>(*r);
                 }
             }
         }
-        self.line(&text);
-        self.text = text;
+        self.log.write_bytes(&self.text);
+        self.console.line(self.text.as_text());
         self.console.progress(info);
         if restart {
             return self.log.flush();

@@ -142,11 +142,20 @@ impl Document {
 
     /// Adds a `DataArray` of `values` with `components` per tuple.
     fn array<T: Value>(&mut self, name: &str, components: usize, values: &[T]) {
-        let _ = write!(
-            self.xml,
-            "        <DataArray type=\"{}\" Name=\"{name}\" NumberOfComponents=\"{components}\"",
-            T::TYPE
-        );
+        // `<DataArray type="Float64" Name="x" NumberOfComponents="3"`,
+        // piece by piece (no `core::fmt`: a grid per output step)
+        let mut count = itoa::Buffer::new();
+        for piece in [
+            "        <DataArray type=\"",
+            T::TYPE,
+            "\" Name=\"",
+            name,
+            "\" NumberOfComponents=\"",
+            count.format(components),
+            "\"",
+        ] {
+            self.xml.push_str(piece);
+        }
         match self.encoding {
             Encoding::Ascii => {
                 self.xml.push_str(" format=\"ascii\">\n         ");
@@ -160,11 +169,14 @@ impl Document {
                 self.xml.push_str("\n        </DataArray>\n");
             }
             Encoding::Binary => {
-                let _ = writeln!(
-                    self.xml,
-                    " format=\"appended\" offset=\"{}\"/>",
-                    self.appended.len()
-                );
+                let mut offset = itoa::Buffer::new();
+                for piece in [
+                    " format=\"appended\" offset=\"",
+                    offset.format(self.appended.len()),
+                    "\"/>\n",
+                ] {
+                    self.xml.push_str(piece);
+                }
                 self.raw.clear();
                 for v in values {
                     v.push_le(&mut self.raw);

@@ -103,6 +103,10 @@ def _node(nid, x, velocity=None, angular_velocity=None, dynamic=True):
     return s
 
 
+# No VTK files: Exudyn writes no solution file either (its sensors are kept
+# in memory); unfold still writes its CSV files, nodes.csv among them.
+_OUTPUT = "[output]\nvtk = false\n"
+
 # Gravity is constant in time: the default curve of `[gravity]` is the ramp f(t) = t.
 _CONSTANT_CURVE = '[[curves]]\nname = "constant"\nfunction = "linear"\noffset = 1.0\nslope = 0.0\n'
 
@@ -137,6 +141,7 @@ def pendulum_toml(n, h, p=Pendulum, dynamic=True, cutbacks=False):
             "axis = [0.0, 1.0, 0.0]\n",
             _CONSTANT_CURVE,
             f'[gravity]\nacceleration = [0.0, 0.0, {-GRAVITY!r}]\ncurve = "constant"\n',
+            _OUTPUT,
         ]
     )
 
@@ -162,6 +167,7 @@ def top_toml(h, t=HeavyTop, dynamic=True):
             "position = [0.0, 0.0, 0.0]\n",
             _CONSTANT_CURVE,
             f'[gravity]\nacceleration = [0.0, 0.0, {-GRAVITY!r}]\ncurve = "constant"\n',
+            _OUTPUT,
         ]
     )
 

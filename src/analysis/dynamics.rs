@@ -1226,7 +1226,8 @@ impl DynamicAnalysis {
     /// The iteration matrix `S` (D7–D8) at the last converged state, for
     /// a step of size `h`, with its constraint rows and multiplier columns
     /// scaled (D8) if `scaled`: a copy in equation numbering, for studies
-    /// of its conditioning.
+    /// of its conditioning. Its rotation columns are those of the material
+    /// scheme (D7), whichever scheme the analysis runs (§15.9).
     pub fn iteration_matrix(&mut self, h: f64, scaled: bool) -> Option<SparseMatrix> {
         let run = self.run.as_mut()?;
         let model = &*self.model;

@@ -351,41 +351,52 @@ impl<const P: usize> fmt::Display for Sci<P> {
 }
 
 impl Shortest {
-    /// Appends the text to `out`, as bytes.
-    pub fn push_bytes(self, out: &mut Vec<u8>) {
+    /// The text into `buf` and its length, `None` where the standard
+    /// library must write it (not finite).
+    fn text(self, buf: &mut [u8; TEXT]) -> Option<usize> {
         let x = self.0;
         if !x.is_finite() {
-            use std::io::Write as _;
-            let _ = write!(out, "{x:e}");
-            return;
+            return None;
         }
         let (m, n, e) = if x == 0.0 {
             (0, 1, 0)
         } else {
             shortest(x.abs())
         };
+        Some(write_scientific(
+            buf,
+            x.is_sign_negative(),
+            m,
+            n as usize,
+            e,
+        ))
+    }
+
+    /// Appends the text to `out`, as bytes.
+    pub fn push_bytes(self, out: &mut Vec<u8>) {
         let mut buf = [0u8; TEXT];
-        let len = write_scientific(&mut buf, x.is_sign_negative(), m, n as usize, e);
-        push_text(out, &buf, len);
+        match self.text(&mut buf) {
+            Some(n) => push_text(out, &buf, n),
+            None => {
+                use std::io::Write as _;
+                let x = self.0;
+                let _ = write!(out, "{x:e}");
+            }
+        }
     }
 
     /// Appends the text to `out`.
     pub fn push_to(self, out: &mut String) {
-        let x = self.0;
-        if !x.is_finite() {
-            use std::fmt::Write as _;
-            let _ = write!(out, "{x:e}");
-            return;
-        }
-        let (m, n, e) = if x == 0.0 {
-            (0, 1, 0)
-        } else {
-            shortest(x.abs())
-        };
         let mut buf = [0u8; TEXT];
-        let len = write_scientific(&mut buf, x.is_sign_negative(), m, n as usize, e);
-        // ASCII only
-        out.push_str(std::str::from_utf8(&buf[..len]).unwrap_or_default());
+        match self.text(&mut buf) {
+            // ASCII only
+            Some(n) => out.push_str(std::str::from_utf8(&buf[..n]).unwrap_or_default()),
+            None => {
+                use std::fmt::Write as _;
+                let x = self.0;
+                let _ = write!(out, "{x:e}");
+            }
+        }
     }
 }
 
